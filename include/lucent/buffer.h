@@ -1,0 +1,100 @@
+// Buffers (typed 1D/2D/3D arrays shared by host and programs) and texture samplers.
+#pragma once
+
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "lucent/device/reflect.h"
+#include "lucent/error.h"
+#include "lucent/object.h"
+
+namespace lucent {
+
+enum class BufferType { kInput, kOutput, kInputOutput };
+const char* buffer_type_name(BufferType type);
+
+/// A typed array. Element type is fixed at creation; map<T>() checks it.
+class Buffer : public ContextObject {
+public:
+    Buffer(detail::ContextShared* owner, std::string name, BufferType type,
+           const TypeInfo& element, unsigned dimensionality, uint3 size);
+
+    BufferType type() const { return m_type; }
+    const TypeInfo& element() const { return *m_element; }
+    unsigned dimensionality() const { return m_dimensionality; }
+    uint3 size() const { return m_size; }
+    size_t count() const { return size_t(m_size.x) * m_size.y * m_size.z; }
+    std::string describe() const override;
+
+    /// Resize, keeping the dimensionality (unused dimensions must be 1). Contents are zeroed.
+    void resize(unsigned width, unsigned height = 1, unsigned depth = 1);
+
+    /// Host access to the elements; T must be the element type the buffer was created with.
+    template <class T>
+    T* map() {
+        check_element(type_info_of<T>());
+        m_mapped = true;
+        return reinterpret_cast<T*>(bytes());
+    }
+    template <class T>
+    const T* data() const {
+        check_element(type_info_of<T>());
+        return reinterpret_cast<const T*>(bytes());
+    }
+    /// Ends host access: programs see the new contents at the next launch.
+    void unmap();
+    /// Copy `values` in (sizes must match) — map, copy, unmap in one call.
+    template <class T>
+    void upload(const std::vector<T>& values) {
+        if (values.size() != count())
+            throw Error(describe() + ": upload of " + std::to_string(values.size()) +
+                        " elements into a buffer of " + std::to_string(count()) +
+                        "; resize the buffer first");
+        std::memcpy(map<T>(), values.data(), values.size() * sizeof(T));
+        unmap();
+    }
+
+    void* raw() { return bytes(); }
+    const void* raw() const { return bytes(); }
+    uint64_t version() const { return m_version; }
+
+private:
+    void check_element(const TypeInfo& requested) const;
+    struct alignas(16) Block {
+        unsigned char bytes[16];
+    };
+    unsigned char* bytes() { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
+    const unsigned char* bytes() const { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
+    BufferType m_type;
+    const TypeInfo* m_element;
+    unsigned m_dimensionality;
+    uint3 m_size;
+    std::vector<Block> m_blocks;  // 16-byte aligned backing store
+    bool m_mapped = false;
+    uint64_t m_version = 1;
+};
+
+/// A 2D float4 texture with filtering and wrap modes, read by programs via TextureView.
+class TextureSampler : public ContextObject {
+public:
+    using ContextObject::ContextObject;
+    std::string describe() const override;
+
+    /// The texels: a 2D Buffer of float4.
+    void set_buffer(std::shared_ptr<Buffer> texels);
+    void set_wrap_mode(WrapMode u, WrapMode v);
+    void set_filter(FilterMode filter);
+
+    const std::shared_ptr<Buffer>& buffer() const { return m_buffer; }
+    WrapMode wrap_u() const { return m_wrap_u; }
+    WrapMode wrap_v() const { return m_wrap_v; }
+    FilterMode filter() const { return m_filter; }
+
+private:
+    std::shared_ptr<Buffer> m_buffer;
+    WrapMode m_wrap_u = WrapMode::kRepeat, m_wrap_v = WrapMode::kRepeat;
+    FilterMode m_filter = FilterMode::kLinear;
+};
+
+}  // namespace lucent

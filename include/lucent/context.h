@@ -1,0 +1,138 @@
+// The Context: owns every object, the entry points and ray types, and launches.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lucent/buffer.h"
+#include "lucent/nodes.h"
+#include "lucent/program.h"
+#include "lucent/variables.h"
+
+namespace lucent {
+
+enum class BackendKind { kAuto, kCpu, kCuda };
+
+struct ContextOptions {
+    BackendKind backend = BackendKind::kAuto;
+    unsigned threads = 0;  // CPU backend workers; 0 = one per core
+};
+
+/// A ray type: its name, the payload type every program handling it must use, and whether
+/// rays of this type need a closest-hit program on every material they can reach
+/// (false for visibility-only rays that work through any-hit and miss).
+struct RayTypeDesc {
+    std::string name;
+    const TypeInfo* payload = nullptr;
+    bool expects_closest_hit = true;
+};
+
+constexpr int kAllExceptions = -1;
+
+/// What the host learns after a launch: exception counts per code with the first launch
+/// index that raised each, and how long each stage took.
+struct LaunchReport {
+    struct ExceptionSummary {
+        uint64_t count = 0;
+        uint3 first_index{0, 0, 0};
+    };
+    std::map<int, ExceptionSummary> exceptions;
+    double compile_ms = 0;  // validation, variable resolution, record packing
+    double accel_ms = 0;    // acceleration builds and refits
+    double launch_ms = 0;   // running the programs
+    bool recompiled = false;
+    uint64_t exception_count() const;
+    /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
+    std::string summary() const;
+};
+
+/// Human name of an exception code ("stack overflow", "user exception 0x401").
+std::string exception_name(int code);
+
+class Context : public VariableScope {
+public:
+    explicit Context(ContextOptions options = {});
+    ~Context() override;
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    /// "cpu (2 threads)" or "cuda (...)": the backend that runs launches.
+    std::string backend_name() const;
+    std::string scope_name() const override { return "Context"; }
+
+    // ---- entry points and ray types ------------------------------------------
+    void set_entry_point_count(unsigned count);
+    unsigned entry_point_count() const;
+    void set_ray_generation_program(unsigned entry, std::shared_ptr<Program> program);
+    void set_exception_program(unsigned entry, std::shared_ptr<Program> program);
+    std::shared_ptr<Program> ray_generation_program(unsigned entry) const;
+    std::shared_ptr<Program> exception_program(unsigned entry) const;
+
+    /// Declares ray type `index` (ray types are 0, 1, ... with no gaps).
+    template <class Payload>
+    void set_ray_type(unsigned index, std::string name, bool expects_closest_hit = true) {
+        set_ray_type(index, RayTypeDesc{std::move(name), &type_info_of<Payload>(),
+                                        expects_closest_hit});
+    }
+    void set_ray_type(unsigned index, RayTypeDesc desc);
+    unsigned ray_type_count() const;
+    const RayTypeDesc& ray_type(unsigned index) const;
+    void set_miss_program(unsigned ray_type, std::shared_ptr<Program> program);
+    std::shared_ptr<Program> miss_program(unsigned ray_type) const;
+
+    // ---- execution settings ---------------------------------------------------
+    /// Deepest trace nesting allowed (ray generation's trace is depth 1).
+    void set_max_recursion_depth(unsigned depth);
+    unsigned max_recursion_depth() const;
+    /// Turn one exception code (or kAllExceptions) on or off. All are off by default.
+    void set_exception_enabled(int code, bool enabled);
+    bool exception_enabled(int code) const;
+    void set_print_enabled(bool enabled);
+    bool print_enabled() const;
+    /// Only this launch index prints (-1 in a coordinate means any).
+    void set_print_launch_index(int x, int y = -1, int z = -1);
+
+    // ---- object creation ------------------------------------------------------
+    std::shared_ptr<Program> create_program(std::string_view registered_name);
+    std::shared_ptr<Program> create_program(const ProgramDesc& desc);
+    template <class T>
+    std::shared_ptr<Buffer> create_buffer(BufferType type, unsigned width, unsigned height = 0,
+                                          unsigned depth = 0) {
+        return create_buffer(type, type_info_of<T>(), width, height, depth);
+    }
+    /// Width only: 1D; width and height: 2D; all three: 3D.
+    std::shared_ptr<Buffer> create_buffer(BufferType type, const TypeInfo& element,
+                                          unsigned width, unsigned height = 0,
+                                          unsigned depth = 0);
+    std::shared_ptr<TextureSampler> create_texture_sampler();
+    std::shared_ptr<Acceleration> create_acceleration(Builder builder = Builder::kBinnedSah);
+    std::shared_ptr<Group> create_group();
+    std::shared_ptr<GeometryGroup> create_geometry_group();
+    std::shared_ptr<Transform> create_transform();
+    std::shared_ptr<Selector> create_selector();
+    std::shared_ptr<GeometryInstance> create_geometry_instance();
+    std::shared_ptr<Geometry> create_geometry();
+    std::shared_ptr<GeometryTriangles> create_geometry_triangles();
+    std::shared_ptr<Material> create_material();
+
+    // ---- compile and launch ---------------------------------------------------
+    /// Checks everything a launch would (any entry point), without launching; throws Error.
+    void validate();
+    void launch(unsigned entry, unsigned width);
+    void launch(unsigned entry, unsigned width, unsigned height);
+    void launch(unsigned entry, unsigned width, unsigned height, unsigned depth);
+    /// Exceptions and timings of the most recent launch.
+    const LaunchReport& last_launch() const;
+
+    struct Impl;
+
+protected:
+    void variables_changed() override;
+
+private:
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace lucent

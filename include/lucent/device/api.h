@@ -1,0 +1,145 @@
+// The device API: what a program may call. Each backend implements the
+// non-template functions (the CPU backend in src/cpu/device_runtime.cpp).
+#pragma once
+
+#include "lucent/device/types.h"
+
+#if !LUCENT_GPU_CODE
+#include <cstdio>
+#endif
+
+namespace lucent {
+namespace detail {
+/// One distinct address per C++ type: identifies payload types without RTTI.
+template <class T>
+struct TypeTag {
+    static constexpr char id = 0;
+};
+void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
+[[noreturn]] void raise_exception(int code, unsigned detail);
+bool print_enabled_here();
+void print_text(const char* text);
+}  // namespace detail
+
+/// Index of this invocation in the launch grid.
+uint3 launch_index();
+/// Size of the launch grid (unused dimensions are 1).
+uint3 launch_size();
+/// The ray being traced, in the space of the current program (object space in
+/// intersection, any-hit and visit programs below a Transform; world space elsewhere).
+const Ray& current_ray();
+/// Parametric distance of the current hit (closest so far inside intersection programs).
+float t_hit();
+/// Primitive index of the current hit, or of the primitive being intersected.
+unsigned primitive_index();
+
+/// Trace a ray against the graph below `root`; the payload type must match the ray type's.
+template <class Payload>
+void trace(Handle root, const Ray& ray, Payload& payload) {
+    detail::trace_erased(root, ray, &payload, &detail::TypeTag<Payload>::id);
+}
+
+/// In an intersection program: is t inside the ray's current interval?
+bool potential_intersection(float t);
+/// In an intersection program, after potential_intersection(t) returned true and the
+/// attributes were written: commit the hit with this material index (runs any-hit).
+/// Returns false when any-hit ignored it.
+bool report_intersection(unsigned material_index);
+/// In an any-hit program: discard this intersection and go on traversing.
+void ignore_intersection();
+/// In an any-hit program: accept this intersection and stop traversal of this ray.
+void terminate_ray();
+
+/// Object/world transforms of the current hit or traversal position.
+float3 object_to_world_point(float3 p);
+float3 object_to_world_vector(float3 v);
+float3 object_to_world_normal(float3 n);
+float3 world_to_object_point(float3 p);
+float3 world_to_object_vector(float3 v);
+float3 world_to_object_normal(float3 n);
+
+/// Raise a user exception: code must be >= kUserExceptionBase. Ends this launch index
+/// and calls the entry point's exception program.
+[[noreturn]] inline void throw_exception(int code, unsigned detail = 0) {
+    detail::raise_exception(code < kUserExceptionBase ? kUserExceptionBase : code, detail);
+}
+
+/// printf-style output, shown only when printing is enabled on the context (and, if
+/// a print launch index is set, only from that index).
+template <class... Args>
+void print(const char* format, Args... args) {
+#if LUCENT_GPU_CODE
+    printf(format, args...);
+#else
+    if (!detail::print_enabled_here()) return;
+    char text[1024];
+    if constexpr (sizeof...(Args) == 0) {
+        std::snprintf(text, sizeof text, "%s", format);
+    } else {
+        std::snprintf(text, sizeof text, format, args...);
+    }
+    detail::print_text(text);
+#endif
+}
+
+// ---- buffer access with bounds checks --------------------------------------
+template <class T>
+LUCENT_HD T& BufferView<T>::operator[](unsigned i) const {
+    if ((flags & kViewBoundsChecked) && i >= count())
+        detail::raise_exception(kExceptionBufferIndexOutOfBounds, i);
+    return data[i];
+}
+template <class T>
+LUCENT_HD T& BufferView<T>::operator[](uint2 i) const {
+    if ((flags & kViewBoundsChecked) && (i.x >= size.x || i.y >= size.y))
+        detail::raise_exception(kExceptionBufferIndexOutOfBounds, i.y * size.x + i.x);
+    return data[i.y * size.x + i.x];
+}
+template <class T>
+LUCENT_HD T& BufferView<T>::operator[](uint3 i) const {
+    if ((flags & kViewBoundsChecked) && (i.x >= size.x || i.y >= size.y || i.z >= size.z))
+        detail::raise_exception(kExceptionBufferIndexOutOfBounds,
+                                (i.z * size.y + i.y) * size.x + i.x);
+    return data[(i.z * size.y + i.y) * size.x + i.x];
+}
+
+// ---- textures ----------------------------------------------------------------
+namespace detail {
+LUCENT_HD inline int wrap_texel(int i, int n, WrapMode mode) {
+    switch (mode) {
+        case WrapMode::kClampToEdge: return i < 0 ? 0 : (i >= n ? n - 1 : i);
+        case WrapMode::kMirror: {
+            int period = 2 * n;
+            int m = i % period;
+            if (m < 0) m += period;
+            return m < n ? m : period - 1 - m;
+        }
+        case WrapMode::kRepeat:
+        default: {
+            int m = i % n;
+            return m < 0 ? m + n : m;
+        }
+    }
+}
+LUCENT_HD inline float4 fetch_texel(const TextureView& t, int x, int y) {
+    x = wrap_texel(x, int(t.width), t.wrap_u);
+    y = wrap_texel(y, int(t.height), t.wrap_v);
+    return t.texels[unsigned(y) * t.width + unsigned(x)];
+}
+}  // namespace detail
+
+/// Sample a texture at uv (texel centres at (i + 0.5) / size), bilinear or nearest.
+LUCENT_HD inline float4 tex2D(const TextureView& t, float2 uv) {
+    float x = uv.x * float(t.width) - 0.5f;
+    float y = uv.y * float(t.height) - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    int ix = int(fx), iy = int(fy);
+    if (t.filter == FilterMode::kNearest)
+        return detail::fetch_texel(t, int(floorf(x + 0.5f)), int(floorf(y + 0.5f)));
+    float ax = x - fx, ay = y - fy;
+    float4 a = detail::fetch_texel(t, ix, iy), b = detail::fetch_texel(t, ix + 1, iy);
+    float4 c = detail::fetch_texel(t, ix, iy + 1), d = detail::fetch_texel(t, ix + 1, iy + 1);
+    return (a * (1 - ax) + b * ax) * (1 - ay) + (c * (1 - ax) + d * ax) * ay;
+}
+
+}  // namespace lucent

@@ -1,0 +1,128 @@
+// Plain types that programs see: rays, node handles, buffer and texture views,
+// boxes, exception codes. All are POD with the same layout on every backend.
+#pragma once
+
+#include "lucent/device/vector_math.h"
+
+namespace lucent {
+
+constexpr float kInfinity = 1e30f;  // "no upper bound" for ray intervals
+
+/// A ray: origin, direction (not necessarily unit), ray type and the interval [tmin, tmax].
+struct Ray {
+    float3 origin;
+    float tmin;
+    float3 direction;
+    float tmax;
+    unsigned ray_type;
+};
+
+LUCENT_HD inline Ray make_ray(float3 origin, float3 direction, unsigned ray_type, float tmin,
+                              float tmax = kInfinity) {
+    Ray r;
+    r.origin = origin;
+    r.direction = direction;
+    r.tmin = tmin;
+    r.tmax = tmax;
+    r.ray_type = ray_type;
+    return r;
+}
+
+/// A node of the compiled scene graph that a program may trace against.
+struct Handle {
+    unsigned index;
+};
+constexpr unsigned kInvalidHandle = 0xffffffffu;
+
+/// Axis-aligned box, written by bounding-box programs.
+struct Aabb {
+    float3 lo;
+    float3 hi;
+};
+
+/// Affine 4x3 matrix, row-major: rows are (m[0..3]), (m[4..7]), (m[8..11]).
+struct Matrix4x3 {
+    float m[12];
+};
+
+LUCENT_HD inline float3 transform_point(const Matrix4x3& a, float3 p) {
+    return make_float3(a.m[0] * p.x + a.m[1] * p.y + a.m[2] * p.z + a.m[3],
+                       a.m[4] * p.x + a.m[5] * p.y + a.m[6] * p.z + a.m[7],
+                       a.m[8] * p.x + a.m[9] * p.y + a.m[10] * p.z + a.m[11]);
+}
+LUCENT_HD inline float3 transform_vector(const Matrix4x3& a, float3 v) {
+    return make_float3(a.m[0] * v.x + a.m[1] * v.y + a.m[2] * v.z,
+                       a.m[4] * v.x + a.m[5] * v.y + a.m[6] * v.z,
+                       a.m[8] * v.x + a.m[9] * v.y + a.m[10] * v.z);
+}
+/// Normals transform by the inverse transpose: pass the *inverse* matrix here.
+LUCENT_HD inline float3 transform_normal_by_inverse(const Matrix4x3& inv, float3 n) {
+    return make_float3(inv.m[0] * n.x + inv.m[4] * n.y + inv.m[8] * n.z,
+                       inv.m[1] * n.x + inv.m[5] * n.y + inv.m[9] * n.z,
+                       inv.m[2] * n.x + inv.m[6] * n.y + inv.m[10] * n.z);
+}
+
+/// Engine exception codes; user codes start at kUserExceptionBase.
+enum ExceptionCode : int {
+    kExceptionStackOverflow = 1,
+    kExceptionBufferIndexOutOfBounds = 2,
+    kExceptionPayloadTypeMismatch = 3,
+    kExceptionInvalidHandle = 4,
+    kUserExceptionBase = 0x400,
+};
+
+/// What the exception program receives.
+struct ExceptionInfo {
+    int code;
+    uint3 launch_index;
+    unsigned detail;  // the out-of-range index, the depth reached, or 0
+};
+
+/// Attributes of the built-in triangles when no attribute program is bound:
+/// barycentrics (u, v) of vertices 1 and 2, and the object-space geometric normal.
+struct TriangleAttributes {
+    float2 barycentrics;
+    float3 geometric_normal;
+};
+
+/// Per-program flags packed into views by the scene compiler.
+enum ViewFlags : unsigned { kViewBoundsChecked = 1u };
+
+/// Typed view of a Buffer (1D, 2D or 3D) as a program sees it.
+template <class T>
+struct BufferView {
+    T* data;
+    uint3 size;     // unused dimensions are 1
+    unsigned flags; // kViewBoundsChecked when out-of-bounds exceptions are on
+
+    LUCENT_HD unsigned count() const { return size.x * size.y * size.z; }
+    LUCENT_HD T& operator[](unsigned i) const;
+    LUCENT_HD T& operator[](uint2 i) const;
+    LUCENT_HD T& operator[](uint3 i) const;
+    LUCENT_HD T* begin() const { return data; }
+    LUCENT_HD T* end() const { return data + count(); }
+};
+
+enum class WrapMode : unsigned { kRepeat = 0, kClampToEdge = 1, kMirror = 2 };
+enum class FilterMode : unsigned { kNearest = 0, kLinear = 1 };
+
+/// A 2D float4 texture as a program sees it (the host TextureSampler packs into this).
+struct TextureView {
+    const float4* texels;
+    unsigned width, height;
+    WrapMode wrap_u, wrap_v;
+    FilterMode filter;
+};
+
+/// A callable program bound through a variable: call it like a function.
+/// On the CPU it is a function pointer and the program's packed record.
+template <class Signature>
+struct Callable;
+template <class R, class... Args>
+struct Callable<R(Args...)> {
+    R (*fn)(const void* record, Args...);
+    const void* record;
+    LUCENT_HD R operator()(Args... args) const { return fn(record, args...); }
+};
+
+}  // namespace lucent

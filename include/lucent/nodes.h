@@ -1,0 +1,233 @@
+// The scene graph (OptiX paper §3.2): Group, GeometryGroup, Transform, Selector, and the
+// leaves GeometryInstance, Geometry, GeometryTriangles and Material; plus Acceleration.
+// Nodes may have several parents (instancing); any node may be the root of a trace.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "lucent/buffer.h"
+#include "lucent/object.h"
+#include "lucent/program.h"
+#include "lucent/variables.h"
+
+namespace lucent {
+
+enum class NodeKind { kGroup, kGeometryGroup, kTransform, kSelector };
+const char* node_kind_name(NodeKind kind);
+
+/// How an Acceleration builds its BVH.
+enum class Builder {
+    kBinnedSah,  // binned SAH (Wald 2007): best traversal, rebuilt when marked dirty
+    kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)
+};
+
+/// The acceleration structure of a Group or GeometryGroup.
+class Acceleration : public ContextObject {
+public:
+    using ContextObject::ContextObject;
+    std::string describe() const override;
+    void set_builder(Builder builder);
+    Builder builder() const { return m_builder; }
+    /// When on, a dirty acceleration whose primitive count is unchanged is refitted
+    /// (boxes updated bottom-up) instead of rebuilt: fast for animated vertices.
+    void set_refit(bool refit);
+    bool refit() const { return m_refit; }
+    /// Geometry below changed (e.g. vertices moved): rebuild or refit at the next launch.
+    void mark_dirty();
+    bool dirty() const { return m_dirty; }
+    void clear_dirty() { m_dirty = false; }
+
+private:
+    Builder m_builder = Builder::kBinnedSah;
+    bool m_refit = false;
+    bool m_dirty = true;
+};
+
+class Node : public ContextObject {
+public:
+    Node(detail::ContextShared* owner, std::string name, NodeKind kind)
+        : ContextObject(owner, std::move(name)), m_kind(kind) {}
+    NodeKind kind() const { return m_kind; }
+    std::string describe() const override;
+
+private:
+    NodeKind m_kind;
+};
+
+/// Child list shared by Group and Selector.
+class NodeWithChildren : public Node {
+public:
+    using Node::Node;
+    /// Appends a child; returns its index.
+    unsigned add_child(std::shared_ptr<Node> child);
+    void set_child(unsigned index, std::shared_ptr<Node> child);
+    void remove_child(unsigned index);
+    unsigned child_count() const { return unsigned(m_children.size()); }
+    const std::shared_ptr<Node>& child(unsigned index) const;
+    const std::vector<std::shared_ptr<Node>>& children() const { return m_children; }
+
+protected:
+    virtual void children_changed() { changed(); }
+    std::vector<std::shared_ptr<Node>> m_children;
+};
+
+/// Children of any node kind, under an acceleration structure (top of a two-level scene).
+class Group : public NodeWithChildren {
+public:
+    Group(detail::ContextShared* owner, std::string name, std::shared_ptr<Acceleration> accel)
+        : NodeWithChildren(owner, std::move(name), NodeKind::kGroup), m_accel(std::move(accel)) {}
+    const std::shared_ptr<Acceleration>& acceleration() const { return m_accel; }
+    void set_acceleration(std::shared_ptr<Acceleration> accel);
+
+protected:
+    void children_changed() override;
+
+private:
+    std::shared_ptr<Acceleration> m_accel;
+};
+
+/// Children chosen per ray by a visit program.
+class Selector : public NodeWithChildren {
+public:
+    Selector(detail::ContextShared* owner, std::string name)
+        : NodeWithChildren(owner, std::move(name), NodeKind::kSelector) {}
+    void set_visit_program(std::shared_ptr<Program> visit);
+    const std::shared_ptr<Program>& visit_program() const { return m_visit; }
+
+private:
+    std::shared_ptr<Program> m_visit;
+};
+
+/// One child moved by an affine 4x3 matrix (object to world).
+class Transform : public Node {
+public:
+    Transform(detail::ContextShared* owner, std::string name);
+    void set_child(std::shared_ptr<Node> child);
+    const std::shared_ptr<Node>& child() const { return m_child; }
+    /// Row-major 3x4 (the last row 0 0 0 1 is implied); `transpose` for column-major input.
+    void set_matrix(const float m[12], bool transpose = false);
+    void set_matrix(const Matrix4x3& m) { set_matrix(m.m); }
+    const Matrix4x3& matrix() const { return m_matrix; }
+
+private:
+    std::shared_ptr<Node> m_child;
+    Matrix4x3 m_matrix;
+};
+
+class Material;
+
+/// Common base of Geometry (custom primitives) and GeometryTriangles (built in).
+class GeometryBase : public ContextObject, public VariableScope {
+public:
+    using ContextObject::ContextObject;
+    virtual bool is_triangles() const = 0;
+    virtual unsigned primitive_count() const = 0;
+    std::string scope_name() const override { return describe(); }
+
+protected:
+    void variables_changed() override { changed(); }
+};
+
+/// Custom primitives: a bounding-box and an intersection program shared by all of them.
+class Geometry : public GeometryBase {
+public:
+    using GeometryBase::GeometryBase;
+    std::string describe() const override;
+    bool is_triangles() const override { return false; }
+    void set_primitive_count(unsigned count);
+    unsigned primitive_count() const override { return m_count; }
+    void set_bounding_box_program(std::shared_ptr<Program> program);
+    void set_intersection_program(std::shared_ptr<Program> program);
+    const std::shared_ptr<Program>& bounding_box_program() const { return m_bounds; }
+    const std::shared_ptr<Program>& intersection_program() const { return m_intersect; }
+
+private:
+    unsigned m_count = 0;
+    std::shared_ptr<Program> m_bounds, m_intersect;
+};
+
+/// Built-in triangles: a float3 vertex buffer, an optional uint3 index buffer, an optional
+/// unsigned per-triangle material index buffer, and an optional attribute program.
+class GeometryTriangles : public GeometryBase {
+public:
+    using GeometryBase::GeometryBase;
+    std::string describe() const override;
+    bool is_triangles() const override { return true; }
+    void set_vertices(std::shared_ptr<Buffer> vertices);
+    void set_indices(std::shared_ptr<Buffer> indices);
+    void set_material_indices(std::shared_ptr<Buffer> material_indices);
+    void set_attribute_program(std::shared_ptr<Program> program);
+    const std::shared_ptr<Buffer>& vertices() const { return m_vertices; }
+    const std::shared_ptr<Buffer>& indices() const { return m_indices; }
+    const std::shared_ptr<Buffer>& material_indices() const { return m_material_indices; }
+    const std::shared_ptr<Program>& attribute_program() const { return m_attributes; }
+    unsigned primitive_count() const override;
+
+private:
+    std::shared_ptr<Buffer> m_vertices, m_indices, m_material_indices;
+    std::shared_ptr<Program> m_attributes;
+};
+
+/// Closest-hit and any-hit programs per ray type.
+class Material : public ContextObject, public VariableScope {
+public:
+    using ContextObject::ContextObject;
+    std::string describe() const override;
+    std::string scope_name() const override { return describe(); }
+    void set_closest_hit(unsigned ray_type, std::shared_ptr<Program> program);
+    void set_any_hit(unsigned ray_type, std::shared_ptr<Program> program);
+    /// The program for the ray type, or null.
+    std::shared_ptr<Program> closest_hit(unsigned ray_type) const;
+    std::shared_ptr<Program> any_hit(unsigned ray_type) const;
+
+protected:
+    void variables_changed() override { changed(); }
+
+private:
+    std::vector<std::shared_ptr<Program>> m_closest, m_any;
+};
+
+/// Binds a geometry to its materials (material index reported by intersection selects).
+class GeometryInstance : public ContextObject, public VariableScope {
+public:
+    using ContextObject::ContextObject;
+    std::string describe() const override;
+    std::string scope_name() const override { return describe(); }
+    void set_geometry(std::shared_ptr<GeometryBase> geometry);
+    const std::shared_ptr<GeometryBase>& geometry() const { return m_geometry; }
+    /// Appends a material; returns its index.
+    unsigned add_material(std::shared_ptr<Material> material);
+    void set_material(unsigned index, std::shared_ptr<Material> material);
+    unsigned material_count() const { return unsigned(m_materials.size()); }
+    const std::shared_ptr<Material>& material(unsigned index) const;
+
+protected:
+    void variables_changed() override { changed(); }
+
+private:
+    std::shared_ptr<GeometryBase> m_geometry;
+    std::vector<std::shared_ptr<Material>> m_materials;
+};
+
+/// Leaves of the graph: geometry instances under one acceleration structure.
+class GeometryGroup : public Node {
+public:
+    GeometryGroup(detail::ContextShared* owner, std::string name,
+                  std::shared_ptr<Acceleration> accel)
+        : Node(owner, std::move(name), NodeKind::kGeometryGroup), m_accel(std::move(accel)) {}
+    unsigned add_child(std::shared_ptr<GeometryInstance> instance);
+    void set_child(unsigned index, std::shared_ptr<GeometryInstance> instance);
+    void remove_child(unsigned index);
+    unsigned child_count() const { return unsigned(m_children.size()); }
+    const std::shared_ptr<GeometryInstance>& child(unsigned index) const;
+    const std::vector<std::shared_ptr<GeometryInstance>>& children() const { return m_children; }
+    const std::shared_ptr<Acceleration>& acceleration() const { return m_accel; }
+    void set_acceleration(std::shared_ptr<Acceleration> accel);
+
+private:
+    std::vector<std::shared_ptr<GeometryInstance>> m_children;
+    std::shared_ptr<Acceleration> m_accel;
+};
+
+}  // namespace lucent

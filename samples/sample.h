@@ -1,0 +1,63 @@
+// What every sample offers the command line and the tests: a name, its options
+// (given as --set name=value) and a render function.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lucent/context.h"
+#include "scene/image_io.h"
+
+namespace lucent::samples {
+
+/// One `--set` option of a sample.
+struct SampleOption {
+    std::string name;
+    std::string default_value;
+    std::string help;  // one line, with the accepted range
+};
+
+struct RenderSettings {
+    unsigned width = 1024, height = 1024;
+    BackendKind backend = BackendKind::kAuto;
+    unsigned threads = 0;                     // CPU workers, 0 = all cores
+    std::string scene;                        // built-in scene name or file; empty = default
+    std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
+    bool verbose = false;
+};
+
+struct StageTiming {
+    std::string name;
+    double ms = 0;
+};
+
+struct RenderResult {
+    scene::Image image;               // linear RGB
+    std::string backend;              // Context::backend_name()
+    std::vector<StageTiming> stages;  // in order: e.g. scene setup, compile, accel, launch
+    LaunchReport report;              // exceptions of the last launch
+};
+
+struct SampleInfo {
+    std::string name;
+    std::string description;
+    std::vector<SampleOption> options;
+    RenderResult (*render)(const RenderSettings& settings);
+};
+
+/// Every sample, in the order `--help` lists them.
+const std::vector<SampleInfo>& all_samples();
+/// The sample with this name, or an Error listing the names.
+const SampleInfo& find_sample(const std::string& name);
+
+/// Reads a --set value: the option's default when not given; Error naming the option,
+/// the value and the accepted range when it does not parse or is out of [lo, hi].
+float get_float_option(const RenderSettings& s, const SampleInfo& info, const std::string& name,
+                       float lo, float hi);
+int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name,
+                   int lo, int hi);
+/// Error naming any --set that the sample does not have, with the list it does have.
+void check_options(const RenderSettings& s, const SampleInfo& info);
+
+}  // namespace lucent::samples

@@ -1,0 +1,36 @@
+// Images in and out: PNG (8-bit sRGB) and PFM (float), chosen by file extension.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lucent/device/vector_math.h"
+
+namespace lucent::scene {
+
+/// A linear-RGB float image, row 0 at the top.
+struct Image {
+    unsigned width = 0, height = 0;
+    std::vector<float3> pixels;
+};
+
+/// Linear [0,1] to 8-bit sRGB (clamped), RGB interleaved, row 0 first.
+std::vector<unsigned char> to_srgb8(const Image& image);
+
+/// Writes .png (8-bit sRGB) or .pfm (32-bit float, linear) by extension. Writes to a
+/// temporary file beside `path` and renames it, so a failure never leaves a partial file.
+/// Throws lucent::Error naming the path and the reason.
+void write_image(const std::string& path, const Image& image);
+
+/// An 8-bit RGB PNG as stored (no colour conversion), for golden-image comparisons.
+struct Image8 {
+    unsigned width = 0, height = 0;
+    std::vector<unsigned char> rgb;
+};
+Image8 read_png8(const std::string& path);
+
+/// HIPRT-style comparison: the number of pixels where any channel differs by more than
+/// `threshold` (out of 255).
+size_t count_differing_pixels(const Image8& a, const Image8& b, int threshold = 10);
+
+}  // namespace lucent::scene

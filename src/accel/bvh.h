@@ -1,0 +1,67 @@
+// Binary BVH over arbitrary boxes, built with binned SAH (Wald 2007), with refit and a
+// generic front-to-back traversal that hands leaf primitives to a callback.
+// Used by the engine for Groups (children) and GeometryGroups with custom primitives.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "lucent/device/types.h"
+
+namespace lucent::accel {
+
+struct BuildOptions {
+    int bins = 32;            // SAH bins per axis
+    int max_leaf_size = 4;    // primitives per leaf at most
+    float traversal_cost = 1.0f;
+    float intersection_cost = 1.0f;
+};
+
+struct BuildStats {
+    double build_ms = 0;     // wall time of the build
+    double sah_cost = 0;     // SAH cost of the tree (traversal_cost, intersection_cost above)
+    size_t node_count = 0;
+    size_t leaf_count = 0;
+    unsigned depth = 0;
+};
+
+/// A node of the binary BVH: a box, and either two children (count == 0, children at
+/// first and first + 1) or `count` primitives at prim_order()[first ...].
+struct BvhNode {
+    float3 lo;
+    uint32_t first;
+    float3 hi;
+    uint32_t count;
+};
+
+class Bvh {
+public:
+    /// Builds over one box per primitive. Empty input gives an empty tree.
+    void build(std::span<const Aabb> boxes, const BuildOptions& options = {},
+               BuildStats* stats = nullptr);
+    /// Recomputes node boxes bottom-up for moved primitives (same count, same order).
+    void refit(std::span<const Aabb> boxes);
+
+    bool empty() const { return m_nodes.empty(); }
+    Aabb bounds() const;
+    const std::vector<BvhNode>& nodes() const { return m_nodes; }
+    const std::vector<uint32_t>& prim_order() const { return m_prim_order; }
+    /// SAH cost of the current tree.
+    double sah_cost(const BuildOptions& options = {}) const;
+
+    /// Calls visit(prim) -> bool(stop) for every primitive of every leaf whose box the ray
+    /// overlaps within [tmin, tmax], nearer children first. `tmax` is read at each step, so
+    /// the callback may shorten it (by writing to the variable passed in) to cull farther nodes.
+    template <class Visit>
+    void traverse(float3 origin, float3 direction, float tmin, const float& tmax,
+                  Visit&& visit) const;
+
+private:
+    std::vector<BvhNode> m_nodes;
+    std::vector<uint32_t> m_prim_order;
+};
+
+}  // namespace lucent::accel
+
+#include "accel/bvh_traverse.inl"

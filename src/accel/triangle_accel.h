@@ -1,0 +1,61 @@
+// Acceleration structure for triangle meshes: binned-SAH build, a layout tuned for
+// single-ray CPU traversal, the built-in watertight ray/triangle test (Woop, Benthin and
+// Wald 2013), closest-hit, any-hit (occlusion) and filtered queries, and refit.
+// Used by GeometryGroups made only of GeometryTriangles, and by `lucent bench rays`.
+#pragma once
+
+#include <memory>
+#include <span>
+
+#include "accel/bvh.h"
+
+namespace lucent::accel {
+
+struct TriangleHit {
+    float t;
+    float u, v;      // barycentrics of vertices 1 and 2
+    uint32_t prim;   // triangle index in the input order
+};
+
+/// What a filter (the engine's any-hit) decides about a candidate hit.
+enum class HitDecision { kAccept, kIgnore, kAcceptAndStop };
+
+class TriangleAccel {
+public:
+    TriangleAccel();
+    ~TriangleAccel();
+    TriangleAccel(TriangleAccel&&) noexcept;
+    TriangleAccel& operator=(TriangleAccel&&) noexcept;
+
+    /// Builds over triangles (indices may be empty: then triangle i is vertices 3i..3i+2).
+    void build(std::span<const float3> vertices, std::span<const uint3> indices,
+               const BuildOptions& options = {}, BuildStats* stats = nullptr);
+    /// Refit after vertices moved (same triangles).
+    void refit(std::span<const float3> vertices, std::span<const uint3> indices);
+
+    size_t triangle_count() const;
+    Aabb bounds() const;
+    double sah_cost() const;
+
+    /// Closest hit with t in (tmin, tmax); false when there is none.
+    bool intersect(float3 origin, float3 direction, float tmin, float tmax,
+                   TriangleHit& hit) const;
+    /// True when any triangle is hit with t in (tmin, tmax).
+    bool occluded(float3 origin, float3 direction, float tmin, float tmax) const;
+
+    /// Closest hit where every candidate nearer than the current closest is first offered
+    /// to filter(const TriangleHit&) -> HitDecision. Candidates may come out of order.
+    /// Returns true when a hit was accepted; `hit` holds the closest accepted one.
+    template <class Filter>
+    bool intersect_filtered(float3 origin, float3 direction, float tmin, float tmax,
+                            TriangleHit& hit, Filter&& filter) const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace lucent::accel
+
+#include "accel/triangle_accel_filtered.inl"
