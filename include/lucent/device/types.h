@@ -68,6 +68,8 @@ enum ExceptionCode : int {
     kExceptionBufferIndexOutOfBounds = 2,
     kExceptionPayloadTypeMismatch = 3,
     kExceptionInvalidHandle = 4,
+    kExceptionInvalidRayType = 5,
+    kExceptionMaterialIndexOutOfRange = 6,
     kUserExceptionBase = 0x400,
 };
 

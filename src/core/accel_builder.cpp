@@ -1,0 +1,190 @@
+// Acceleration structures of the compiled scene: GeometryGroups are built (or refitted)
+// only when what they are made of changed; Groups are rebuilt each compile (few children).
+#include <chrono>
+#include <cstring>
+#include <set>
+
+#include "core/scene_compiler.h"
+
+namespace lucent::core {
+
+namespace {
+struct Hasher {  // FNV-1a over the bytes of the values that define an acceleration
+    uint64_t h = 1469598103934665603ull;
+    template <class T>
+    Hasher& add(const T& v) {
+        const unsigned char* p = reinterpret_cast<const unsigned char*>(&v);
+        for (size_t i = 0; i < sizeof(T); ++i) h = (h ^ p[i]) * 1099511628211ull;
+        return *this;
+    }
+    Hasher& add_bytes(const void* data, size_t n) {
+        const unsigned char* p = static_cast<const unsigned char*>(data);
+        for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+        return *this;
+    }
+};
+
+Aabb empty_box() { return Aabb{make_float3(kInfinity), make_float3(-kInfinity)}; }
+void grow(Aabb& b, float3 p) {
+    b.lo = fminf(b.lo, p);
+    b.hi = fmaxf(b.hi, p);
+}
+void grow(Aabb& b, const Aabb& o) {
+    b.lo = fminf(b.lo, o.lo);
+    b.hi = fmaxf(b.hi, o.hi);
+}
+bool is_empty(const Aabb& b) { return b.lo.x > b.hi.x; }
+
+uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
+    return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
+}
+
+Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
+    Aabb box = empty_box();
+    if (inst.triangles) {
+        uint3 t = triangle_of(inst, prim);
+        grow(box, inst.vertices[t.x]);
+        grow(box, inst.vertices[t.y]);
+        grow(box, inst.vertices[t.z]);
+    } else {
+        inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
+    }
+    return box;
+}
+
+const GeometryTriangles* triangles_of(const CompiledInstance& inst) {
+    return inst.triangles ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
+                          : nullptr;
+}
+}  // namespace
+
+void SceneCompiler::build_geometry_accel(CompiledNode& node) {
+    auto* group = static_cast<const GeometryGroup*>(node.source);
+    Acceleration& accel = *group->acceleration();
+    auto& cached = m_cache[group];
+    if (!cached) cached = std::make_shared<GeometryAccel>();
+    GeometryAccel& ga = *cached;
+
+    Hasher structure, content;
+    bool triangles_only = !node.instances.empty();
+    for (unsigned i : node.instances) {
+        const CompiledInstance& inst = m_scene->instances[i];
+        structure.add(inst.source).add(inst.triangles).add(inst.primitive_count);
+        if (const GeometryTriangles* tris = triangles_of(inst)) {
+            structure.add(tris->indices().get()).add(tris->indices() ? tris->indices()->version() : 0);
+            content.add(tris->vertices().get()).add(tris->vertices()->version());
+        } else {
+            triangles_only = false;
+            content.add_bytes(inst.bounding_box.rec(), inst.bounding_box.desc->record->size);
+            for (const Buffer* b : inst.bounding_box.buffers) content.add(b).add(b->version());
+        }
+    }
+    structure.add(accel.builder());
+    const bool same_structure = ga.structure_signature == structure.h;
+    const bool same_content = ga.content_signature == content.h;
+    node.geometry = cached;
+    if (same_structure && same_content && !accel.dirty()) return;
+    const bool refit = same_structure && accel.refit() && !node.brute_force;
+
+    // Gather primitives: global reference = prim_first[instance] + local index.
+    ga.triangles_only = triangles_only && !node.brute_force;
+    ga.prim_first.clear();
+    uint32_t total = 0;
+    for (unsigned i : node.instances) {
+        ga.prim_first.push_back(total);
+        total += m_scene->instances[i].primitive_count;
+    }
+    if (ga.triangles_only) {
+        ga.vertices.clear();
+        ga.indices.clear();
+        ga.tri_instance.clear();
+        for (unsigned k = 0; k < node.instances.size(); ++k) {
+            const CompiledInstance& inst = m_scene->instances[node.instances[k]];
+            const GeometryTriangles* tris = triangles_of(inst);
+            uint32_t base = uint32_t(ga.vertices.size());
+            const float3* v = inst.vertices;
+            ga.vertices.insert(ga.vertices.end(), v, v + tris->vertices()->count());
+            for (unsigned p = 0; p < inst.primitive_count; ++p) {
+                uint3 t = triangle_of(inst, p);
+                ga.indices.push_back(uint3{t.x + base, t.y + base, t.z + base});
+                ga.tri_instance.push_back(k);
+            }
+        }
+        if (refit) ga.triangles.refit(ga.vertices, ga.indices);
+        else ga.triangles.build(ga.vertices, ga.indices);
+        ga.bounds = ga.triangles.triangle_count() ? ga.triangles.bounds() : empty_box();
+    } else {
+        std::vector<Aabb> boxes;
+        boxes.reserve(total);
+        Aabb all = empty_box();
+        for (unsigned i : node.instances) {
+            const CompiledInstance& inst = m_scene->instances[i];
+            for (unsigned p = 0; p < inst.primitive_count; ++p) {
+                boxes.push_back(primitive_box(inst, p));
+                if (!is_empty(boxes.back())) grow(all, boxes.back());
+            }
+        }
+        if (refit) ga.bvh.refit(boxes);
+        else ga.bvh.build(boxes);
+        ga.bounds = all;
+    }
+    ga.structure_signature = structure.h;
+    ga.content_signature = content.h;
+}
+
+Aabb SceneCompiler::node_bounds(unsigned index, std::vector<int>& state) {
+    CompiledNode& node = m_scene->nodes[index];
+    if (state[index] == 2) return node.bounds;
+    Aabb box = empty_box();
+    switch (node.kind) {
+        case NodeKind::kGeometryGroup:
+            build_geometry_accel(node);
+            box = node.geometry->bounds;
+            break;
+        case NodeKind::kTransform: {
+            Aabb child = node_bounds(node.children[0], state);
+            if (!is_empty(child))
+                for (int c = 0; c < 8; ++c) {
+                    float3 corner = make_float3(c & 1 ? child.hi.x : child.lo.x,
+                                                c & 2 ? child.hi.y : child.lo.y,
+                                                c & 4 ? child.hi.z : child.lo.z);
+                    grow(box, transform_point(node.to_world, corner));
+                }
+            break;
+        }
+        case NodeKind::kGroup:
+        case NodeKind::kSelector: {
+            std::vector<Aabb> boxes;
+            for (unsigned c : node.children) {
+                boxes.push_back(node_bounds(c, state));
+                if (!is_empty(boxes.back())) grow(box, boxes.back());
+            }
+            if (node.kind == NodeKind::kGroup && !node.brute_force) node.child_bvh.build(boxes);
+            break;
+        }
+    }
+    node.bounds = box;
+    state[index] = 2;
+    return box;
+}
+
+void SceneCompiler::build_accelerations() {
+    auto t0 = std::chrono::steady_clock::now();
+    std::vector<int> state(m_scene->nodes.size(), 0);
+    for (unsigned n = 0; n < m_scene->nodes.size(); ++n) node_bounds(n, state);
+    std::set<const GeometryGroup*> used;
+    for (const CompiledNode& node : m_scene->nodes) {
+        if (node.kind == NodeKind::kGeometryGroup) {
+            auto* g = static_cast<const GeometryGroup*>(node.source);
+            used.insert(g);
+            g->acceleration()->clear_dirty();
+        } else if (node.kind == NodeKind::kGroup) {
+            static_cast<const Group*>(node.source)->acceleration()->clear_dirty();
+        }
+    }
+    for (auto it = m_cache.begin(); it != m_cache.end();)
+        it = used.count(it->first) ? std::next(it) : m_cache.erase(it);
+    m_accel_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace lucent::core

@@ -1,0 +1,111 @@
+// The compiled scene: what a backend launches. Built from the node graph by
+// SceneCompiler (validation, variable resolution, record packing, acceleration builds).
+// Everything here is flat arrays indexed by integers, so the CUDA backend can upload it.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "accel/triangle_accel.h"
+#include "lucent/context.h"
+#include "lucent/device/program.h"
+
+namespace lucent::core {
+
+/// A program's record, resolved and packed (16-byte aligned storage).
+class PackedRecord {
+public:
+    void resize(size_t bytes) { m_blocks.assign((bytes + 15) / 16, Block{}); }
+    unsigned char* data() { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
+    const unsigned char* data() const { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
+    size_t size() const { return m_blocks.size() * 16; }
+
+private:
+    struct alignas(16) Block {
+        unsigned char bytes[16];
+    };
+    std::vector<Block> m_blocks;
+};
+
+/// A bound program: its description and its packed record.
+struct CompiledProgram {
+    const ProgramDesc* desc = nullptr;
+    std::shared_ptr<PackedRecord> record;  // shared: callables point into it
+    std::string label;                     // "closest hit 'phong' of Material 'glass'"
+    std::vector<const Buffer*> buffers;    // every buffer the record views
+
+    explicit operator bool() const { return desc != nullptr; }
+    const void* rec() const { return record ? record->data() : nullptr; }
+    template <class Fn>
+    Fn entry() const { return reinterpret_cast<Fn>(desc->entry); }
+};
+
+struct CompiledMaterial {
+    std::vector<CompiledProgram> closest_hit;  // per ray type
+    std::vector<CompiledProgram> any_hit;      // per ray type
+};
+
+/// A GeometryInstance with its records resolved (GeometryInstance scope included).
+struct CompiledInstance {
+    const GeometryInstance* source = nullptr;
+    bool triangles = false;
+    unsigned primitive_count = 0;
+    CompiledProgram intersection, bounding_box, attribute;
+    std::vector<CompiledMaterial> materials;
+    const TypeInfo* attributes = nullptr;  // the attribute type this geometry produces
+    // Built-in triangles (host pointers into the Buffers).
+    const float3* vertices = nullptr;
+    const uint3* indices = nullptr;  // null: triangle i is vertices 3i..3i+2
+    const unsigned* material_indices = nullptr;
+};
+
+/// Acceleration data of a GeometryGroup, kept across compiles while unchanged.
+struct GeometryAccel {
+    uint64_t structure_signature = 0;  // instances, primitive counts, index buffers
+    uint64_t content_signature = 0;    // vertex buffer versions, bounding-box records
+    bool triangles_only = false;
+    accel::TriangleAccel triangles;     // triangles_only: all instances' triangles together
+    std::vector<float3> vertices;       // the concatenated vertices
+    std::vector<uint3> indices;         // concatenated, rebased indices
+    std::vector<uint32_t> tri_instance; // triangle → position in CompiledNode::instances
+    accel::Bvh bvh;                     // otherwise: over every primitive of every instance
+    std::vector<uint32_t> prim_first;   // per instance: first global primitive (and triangle)
+    Aabb bounds{};
+};
+
+struct CompiledNode {
+    NodeKind kind = NodeKind::kGroup;
+    const Node* source = nullptr;
+    std::vector<unsigned> children;   // node indices (Transform: one)
+    std::vector<unsigned> instances;  // GeometryGroup: CompiledInstance indices
+    std::shared_ptr<GeometryAccel> geometry;  // GeometryGroup
+    accel::Bvh child_bvh;             // Group: over children's boxes
+    bool brute_force = false;         // Builder::kNone
+    Matrix4x3 to_world{}, to_object{};  // Transform
+    CompiledProgram visit;            // Selector
+    Aabb bounds{};
+    std::vector<bool> any_hit_for_ray_type;  // GeometryGroup: some material has any-hit
+};
+
+struct CompiledEntry {
+    CompiledProgram ray_generation;
+    CompiledProgram exception;
+    std::vector<const Buffer*> output_buffers;  // Output buffers the ray-generation record views
+};
+
+struct CompiledScene {
+    uint64_t generation = 0;
+    std::vector<CompiledEntry> entries;
+    std::vector<RayTypeDesc> ray_types;
+    std::vector<CompiledProgram> miss;  // per ray type
+    std::vector<CompiledNode> nodes;
+    std::vector<CompiledInstance> instances;
+    unsigned max_depth = 8;
+    bool print_enabled = false;
+    int3 print_index{-1, -1, -1};
+    std::vector<int> enabled_exceptions;  // codes whose exception program runs
+    bool exception_enabled(int code) const;
+};
+
+}  // namespace lucent::core

@@ -1,0 +1,323 @@
+// Context: settings, object creation, and launch = compile (when stale) + backend run.
+#include "lucent/context.h"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "core/backend.h"
+#include "core/context_state.h"
+#include "core/scene_compiler.h"
+
+namespace lucent {
+
+struct Context::Impl {
+    detail::ContextShared shared;
+    core::ContextState state;
+    core::AccelCache accel_cache;
+    std::unique_ptr<core::Backend> backend;
+    std::unique_ptr<core::CompiledScene> compiled;
+    LaunchReport last;
+    unsigned next_id = 0;
+
+    std::string next_name(const char* kind) { return std::string(kind) + "#" + std::to_string(++next_id); }
+};
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+}  // namespace
+
+Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
+    m_impl->state.context = this;
+    if (options.backend == BackendKind::kCuda)
+        throw Error(
+            "Context: the CUDA backend is not part of this build (it needs the CUDA toolkit "
+            "at configure time); use --backend cpu or --backend auto");
+    // kAuto: no GPU backend in this build, so the CPU runs.
+    m_impl->backend = core::make_cpu_backend(options.threads);
+}
+
+Context::~Context() = default;
+
+std::string Context::backend_name() const { return m_impl->backend->name(); }
+
+void Context::variables_changed() { ++m_impl->shared.generation; }
+
+// ---- entry points and ray types ------------------------------------------------------
+namespace {
+void check_entry(const core::ContextState& s, unsigned entry, const char* call) {
+    if (entry >= s.entries.size())
+        throw Error(std::string("Context::") + call + ": entry point " + std::to_string(entry) +
+                    " is out of range; there are " + std::to_string(s.entries.size()) +
+                    " (call set_entry_point_count first)");
+}
+void check_kind(const std::shared_ptr<Program>& p, ProgramKind kind, const char* call,
+                const char* macro) {
+    if (p && p->kind() != kind)
+        throw Error(std::string("Context::") + call + ": " + p->describe() + " is not a " +
+                    program_kind_name(kind) + " program; define it with " + macro);
+}
+}  // namespace
+
+void Context::set_entry_point_count(unsigned count) {
+    if (count == 0) throw Error("Context::set_entry_point_count: need at least one entry point");
+    m_impl->state.entries.resize(count);
+    ++m_impl->shared.generation;
+}
+unsigned Context::entry_point_count() const { return unsigned(m_impl->state.entries.size()); }
+
+void Context::set_ray_generation_program(unsigned entry, std::shared_ptr<Program> program) {
+    check_entry(m_impl->state, entry, "set_ray_generation_program");
+    check_kind(program, ProgramKind::kRayGeneration, "set_ray_generation_program",
+               "LUCENT_RAY_GENERATION");
+    m_impl->state.entries[entry].ray_generation = std::move(program);
+    ++m_impl->shared.generation;
+}
+void Context::set_exception_program(unsigned entry, std::shared_ptr<Program> program) {
+    check_entry(m_impl->state, entry, "set_exception_program");
+    check_kind(program, ProgramKind::kException, "set_exception_program", "LUCENT_EXCEPTION");
+    m_impl->state.entries[entry].exception = std::move(program);
+    ++m_impl->shared.generation;
+}
+std::shared_ptr<Program> Context::ray_generation_program(unsigned entry) const {
+    check_entry(m_impl->state, entry, "ray_generation_program");
+    return m_impl->state.entries[entry].ray_generation;
+}
+std::shared_ptr<Program> Context::exception_program(unsigned entry) const {
+    check_entry(m_impl->state, entry, "exception_program");
+    return m_impl->state.entries[entry].exception;
+}
+
+void Context::set_ray_type(unsigned index, RayTypeDesc desc) {
+    if (index >= 64)
+        throw Error("Context::set_ray_type: ray type " + std::to_string(index) +
+                    " is out of range (at most 64 ray types, numbered from 0)");
+    if (!desc.payload) throw Error("Context::set_ray_type: ray type '" + desc.name + "' needs a payload type");
+    auto& s = m_impl->state;
+    if (s.ray_types.size() <= index) {
+        s.ray_types.resize(index + 1);
+        s.miss.resize(index + 1);
+    }
+    s.ray_types[index] = std::move(desc);
+    ++m_impl->shared.generation;
+}
+unsigned Context::ray_type_count() const { return unsigned(m_impl->state.ray_types.size()); }
+const RayTypeDesc& Context::ray_type(unsigned index) const {
+    if (index >= m_impl->state.ray_types.size())
+        throw Error("Context::ray_type: ray type " + std::to_string(index) +
+                    " is not declared; declare it with set_ray_type<Payload>(index, name)");
+    return m_impl->state.ray_types[index];
+}
+void Context::set_miss_program(unsigned ray_type, std::shared_ptr<Program> program) {
+    auto& s = m_impl->state;
+    if (ray_type >= s.ray_types.size() || !s.ray_types[ray_type].payload)
+        throw Error("Context::set_miss_program: ray type " + std::to_string(ray_type) +
+                    " is not declared; declare it first with set_ray_type<Payload>(" +
+                    std::to_string(ray_type) + ", name)");
+    check_kind(program, ProgramKind::kMiss, "set_miss_program", "LUCENT_MISS");
+    s.miss[ray_type] = std::move(program);
+    ++m_impl->shared.generation;
+}
+std::shared_ptr<Program> Context::miss_program(unsigned ray_type) const {
+    auto& s = m_impl->state;
+    return ray_type < s.miss.size() ? s.miss[ray_type] : nullptr;
+}
+
+// ---- execution settings ---------------------------------------------------------------
+void Context::set_max_recursion_depth(unsigned depth) {
+    if (depth == 0 || depth > 1024)
+        throw Error("Context::set_max_recursion_depth: " + std::to_string(depth) +
+                    " is out of range; use 1..1024");
+    m_impl->state.max_depth = depth;
+    ++m_impl->shared.generation;
+}
+unsigned Context::max_recursion_depth() const { return m_impl->state.max_depth; }
+
+void Context::set_exception_enabled(int code, bool enabled) {
+    auto& codes = m_impl->state.enabled_exceptions;
+    if (code == kAllExceptions) {
+        codes.clear();
+        if (enabled) codes.push_back(kAllExceptions);
+    } else if (enabled) {
+        if (std::find(codes.begin(), codes.end(), code) == codes.end()) codes.push_back(code);
+    } else {
+        if (exception_enabled(kAllExceptions)) {
+            // Expand "all" into the engine codes so one can be turned off.
+            codes = {kExceptionStackOverflow, kExceptionBufferIndexOutOfBounds,
+                     kExceptionPayloadTypeMismatch, kExceptionInvalidHandle,
+                     kExceptionInvalidRayType, kExceptionMaterialIndexOutOfRange,
+                     kUserExceptionBase};
+        }
+        codes.erase(std::remove(codes.begin(), codes.end(), code), codes.end());
+    }
+    ++m_impl->shared.generation;
+}
+bool Context::exception_enabled(int code) const {
+    auto& codes = m_impl->state.enabled_exceptions;
+    if (std::find(codes.begin(), codes.end(), kAllExceptions) != codes.end()) return true;
+    if (code >= kUserExceptionBase)  // user codes are switched together
+        return std::find(codes.begin(), codes.end(), kUserExceptionBase) != codes.end() ||
+               std::find(codes.begin(), codes.end(), code) != codes.end();
+    return std::find(codes.begin(), codes.end(), code) != codes.end();
+}
+void Context::set_print_enabled(bool enabled) {
+    m_impl->state.print_enabled = enabled;
+    ++m_impl->shared.generation;
+}
+bool Context::print_enabled() const { return m_impl->state.print_enabled; }
+void Context::set_print_launch_index(int x, int y, int z) {
+    m_impl->state.print_index = int3{x, y, z};
+    ++m_impl->shared.generation;
+}
+
+// ---- object creation -------------------------------------------------------------------
+std::shared_ptr<Program> Context::create_program(std::string_view registered_name) {
+    return create_program(find_program(registered_name));
+}
+std::shared_ptr<Program> Context::create_program(const ProgramDesc& desc) {
+    return std::make_shared<Program>(&m_impl->shared, desc);
+}
+std::shared_ptr<Buffer> Context::create_buffer(BufferType type, const TypeInfo& element,
+                                               unsigned width, unsigned height, unsigned depth) {
+    unsigned dims = depth ? 3 : height ? 2 : 1;
+    if ((dims >= 2 && height == 0) || (dims == 3 && depth == 0))
+        throw Error("Context::create_buffer: a dimension is 0");
+    return std::make_shared<Buffer>(&m_impl->shared, m_impl->next_name("buffer"), type, element,
+                                    dims, uint3{width, height ? height : 1, depth ? depth : 1});
+}
+std::shared_ptr<TextureSampler> Context::create_texture_sampler() {
+    return std::make_shared<TextureSampler>(&m_impl->shared, m_impl->next_name("texture"));
+}
+std::shared_ptr<Acceleration> Context::create_acceleration(Builder builder) {
+    auto a = std::make_shared<Acceleration>(&m_impl->shared, m_impl->next_name("acceleration"));
+    a->set_builder(builder);
+    return a;
+}
+std::shared_ptr<Group> Context::create_group() {
+    return std::make_shared<Group>(&m_impl->shared, m_impl->next_name("group"), create_acceleration());
+}
+std::shared_ptr<GeometryGroup> Context::create_geometry_group() {
+    return std::make_shared<GeometryGroup>(&m_impl->shared, m_impl->next_name("geometry_group"),
+                                           create_acceleration());
+}
+std::shared_ptr<Transform> Context::create_transform() {
+    return std::make_shared<Transform>(&m_impl->shared, m_impl->next_name("transform"));
+}
+std::shared_ptr<Selector> Context::create_selector() {
+    return std::make_shared<Selector>(&m_impl->shared, m_impl->next_name("selector"));
+}
+std::shared_ptr<GeometryInstance> Context::create_geometry_instance() {
+    return std::make_shared<GeometryInstance>(&m_impl->shared, m_impl->next_name("geometry_instance"));
+}
+std::shared_ptr<Geometry> Context::create_geometry() {
+    return std::make_shared<Geometry>(&m_impl->shared, m_impl->next_name("geometry"));
+}
+std::shared_ptr<GeometryTriangles> Context::create_geometry_triangles() {
+    return std::make_shared<GeometryTriangles>(&m_impl->shared, m_impl->next_name("triangles"));
+}
+std::shared_ptr<Material> Context::create_material() {
+    return std::make_shared<Material>(&m_impl->shared, m_impl->next_name("material"));
+}
+
+// ---- compile and launch ----------------------------------------------------------------
+namespace {
+void check_ray_generation(const core::CompiledScene& scene, unsigned entry) {
+    if (!scene.entries[entry].ray_generation)
+        throw Error("Context: entry point " + std::to_string(entry) +
+                    " has no ray generation program; bind one with "
+                    "set_ray_generation_program(" + std::to_string(entry) + ", program)");
+}
+}  // namespace
+
+void Context::validate() {
+    LaunchReport scratch;
+    core::SceneCompiler(m_impl->state, m_impl->accel_cache).validate_only();
+    for (unsigned e = 0; e < m_impl->state.entries.size(); ++e)
+        if (!m_impl->state.entries[e].ray_generation)
+            throw Error("Context: entry point " + std::to_string(e) +
+                        " has no ray generation program; bind one with "
+                        "set_ray_generation_program(" + std::to_string(e) +
+                        ", program) or lower the entry point count");
+}
+
+void Context::launch(unsigned entry, unsigned width) { launch(entry, width, 1, 1); }
+void Context::launch(unsigned entry, unsigned width, unsigned height) {
+    launch(entry, width, height, 1);
+}
+void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned depth) {
+    check_entry(m_impl->state, entry, "launch");
+    if (width == 0 || height == 0 || depth == 0)
+        throw Error("Context::launch: launch size " + std::to_string(width) + "x" +
+                    std::to_string(height) + "x" + std::to_string(depth) +
+                    " is empty; every dimension must be at least 1");
+    LaunchReport report;
+    auto t0 = Clock::now();
+    if (!m_impl->compiled || m_impl->compiled->generation != m_impl->shared.generation) {
+        m_impl->compiled.reset();  // a failed compile must not leave a stale scene behind
+        core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache);
+        m_impl->compiled = compiler.compile();
+        m_impl->compiled->generation = m_impl->shared.generation;
+        report.accel_ms = compiler.accel_ms();
+        report.compile_ms = ms_since(t0) - report.accel_ms;
+        report.recompiled = true;
+    }
+    const core::CompiledScene& scene = *m_impl->compiled;
+    check_ray_generation(scene, entry);
+    unsigned dims = depth > 1 ? 3 : height > 1 ? 2 : 1;
+    for (const Buffer* out : scene.entries[entry].output_buffers) {
+        uint3 s = out->size();
+        if (out->dimensionality() == dims && (s.x != width || s.y != height || s.z != depth))
+            throw Error("Context::launch: " + out->describe() + " is written by the ray generation program of entry " +
+                        std::to_string(entry) + " but the launch is " + std::to_string(width) +
+                        "x" + std::to_string(height) + (dims == 3 ? "x" + std::to_string(depth) : "") +
+                        "; resize the buffer to the launch size");
+    }
+    auto t1 = Clock::now();
+    m_impl->backend->launch(scene, entry, uint3{width, height, depth}, report);
+    report.launch_ms = ms_since(t1);
+    m_impl->last = std::move(report);
+}
+
+const LaunchReport& Context::last_launch() const { return m_impl->last; }
+
+// ---- reports ------------------------------------------------------------------------------
+uint64_t LaunchReport::exception_count() const {
+    uint64_t n = 0;
+    for (auto& [code, e] : exceptions) n += e.count;
+    return n;
+}
+
+std::string exception_name(int code) {
+    switch (code) {
+        case kExceptionStackOverflow: return "stack overflow";
+        case kExceptionBufferIndexOutOfBounds: return "buffer index out of bounds";
+        case kExceptionPayloadTypeMismatch: return "payload type mismatch";
+        case kExceptionInvalidHandle: return "invalid node handle";
+        case kExceptionInvalidRayType: return "invalid ray type";
+        case kExceptionMaterialIndexOutOfRange: return "material index out of range";
+    }
+    std::ostringstream s;
+    if (code >= kUserExceptionBase) s << "user exception 0x" << std::hex << code;
+    else s << "exception " << code;
+    return s.str();
+}
+
+std::string LaunchReport::summary() const {
+    std::ostringstream s;
+    for (auto& [code, e] : exceptions)
+        s << exception_name(code) << ": " << e.count << " (first at " << e.first_index.x << ","
+          << e.first_index.y << "," << e.first_index.z << ")\n";
+    return s.str();
+}
+
+bool core::CompiledScene::exception_enabled(int code) const {
+    for (int c : enabled_exceptions)
+        if (c == kAllExceptions || c == code || (code >= kUserExceptionBase && c == kUserExceptionBase))
+            return true;
+    return false;
+}
+
+}  // namespace lucent

@@ -1,0 +1,265 @@
+// Scene-graph node objects: setters check their arguments and mark the scene stale.
+#include "lucent/nodes.h"
+
+#include <cmath>
+
+namespace lucent {
+
+const char* node_kind_name(NodeKind kind) {
+    switch (kind) {
+        case NodeKind::kGroup: return "Group";
+        case NodeKind::kGeometryGroup: return "GeometryGroup";
+        case NodeKind::kTransform: return "Transform";
+        case NodeKind::kSelector: return "Selector";
+    }
+    return "?";
+}
+
+namespace {
+template <class T>
+void require(const std::shared_ptr<T>& p, const ContextObject& owner, const char* what) {
+    if (!p) throw Error(owner.describe() + ": " + what + " is null; pass an object created by the Context");
+}
+template <class T>
+void require_same_context(const std::shared_ptr<T>& p, const ContextObject& owner) {
+    if (p && p->owner() != owner.owner())
+        throw Error(owner.describe() + ": " + p->describe() +
+                    " belongs to another Context; create it with this node's Context");
+}
+std::string index_error(const ContextObject& owner, const char* what, unsigned index,
+                        size_t count) {
+    return owner.describe() + ": " + what + " index " + std::to_string(index) +
+           " is out of range; it has " + std::to_string(count) + " (valid: 0.." +
+           (count ? std::to_string(count - 1) : std::string("none")) + ")";
+}
+}  // namespace
+
+std::string Acceleration::describe() const { return "Acceleration '" + name() + "'"; }
+void Acceleration::set_builder(Builder builder) {
+    m_builder = builder;
+    mark_dirty();
+}
+void Acceleration::set_refit(bool refit) {
+    m_refit = refit;
+    changed();
+}
+void Acceleration::mark_dirty() {
+    m_dirty = true;
+    changed();
+}
+
+std::string Node::describe() const {
+    return std::string(node_kind_name(m_kind)) + " '" + name() + "'";
+}
+
+unsigned NodeWithChildren::add_child(std::shared_ptr<Node> child) {
+    require(child, *this, "child");
+    require_same_context(child, *this);
+    m_children.push_back(std::move(child));
+    children_changed();
+    return unsigned(m_children.size() - 1);
+}
+void NodeWithChildren::set_child(unsigned index, std::shared_ptr<Node> child) {
+    require(child, *this, "child");
+    require_same_context(child, *this);
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    m_children[index] = std::move(child);
+    children_changed();
+}
+void NodeWithChildren::remove_child(unsigned index) {
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    m_children.erase(m_children.begin() + index);
+    children_changed();
+}
+const std::shared_ptr<Node>& NodeWithChildren::child(unsigned index) const {
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    return m_children[index];
+}
+
+void Group::set_acceleration(std::shared_ptr<Acceleration> accel) {
+    require(accel, *this, "acceleration");
+    m_accel = std::move(accel);
+    m_accel->mark_dirty();
+}
+void Group::children_changed() {
+    m_accel->mark_dirty();
+    changed();
+}
+
+void Selector::set_visit_program(std::shared_ptr<Program> visit) {
+    require(visit, *this, "visit program");
+    if (visit->kind() != ProgramKind::kVisit)
+        throw Error(describe() + ": " + visit->describe() +
+                    " is not a selector visit program; define it with LUCENT_VISIT");
+    m_visit = std::move(visit);
+    changed();
+}
+
+Transform::Transform(detail::ContextShared* owner, std::string name)
+    : Node(owner, std::move(name), NodeKind::kTransform),
+      m_matrix{{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}} {}
+void Transform::set_child(std::shared_ptr<Node> child) {
+    require(child, *this, "child");
+    require_same_context(child, *this);
+    m_child = std::move(child);
+    changed();
+}
+void Transform::set_matrix(const float m[12], bool transpose) {
+    // Non-finite or singular matrices are reported at validate/launch, where the message
+    // can say which node in the graph it is; here we only store.
+    if (!transpose) {
+        for (int i = 0; i < 12; ++i) m_matrix.m[i] = m[i];
+    } else {  // column-major 4x3 input: m[c*3 + r]
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) m_matrix.m[r * 4 + c] = m[c * 3 + r];
+    }
+    changed();
+}
+
+std::string Geometry::describe() const { return "Geometry '" + name() + "'"; }
+void Geometry::set_primitive_count(unsigned count) {
+    m_count = count;
+    changed();
+}
+void Geometry::set_bounding_box_program(std::shared_ptr<Program> program) {
+    require(program, *this, "bounding-box program");
+    if (program->kind() != ProgramKind::kBoundingBox)
+        throw Error(describe() + ": " + program->describe() +
+                    " is not a bounding-box program; define it with LUCENT_BOUNDING_BOX");
+    m_bounds = std::move(program);
+    changed();
+}
+void Geometry::set_intersection_program(std::shared_ptr<Program> program) {
+    require(program, *this, "intersection program");
+    if (program->kind() != ProgramKind::kIntersection)
+        throw Error(describe() + ": " + program->describe() +
+                    " is not an intersection program; define it with LUCENT_INTERSECTION");
+    m_intersect = std::move(program);
+    changed();
+}
+
+std::string GeometryTriangles::describe() const { return "GeometryTriangles '" + name() + "'"; }
+void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
+    require(vertices, *this, "vertex buffer");
+    if (vertices->element().tag != type_info_of<float3>().tag || vertices->dimensionality() != 1)
+        throw Error(describe() + ": vertices must be a 1D buffer of float3, got " +
+                    vertices->describe());
+    m_vertices = std::move(vertices);
+    changed();
+}
+void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
+    if (indices && (indices->dimensionality() != 1 ||
+                    (indices->element().tag != type_info_of<uint3>().tag &&
+                     indices->element().tag != type_info_of<int3>().tag)))
+        throw Error(describe() + ": indices must be a 1D buffer of uint3 or int3, got " +
+                    indices->describe());
+    m_indices = std::move(indices);
+    changed();
+}
+void GeometryTriangles::set_material_indices(std::shared_ptr<Buffer> material_indices) {
+    if (material_indices && (material_indices->dimensionality() != 1 ||
+                             material_indices->element().tag != type_info_of<unsigned>().tag))
+        throw Error(describe() + ": material indices must be a 1D buffer of unsigned, got " +
+                    material_indices->describe());
+    m_material_indices = std::move(material_indices);
+    changed();
+}
+void GeometryTriangles::set_attribute_program(std::shared_ptr<Program> program) {
+    if (program && program->kind() != ProgramKind::kAttribute)
+        throw Error(describe() + ": " + program->describe() +
+                    " is not an attribute program; define it with LUCENT_ATTRIBUTE");
+    m_attributes = std::move(program);
+    changed();
+}
+unsigned GeometryTriangles::primitive_count() const {
+    if (m_indices) return unsigned(m_indices->count());
+    return m_vertices ? unsigned(m_vertices->count() / 3) : 0;
+}
+
+std::string Material::describe() const { return "Material '" + name() + "'"; }
+void Material::set_closest_hit(unsigned ray_type, std::shared_ptr<Program> program) {
+    if (program && program->kind() != ProgramKind::kClosestHit)
+        throw Error(describe() + ": " + program->describe() +
+                    " is not a closest-hit program; define it with LUCENT_CLOSEST_HIT");
+    if (ray_type >= 64)
+        throw Error(describe() + ": ray type " + std::to_string(ray_type) +
+                    " is out of range; declare ray types 0, 1, ... with Context::set_ray_type");
+    if (m_closest.size() <= ray_type) m_closest.resize(ray_type + 1);
+    m_closest[ray_type] = std::move(program);
+    changed();
+}
+void Material::set_any_hit(unsigned ray_type, std::shared_ptr<Program> program) {
+    if (program && program->kind() != ProgramKind::kAnyHit)
+        throw Error(describe() + ": " + program->describe() +
+                    " is not an any-hit program; define it with LUCENT_ANY_HIT");
+    if (ray_type >= 64)
+        throw Error(describe() + ": ray type " + std::to_string(ray_type) +
+                    " is out of range; declare ray types 0, 1, ... with Context::set_ray_type");
+    if (m_any.size() <= ray_type) m_any.resize(ray_type + 1);
+    m_any[ray_type] = std::move(program);
+    changed();
+}
+std::shared_ptr<Program> Material::closest_hit(unsigned ray_type) const {
+    return ray_type < m_closest.size() ? m_closest[ray_type] : nullptr;
+}
+std::shared_ptr<Program> Material::any_hit(unsigned ray_type) const {
+    return ray_type < m_any.size() ? m_any[ray_type] : nullptr;
+}
+
+std::string GeometryInstance::describe() const { return "GeometryInstance '" + name() + "'"; }
+void GeometryInstance::set_geometry(std::shared_ptr<GeometryBase> geometry) {
+    require(geometry, *this, "geometry");
+    require_same_context(geometry, *this);
+    m_geometry = std::move(geometry);
+    changed();
+}
+unsigned GeometryInstance::add_material(std::shared_ptr<Material> material) {
+    require(material, *this, "material");
+    require_same_context(material, *this);
+    m_materials.push_back(std::move(material));
+    changed();
+    return unsigned(m_materials.size() - 1);
+}
+void GeometryInstance::set_material(unsigned index, std::shared_ptr<Material> material) {
+    require(material, *this, "material");
+    require_same_context(material, *this);
+    if (index >= m_materials.size()) m_materials.resize(index + 1);
+    m_materials[index] = std::move(material);
+    changed();
+}
+const std::shared_ptr<Material>& GeometryInstance::material(unsigned index) const {
+    if (index >= m_materials.size())
+        throw Error(index_error(*this, "material", index, m_materials.size()));
+    return m_materials[index];
+}
+
+unsigned GeometryGroup::add_child(std::shared_ptr<GeometryInstance> instance) {
+    require(instance, *this, "child");
+    require_same_context(instance, *this);
+    m_children.push_back(std::move(instance));
+    m_accel->mark_dirty();
+    return unsigned(m_children.size() - 1);
+}
+void GeometryGroup::set_child(unsigned index, std::shared_ptr<GeometryInstance> instance) {
+    require(instance, *this, "child");
+    require_same_context(instance, *this);
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    m_children[index] = std::move(instance);
+    m_accel->mark_dirty();
+}
+void GeometryGroup::remove_child(unsigned index) {
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    m_children.erase(m_children.begin() + index);
+    m_accel->mark_dirty();
+}
+const std::shared_ptr<GeometryInstance>& GeometryGroup::child(unsigned index) const {
+    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    return m_children[index];
+}
+void GeometryGroup::set_acceleration(std::shared_ptr<Acceleration> accel) {
+    require(accel, *this, "acceleration");
+    m_accel = std::move(accel);
+    m_accel->mark_dirty();
+}
+
+}  // namespace lucent

@@ -1,0 +1,320 @@
+// Scene compilation: graph discovery, checks, program binding (see scene_compiler.h).
+#include "core/scene_compiler.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lucent::core {
+
+namespace {
+constexpr size_t kMaxAttributeBytes = 256;  // the engine's attribute scratch space
+
+std::string ray_type_label(const ContextState& s, unsigned r) {
+    return "ray type " + std::to_string(r) + " ('" + s.ray_types[r].name + "')";
+}
+
+/// Inverse of an affine 4x3 matrix; false when singular.
+bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
+    const float* m = a.m;
+    float c00 = m[5] * m[10] - m[6] * m[9], c01 = m[6] * m[8] - m[4] * m[10],
+          c02 = m[4] * m[9] - m[5] * m[8];
+    float det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+    if (!(std::fabs(det) > 1e-20f)) return false;
+    float id = 1.0f / det;
+    float r[9] = {c00 * id, (m[2] * m[9] - m[1] * m[10]) * id, (m[1] * m[6] - m[2] * m[5]) * id,
+                  c01 * id, (m[0] * m[10] - m[2] * m[8]) * id, (m[2] * m[4] - m[0] * m[6]) * id,
+                  c02 * id, (m[1] * m[8] - m[0] * m[9]) * id, (m[0] * m[5] - m[1] * m[4]) * id};
+    for (int row = 0; row < 3; ++row) {
+        float t = -(r[row * 3] * m[3] + r[row * 3 + 1] * m[7] + r[row * 3 + 2] * m[11]);
+        inv.m[row * 4 + 0] = r[row * 3 + 0];
+        inv.m[row * 4 + 1] = r[row * 3 + 1];
+        inv.m[row * 4 + 2] = r[row * 3 + 2];
+        inv.m[row * 4 + 3] = t;
+    }
+    return true;
+}
+}  // namespace
+
+std::unique_ptr<CompiledScene> SceneCompiler::compile() {
+    compile_graph();
+    build_accelerations();
+    return std::move(m_scene);
+}
+
+void SceneCompiler::validate_only() { compile_graph(); }
+
+void SceneCompiler::compile_graph() {
+    m_scene = std::make_unique<CompiledScene>();
+    CompiledScene& scene = *m_scene;
+    scene.max_depth = m_state.max_depth;
+    scene.print_enabled = m_state.print_enabled;
+    scene.print_index = m_state.print_index;
+    scene.enabled_exceptions = m_state.enabled_exceptions;
+
+    for (unsigned r = 0; r < m_state.ray_types.size(); ++r)
+        if (!m_state.ray_types[r].payload)
+            throw Error("Context: ray type " + std::to_string(r) +
+                        " is not declared but a higher one is; ray types are numbered 0, 1, ... "
+                        "without gaps: declare it with set_ray_type<Payload>(" +
+                        std::to_string(r) + ", name)");
+    scene.ray_types = m_state.ray_types;
+
+    ScopeChain context_scope;
+    context_scope.then(m_state.context);
+    for (unsigned e = 0; e < m_state.entries.size(); ++e) {
+        CompiledEntry entry;
+        const std::string owner = "entry point " + std::to_string(e);
+        entry.ray_generation =
+            pack(m_state.entries[e].ray_generation, context_scope, owner, &entry.output_buffers);
+        entry.exception = pack(m_state.entries[e].exception, context_scope, owner);
+        scene.entries.push_back(std::move(entry));
+    }
+    for (unsigned r = 0; r < m_state.ray_types.size(); ++r)
+        scene.miss.push_back(pack(m_state.miss[r], context_scope, ray_type_label(m_state, r)));
+
+    // Nodes are discovered while packing (Handle variables) and compiled breadth-first.
+    for (size_t i = 0; i < m_node_queue.size(); ++i) compile_node(m_node_queue[i]);
+    check_cycles();
+    check_types();
+}
+
+unsigned SceneCompiler::node_index(const std::shared_ptr<Node>& node) {
+    auto it = m_node_ids.find(node.get());
+    if (it != m_node_ids.end()) return it->second;
+    unsigned index = unsigned(m_scene->nodes.size());
+    m_node_ids[node.get()] = index;
+    m_node_refs.push_back(node);
+    CompiledNode compiled;
+    compiled.kind = node->kind();
+    compiled.source = node.get();
+    m_scene->nodes.push_back(std::move(compiled));
+    m_node_queue.push_back(index);
+    return index;
+}
+
+unsigned SceneCompiler::instance_index(const GeometryInstance& instance) {
+    auto it = m_instance_ids.find(&instance);
+    if (it != m_instance_ids.end()) return it->second;
+    unsigned index = unsigned(m_scene->instances.size());
+    m_instance_ids[&instance] = index;
+    m_scene->instances.emplace_back();
+    m_scene->instances.back().source = &instance;
+    compile_instance(index);
+    return index;
+}
+
+void SceneCompiler::compile_node(unsigned index) {
+    const Node& node = *m_scene->nodes[index].source;
+    ScopeChain context_scope;
+    context_scope.then(m_state.context);
+    switch (node.kind()) {
+        case NodeKind::kGroup:
+        case NodeKind::kSelector: {
+            auto& n = static_cast<const NodeWithChildren&>(node);
+            std::vector<unsigned> children;
+            for (auto& child : n.children()) children.push_back(node_index(child));
+            CompiledNode& c = m_scene->nodes[index];
+            c.children = std::move(children);
+            if (node.kind() == NodeKind::kGroup) {
+                c.brute_force = static_cast<const Group&>(node).acceleration()->builder() == Builder::kNone;
+            } else {
+                auto& visit = static_cast<const Selector&>(node).visit_program();
+                if (!visit)
+                    throw Error(node.describe() +
+                                " has no visit program; set one with set_visit_program");
+                CompiledProgram p = pack(visit, context_scope, node.describe());
+                m_scene->nodes[index].visit = std::move(p);
+            }
+            break;
+        }
+        case NodeKind::kTransform: {
+            auto& t = static_cast<const Transform&>(node);
+            if (!t.child())
+                throw Error(node.describe() + " has no child; give it one with set_child");
+            for (float v : t.matrix().m)
+                if (!std::isfinite(v))
+                    throw Error(node.describe() +
+                                ": the matrix has a non-finite entry (NaN or infinity); "
+                                "set a finite affine matrix with set_matrix");
+            Matrix4x3 inverse;
+            if (!invert_affine(t.matrix(), inverse))
+                throw Error(node.describe() +
+                            ": the matrix is singular (scale 0?); set an invertible matrix");
+            unsigned child = node_index(t.child());
+            CompiledNode& c = m_scene->nodes[index];
+            c.children = {child};
+            c.to_world = t.matrix();
+            c.to_object = inverse;
+            break;
+        }
+        case NodeKind::kGeometryGroup: {
+            auto& g = static_cast<const GeometryGroup&>(node);
+            std::vector<unsigned> instances;
+            for (auto& gi : g.children()) instances.push_back(instance_index(*gi));
+            CompiledNode& c = m_scene->nodes[index];
+            c.instances = std::move(instances);
+            c.brute_force = g.acceleration()->builder() == Builder::kNone;
+            c.any_hit_for_ray_type.assign(m_state.ray_types.size(), false);
+            for (unsigned i : c.instances)
+                for (auto& m : m_scene->instances[i].materials)
+                    for (unsigned r = 0; r < m.any_hit.size(); ++r)
+                        if (m.any_hit[r]) c.any_hit_for_ray_type[r] = true;
+            break;
+        }
+    }
+}
+
+void SceneCompiler::compile_instance(unsigned index) {
+    const GeometryInstance& gi = *m_scene->instances[index].source;
+    if (!gi.geometry())
+        throw Error(gi.describe() + " has no geometry; set one with set_geometry");
+    if (gi.material_count() == 0)
+        throw Error(gi.describe() + " has no material; add one with add_material");
+    const GeometryBase& geometry = *gi.geometry();
+    CompiledInstance out;
+    out.source = &gi;
+    out.triangles = geometry.is_triangles();
+    out.primitive_count = geometry.primitive_count();
+
+    ScopeChain geometry_scope;
+    geometry_scope.then(&gi).then(&geometry).then(m_state.context);
+    if (out.triangles) {
+        auto& tris = static_cast<const GeometryTriangles&>(geometry);
+        if (!tris.vertices())
+            throw Error(tris.describe() + " has no vertex buffer; set one with set_vertices");
+        out.vertices = tris.vertices()->data<float3>();
+        size_t vertex_count = tris.vertices()->count();
+        if (tris.indices()) {
+            out.indices = static_cast<const uint3*>(tris.indices()->raw());
+            for (unsigned i = 0; i < out.primitive_count; ++i) {
+                uint3 t = out.indices[i];
+                if (t.x >= vertex_count || t.y >= vertex_count || t.z >= vertex_count)
+                    throw Error(tris.describe() + ": triangle " + std::to_string(i) +
+                                " uses vertex " + std::to_string(std::max({t.x, t.y, t.z})) +
+                                " but there are " + std::to_string(vertex_count) +
+                                " vertices; fix the index buffer");
+            }
+        } else if (vertex_count % 3 != 0) {
+            throw Error(tris.describe() + ": without an index buffer the vertex count must be a "
+                        "multiple of 3, got " + std::to_string(vertex_count));
+        }
+        if (tris.material_indices()) {
+            if (tris.material_indices()->count() != out.primitive_count)
+                throw Error(tris.describe() + ": the material index buffer has " +
+                            std::to_string(tris.material_indices()->count()) +
+                            " entries for " + std::to_string(out.primitive_count) +
+                            " triangles; give one per triangle");
+            out.material_indices = tris.material_indices()->data<unsigned>();
+            for (unsigned i = 0; i < out.primitive_count; ++i)
+                if (out.material_indices[i] >= gi.material_count())
+                    throw Error(tris.describe() + ": triangle " + std::to_string(i) +
+                                " selects material " + std::to_string(out.material_indices[i]) +
+                                " but " + gi.describe() + " has " +
+                                std::to_string(gi.material_count()) + "; add materials or fix the index");
+        }
+        out.attribute = pack(tris.attribute_program(), geometry_scope, gi.describe());
+        out.attributes = out.attribute ? out.attribute.desc->attributes
+                                       : &type_info_of<TriangleAttributes>();
+    } else {
+        auto& custom = static_cast<const Geometry&>(geometry);
+        if (!custom.intersection_program())
+            throw Error(custom.describe() +
+                        " has no intersection program; set one with set_intersection_program");
+        if (!custom.bounding_box_program())
+            throw Error(custom.describe() +
+                        " has no bounding-box program; set one with set_bounding_box_program");
+        out.intersection = pack(custom.intersection_program(), geometry_scope, gi.describe());
+        out.bounding_box = pack(custom.bounding_box_program(), geometry_scope, gi.describe());
+        out.attributes = out.intersection.desc->attributes;
+    }
+    if (out.attributes->size > kMaxAttributeBytes)
+        throw Error(gi.describe() + ": attribute type " + std::string(out.attributes->name) +
+                    " is " + std::to_string(out.attributes->size) + " bytes; the engine allows " +
+                    std::to_string(kMaxAttributeBytes) + ": keep attributes small");
+
+    ScopeChain material_scope;
+    for (unsigned m = 0; m < gi.material_count(); ++m) {
+        const auto& material = gi.material(m);
+        if (!material)
+            throw Error(gi.describe() + ": material " + std::to_string(m) +
+                        " is not set; set it with set_material");
+        material_scope = ScopeChain{};
+        material_scope.then(&gi).then(material.get()).then(m_state.context);
+        CompiledMaterial cm;
+        for (unsigned r = 0; r < m_state.ray_types.size(); ++r) {
+            std::string owner = material->describe() + " for " + ray_type_label(m_state, r) +
+                                " in " + gi.describe();
+            cm.closest_hit.push_back(pack(material->closest_hit(r), material_scope, owner));
+            cm.any_hit.push_back(pack(material->any_hit(r), material_scope, owner));
+        }
+        out.materials.push_back(std::move(cm));
+    }
+    m_scene->instances[index] = std::move(out);
+}
+
+void SceneCompiler::check_cycles() const {
+    // Depth-first search over child edges: 0 unvisited, 1 on the path, 2 done.
+    const auto& nodes = m_scene->nodes;
+    std::vector<int> state(nodes.size(), 0);
+    std::vector<unsigned> path;
+    auto visit = [&](auto&& self, unsigned n) -> void {
+        state[n] = 1;
+        path.push_back(n);
+        for (unsigned c : nodes[n].children) {
+            if (state[c] == 1) {
+                std::string cycle;
+                bool in = false;
+                for (unsigned p : path) {
+                    in = in || p == c;
+                    if (in) cycle += nodes[p].source->describe() + " -> ";
+                }
+                throw Error("the scene graph has a cycle: " + cycle +
+                            nodes[c].source->describe() +
+                            "; a node may not be its own descendant (remove one of these edges)");
+            }
+            if (state[c] == 0) self(self, c);
+        }
+        path.pop_back();
+        state[n] = 2;
+    };
+    for (unsigned n = 0; n < nodes.size(); ++n)
+        if (state[n] == 0) visit(visit, n);
+}
+
+void SceneCompiler::check_types() const {
+    const CompiledScene& scene = *m_scene;
+    auto payload_check = [&](const CompiledProgram& p, unsigned r) {
+        if (p && p.desc->payload->tag != scene.ray_types[r].payload->tag)
+            throw Error(p.label + ": its payload type is " + std::string(p.desc->payload->name) +
+                        " but " + ray_type_label(m_state, r) + " carries " +
+                        std::string(scene.ray_types[r].payload->name) +
+                        "; make the program take that payload, or bind it to another ray type");
+    };
+    for (unsigned r = 0; r < scene.miss.size(); ++r) payload_check(scene.miss[r], r);
+    for (const CompiledInstance& inst : scene.instances) {
+        for (unsigned m = 0; m < inst.materials.size(); ++m) {
+            const CompiledMaterial& mat = inst.materials[m];
+            for (unsigned r = 0; r < scene.ray_types.size(); ++r) {
+                for (const CompiledProgram* p : {&mat.closest_hit[r], &mat.any_hit[r]}) {
+                    payload_check(*p, r);
+                    if (*p && p->desc->attributes->tag != inst.attributes->tag)
+                        throw Error(p->label + ": it reads attributes " +
+                                    std::string(p->desc->attributes->name) + " but " +
+                                    inst.source->geometry()->describe() + " reports " +
+                                    std::string(inst.attributes->name) +
+                                    "; use the same attribute type in the intersection (or "
+                                    "attribute) program and the hit programs");
+                }
+                if (scene.ray_types[r].expects_closest_hit && !mat.closest_hit[r])
+                    throw Error(inst.source->material(m)->describe() + " in " +
+                                inst.source->describe() + " has no closest-hit program for " +
+                                ray_type_label(m_state, r) +
+                                ", which reaches it; bind one with set_closest_hit(" +
+                                std::to_string(r) + ", program), or declare the ray type with "
+                                "expects_closest_hit = false if it only needs any-hit");
+            }
+        }
+    }
+}
+
+}  // namespace lucent::core
