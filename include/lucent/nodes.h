@@ -3,6 +3,7 @@
 // Nodes may have several parents (instancing); any node may be the root of a trace.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -180,6 +181,8 @@ public:
     /// The program for the ray type, or null.
     std::shared_ptr<Program> closest_hit(unsigned ray_type) const;
     std::shared_ptr<Program> any_hit(unsigned ray_type) const;
+    /// One more than the highest ray type that has a program here.
+    unsigned ray_type_slots() const { return unsigned(std::max(m_closest.size(), m_any.size())); }
 
 protected:
     void variables_changed() override { changed(); }

@@ -101,6 +101,7 @@ struct CompiledScene {
     std::vector<CompiledProgram> miss;  // per ray type
     std::vector<CompiledNode> nodes;
     std::vector<CompiledInstance> instances;
+    std::vector<std::shared_ptr<PackedRecord>> callable_records;  // Callable::record targets
     unsigned max_depth = 8;
     bool print_enabled = false;
     int3 print_index{-1, -1, -1};

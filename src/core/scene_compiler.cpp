@@ -240,6 +240,13 @@ void SceneCompiler::compile_instance(unsigned index) {
                         " is not set; set it with set_material");
         material_scope = ScopeChain{};
         material_scope.then(&gi).then(material.get()).then(m_state.context);
+        for (unsigned r = unsigned(m_state.ray_types.size()); r < material->ray_type_slots(); ++r)
+            if (material->closest_hit(r) || material->any_hit(r))
+                throw Error(material->describe() + " has a program for ray type " +
+                            std::to_string(r) + ", which is not declared (the context has " +
+                            std::to_string(m_state.ray_types.size()) +
+                            "); declare it with set_ray_type<Payload>(" + std::to_string(r) +
+                            ", name)");
         CompiledMaterial cm;
         for (unsigned r = 0; r < m_state.ray_types.size(); ++r) {
             std::string owner = material->describe() + " for " + ray_type_label(m_state, r) +

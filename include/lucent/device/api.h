@@ -15,59 +15,64 @@ template <class T>
 struct TypeTag {
     static constexpr char id = 0;
 };
-void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
-[[noreturn]] void raise_exception(int code, unsigned detail);
-bool print_enabled_here();
-void print_text(const char* text);
+LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
+[[noreturn]] LUCENT_HD void raise_exception(int code, unsigned detail);
+LUCENT_HD bool print_enabled_here();
+LUCENT_HD void print_text(const char* text);
 }  // namespace detail
 
 /// Index of this invocation in the launch grid.
-uint3 launch_index();
+LUCENT_HD uint3 launch_index();
 /// Size of the launch grid (unused dimensions are 1).
-uint3 launch_size();
+LUCENT_HD uint3 launch_size();
 /// The ray being traced, in the space of the current program (object space in
 /// intersection, any-hit and visit programs below a Transform; world space elsewhere).
-const Ray& current_ray();
+LUCENT_HD const Ray& current_ray();
 /// Parametric distance of the current hit (closest so far inside intersection programs).
-float t_hit();
+LUCENT_HD float t_hit();
 /// Primitive index of the current hit, or of the primitive being intersected.
-unsigned primitive_index();
+LUCENT_HD unsigned primitive_index();
 
 /// Trace a ray against the graph below `root`; the payload type must match the ray type's.
 template <class Payload>
-void trace(Handle root, const Ray& ray, Payload& payload) {
+LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
+#if LUCENT_GPU_CODE
+    // The megakernel is generated for known payload types: no run-time tag needed.
+    detail::trace_erased(root, ray, &payload, nullptr);
+#else
     detail::trace_erased(root, ray, &payload, &detail::TypeTag<Payload>::id);
+#endif
 }
 
 /// In an intersection program: is t inside the ray's current interval?
-bool potential_intersection(float t);
+LUCENT_HD bool potential_intersection(float t);
 /// In an intersection program, after potential_intersection(t) returned true and the
 /// attributes were written: commit the hit with this material index (runs any-hit).
 /// Returns false when any-hit ignored it.
-bool report_intersection(unsigned material_index);
+LUCENT_HD bool report_intersection(unsigned material_index);
 /// In an any-hit program: discard this intersection and go on traversing.
-void ignore_intersection();
+LUCENT_HD void ignore_intersection();
 /// In an any-hit program: accept this intersection and stop traversal of this ray.
-void terminate_ray();
+LUCENT_HD void terminate_ray();
 
 /// Object/world transforms of the current hit or traversal position.
-float3 object_to_world_point(float3 p);
-float3 object_to_world_vector(float3 v);
-float3 object_to_world_normal(float3 n);
-float3 world_to_object_point(float3 p);
-float3 world_to_object_vector(float3 v);
-float3 world_to_object_normal(float3 n);
+LUCENT_HD float3 object_to_world_point(float3 p);
+LUCENT_HD float3 object_to_world_vector(float3 v);
+LUCENT_HD float3 object_to_world_normal(float3 n);
+LUCENT_HD float3 world_to_object_point(float3 p);
+LUCENT_HD float3 world_to_object_vector(float3 v);
+LUCENT_HD float3 world_to_object_normal(float3 n);
 
 /// Raise a user exception: code must be >= kUserExceptionBase. Ends this launch index
 /// and calls the entry point's exception program.
-[[noreturn]] inline void throw_exception(int code, unsigned detail = 0) {
+[[noreturn]] LUCENT_HD inline void throw_exception(int code, unsigned detail = 0) {
     detail::raise_exception(code < kUserExceptionBase ? kUserExceptionBase : code, detail);
 }
 
 /// printf-style output, shown only when printing is enabled on the context (and, if
 /// a print launch index is set, only from that index).
 template <class... Args>
-void print(const char* format, Args... args) {
+LUCENT_HD void print(const char* format, Args... args) {
 #if LUCENT_GPU_CODE
     printf(format, args...);
 #else

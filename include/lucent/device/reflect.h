@@ -105,8 +105,6 @@ FieldInfo make_field_info(std::string_view name, size_t offset) {
                      has_element ? &type_info_of<Element>() : nullptr};
 }
 
-/// A record with no variables, for programs that need none.
-struct NoRecord {};
 inline const RecordInfo& lucent_record_info(const NoRecord*) {
     static const RecordInfo info{"NoRecord", sizeof(NoRecord), alignof(NoRecord), {}};
     return info;

@@ -87,6 +87,9 @@ struct TriangleAttributes {
     float3 geometric_normal;
 };
 
+/// A record with no variables, for programs that need none.
+struct NoRecord {};
+
 /// Per-program flags packed into views by the scene compiler.
 enum ViewFlags : unsigned { kViewBoundsChecked = 1u };
 
