@@ -18,6 +18,7 @@ struct RaysOptions {
     unsigned threads = 0;       // 0 = all cores
     bool peer = true;           // run Embree on the same rays when built with it
     bool json = false;          // machine-readable output
+    std::string backend = "cpu";  // "cpu", or "cuda" (src/cuda/bench_rays_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,
 /// and the peer's lines and ratios. Returns the process exit code; throws lucent::Error
@@ -30,6 +31,7 @@ struct BuildBenchOptions {
     unsigned threads = 0;
     bool peer = true;
     bool json = false;
+    std::string backend = "cpu";  // "cpu", or "cuda": build + convert + upload the GPU layout
 };
 /// Prints build time (median), Mtris/s, SAH cost and node count, and the peer's build time.
 int run_bench_build(const BuildBenchOptions& options);

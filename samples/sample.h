@@ -25,6 +25,10 @@ struct RenderSettings {
     std::string scene;                        // built-in scene name or file; empty = default
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
     bool verbose = false;
+    int jit_check_sm = 0;                     // --jit-check: also compile the CUDA megakernel
+
+    /// The Context options these settings ask for.
+    ContextOptions context_options() const { return ContextOptions{backend, threads, jit_check_sm}; }
 };
 
 struct StageTiming {
@@ -35,6 +39,7 @@ struct StageTiming {
 struct RenderResult {
     scene::Image image;               // linear RGB
     std::string backend;              // Context::backend_name()
+    std::string backend_notice;       // Context::backend_notice(): why auto chose the CPU
     std::vector<StageTiming> stages;  // in order: e.g. scene setup, compile, accel, launch
     LaunchReport report;              // exceptions of the last launch
 };

@@ -18,6 +18,10 @@ enum class BackendKind { kAuto, kCpu, kCuda };
 struct ContextOptions {
     BackendKind backend = BackendKind::kAuto;
     unsigned threads = 0;  // CPU backend workers; 0 = one per core
+    /// With the CPU backend: also generate the CUDA megakernel at each compile and compile it
+    /// with NVRTC for this compute capability (e.g. 90), without a GPU; 0 = off. A check
+    /// that the GPU path compiles; needs a build with the CUDA toolkit.
+    int jit_check_sm = 0;
 };
 
 /// A ray type: its name, the payload type every program handling it must use, and whether
@@ -43,6 +47,8 @@ struct LaunchReport {
     double accel_ms = 0;    // acceleration builds and refits
     double launch_ms = 0;   // running the programs
     bool recompiled = false;
+    double jit_ms = 0;       // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
+    bool jit_cached = false; // CUDA: the megakernel came from the disk cache
     uint64_t exception_count() const;
     /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
     std::string summary() const;
@@ -60,6 +66,8 @@ public:
 
     /// "cpu (2 threads)" or "cuda (...)": the backend that runs launches.
     std::string backend_name() const;
+    /// Why BackendKind::kAuto chose the CPU ("no NVIDIA driver ..."), or empty.
+    const std::string& backend_notice() const;
     std::string scope_name() const override { return "Context"; }
 
     // ---- entry points and ray types ------------------------------------------

@@ -12,15 +12,15 @@
 namespace lucent::accel {
 
 struct BuildOptions {
-    int bins = 32;            // SAH bins per axis
-    int max_leaf_size = 4;    // primitives per leaf at most
+    int bins = 32;          // SAH bins per axis
+    int max_leaf_size = 4;  // primitives per leaf at most
     float traversal_cost = 1.0f;
     float intersection_cost = 1.0f;
 };
 
 struct BuildStats {
-    double build_ms = 0;     // wall time of the build
-    double sah_cost = 0;     // SAH cost of the tree (traversal_cost, intersection_cost above)
+    double build_ms = 0;  // wall time of the build
+    double sah_cost = 0;  // SAH cost of the tree (traversal_cost, intersection_cost above)
     size_t node_count = 0;
     size_t leaf_count = 0;
     unsigned depth = 0;
@@ -36,7 +36,7 @@ struct BvhNode {
 };
 
 class Bvh {
-public:
+  public:
     /// Builds over one box per primitive. Empty input gives an empty tree.
     void build(std::span<const Aabb> boxes, const BuildOptions& options = {},
                BuildStats* stats = nullptr);
@@ -57,8 +57,13 @@ public:
     void traverse(float3 origin, float3 direction, float tmin, const float& tmax,
                   Visit&& visit) const;
 
-private:
+  private:
+    friend class TriangleAccel;  // sets m_block_size for its four-wide leaves
+
     std::vector<BvhNode> m_nodes;
+    // Primitives tested together in one SIMD step: the SAH counts leaf work in blocks of
+    // this size, as Embree's builders do for Triangle4 leaves.
+    unsigned m_block_size = 1;
     std::vector<uint32_t> m_prim_order;
 };
 

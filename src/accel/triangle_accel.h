@@ -13,15 +13,15 @@ namespace lucent::accel {
 
 struct TriangleHit {
     float t;
-    float u, v;      // barycentrics of vertices 1 and 2
-    uint32_t prim;   // triangle index in the input order
+    float u, v;     // barycentrics of vertices 1 and 2
+    uint32_t prim;  // triangle index in the input order
 };
 
 /// What a filter (the engine's any-hit) decides about a candidate hit.
 enum class HitDecision { kAccept, kIgnore, kAcceptAndStop };
 
 class TriangleAccel {
-public:
+  public:
     TriangleAccel();
     ~TriangleAccel();
     TriangleAccel(TriangleAccel&&) noexcept;
@@ -38,8 +38,7 @@ public:
     double sah_cost() const;
 
     /// Closest hit with t in (tmin, tmax); false when there is none.
-    bool intersect(float3 origin, float3 direction, float tmin, float tmax,
-                   TriangleHit& hit) const;
+    bool intersect(float3 origin, float3 direction, float tmin, float tmax, TriangleHit& hit) const;
     /// True when any triangle is hit with t in (tmin, tmax).
     bool occluded(float3 origin, float3 direction, float tmin, float tmax) const;
 
@@ -52,7 +51,11 @@ public:
 
     struct Impl;
 
-private:
+  private:
+    using FilterThunk = HitDecision (*)(void* filter, const TriangleHit& candidate);
+    bool intersect_filtered_impl(float3 origin, float3 direction, float tmin, float tmax,
+                                 TriangleHit& hit, FilterThunk thunk, void* filter) const;
+
     std::unique_ptr<Impl> m_impl;
 };
 

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <set>
 
+#include "core/program_exception.h"
 #include "core/scene_compiler.h"
 
 namespace lucent::core {
@@ -47,7 +48,14 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
         grow(box, inst.vertices[t.y]);
         grow(box, inst.vertices[t.z]);
     } else {
-        inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
+        try {
+            inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
+        } catch (const ProgramException& e) {
+            throw Error(inst.bounding_box.label + " raised " + exception_name(e.code) +
+                        " (detail " + std::to_string(e.detail) + ") for primitive " +
+                        std::to_string(prim) +
+                        "; check the primitive count against the buffers it reads");
+        }
     }
     return box;
 }

@@ -8,6 +8,10 @@
 #include "core/backend.h"
 #include "core/context_state.h"
 #include "core/scene_compiler.h"
+#if LUCENT_HAVE_CUDA
+#include "cuda/cuda_backend.h"
+#include "cuda/megakernel_compiler.h"
+#endif
 
 namespace lucent {
 
@@ -18,6 +22,8 @@ struct Context::Impl {
     std::unique_ptr<core::Backend> backend;
     std::unique_ptr<core::CompiledScene> compiled;
     LaunchReport last;
+    std::string notice;  // why kAuto chose the CPU
+    int jit_check_sm = 0;
     unsigned next_id = 0;
 
     std::string next_name(const char* kind) { return std::string(kind) + "#" + std::to_string(++next_id); }
@@ -32,13 +38,33 @@ double ms_since(Clock::time_point t0) {
 
 Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     m_impl->state.context = this;
-    if (options.backend == BackendKind::kCuda)
-        throw Error(
-            "Context: the CUDA backend is not part of this build (it needs the CUDA toolkit "
-            "at configure time); use --backend cpu or --backend auto");
-    // kAuto: no GPU backend in this build, so the CPU runs.
-    m_impl->backend = core::make_cpu_backend(options.threads);
+    if (options.backend != BackendKind::kCpu) {
+#if LUCENT_HAVE_CUDA
+        std::string why;
+        m_impl->backend = cuda::make_cuda_backend(&why);
+        if (!m_impl->backend && options.backend == BackendKind::kCuda)
+            throw Error("Context: the CUDA backend cannot run here: " + why +
+                        "; use --backend cpu or --backend auto");
+        if (!m_impl->backend) m_impl->notice = why + ": running on the CPU";
+#else
+        if (options.backend == BackendKind::kCuda)
+            throw Error(
+                "Context: the CUDA backend is not part of this build (it needs the CUDA toolkit "
+                "at configure time); use --backend cpu or --backend auto");
+        m_impl->notice = "this build has no CUDA backend: running on the CPU";
+#endif
+    }
+    if (!m_impl->backend) m_impl->backend = core::make_cpu_backend(options.threads);
+    if (options.jit_check_sm) {
+#if LUCENT_HAVE_CUDA
+        m_impl->jit_check_sm = options.jit_check_sm;
+#else
+        throw Error("Context: the JIT check needs a build with the CUDA toolkit; drop the option");
+#endif
+    }
 }
+
+const std::string& Context::backend_notice() const { return m_impl->notice; }
 
 Context::~Context() = default;
 
@@ -263,6 +289,15 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
         report.accel_ms = compiler.accel_ms();
         report.compile_ms = ms_since(t0) - report.accel_ms;
         report.recompiled = true;
+#if LUCENT_HAVE_CUDA
+        if (m_impl->jit_check_sm) {
+            cuda::Megakernel kernel = cuda::generate_megakernel(
+                *m_impl->compiled, cuda::build_program_table(*m_impl->compiled));
+            cuda::compile_megakernel(kernel, m_impl->jit_check_sm);
+            report.jit_ms = kernel.binary.ms;
+            report.jit_cached = kernel.binary.from_cache;
+        }
+#endif
     }
     const core::CompiledScene& scene = *m_impl->compiled;
     check_ray_generation(scene, entry);

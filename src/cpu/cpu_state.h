@@ -6,17 +6,13 @@
 #include <vector>
 
 #include "core/compiled_scene.h"
+#include "core/program_exception.h"
 
 namespace lucent::cpu {
 
 constexpr size_t kAttributeBytes = 256;
 
-/// Thrown (as a C++ exception) to abandon the current launch index: an engine exception
-/// such as stack overflow, or a user exception. Caught by the launch loop.
-struct ProgramException {
-    int code;
-    unsigned detail;
-};
+using core::ProgramException;
 
 enum class ProgramContext {
     kRayGeneration, kException, kMiss, kClosestHit, kAnyHit, kIntersection, kVisit,

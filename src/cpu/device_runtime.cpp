@@ -15,7 +15,12 @@ std::mutex g_print_mutex;
 const Ray kNoRay{};
 }  // namespace
 
-ThreadState& thread_state() { return *t_state; }
+ThreadState& thread_state() {
+    // Bounding-box programs run on the host thread during the acceleration build, outside
+    // any launch: they see an idle state (no trace, launch index 0, printing off).
+    static thread_local ThreadState idle;
+    return t_state ? *t_state : idle;
+}
 void set_thread_state(ThreadState* state) { t_state = state; }
 bool report_candidate(ThreadState& ts, unsigned material);
 }  // namespace cpu

@@ -318,9 +318,22 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
     if (frame.has_hit) {
         HitState& hit = frame.hit;
         const CompiledInstance& inst = scene.instances[hit.instance];
-        frame.object_ray = ray;
-        if (hit.attributes_pending)
+        if (hit.attributes_pending) {
+            // The attribute program runs as at the hit: its primitive, transform and ray.
+            frame.object_ray = ray;
+            frame.instance = &inst;
+            frame.instance_index = hit.instance;
+            frame.prim = hit.prim;
+            frame.transformed = hit.transformed;
+            if (hit.transformed) {
+                frame.to_world = hit.to_world;
+                frame.to_object = hit.to_object;
+                frame.object_ray.origin = transform_point(hit.to_object, ray.origin);
+                frame.object_ray.direction = transform_vector(hit.to_object, ray.direction);
+            }
             Traverser::compute_triangle_attributes(ts, inst, hit.prim, hit.barycentrics, hit.attributes);
+        }
+        frame.object_ray = ray;
         const core::CompiledProgram& closest = inst.materials[hit.material].closest_hit[ray.ray_type];
         if (closest) {
             frame.context = ProgramContext::kClosestHit;

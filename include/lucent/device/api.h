@@ -16,7 +16,15 @@ struct TypeTag {
     static constexpr char id = 0;
 };
 LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
-[[noreturn]] LUCENT_HD void raise_exception(int code, unsigned detail);
+#if LUCENT_GPU_CODE
+// On the GPU an exception cannot unwind: it is recorded, every later trace() returns at
+// once, and the exception program runs when the ray-generation program returns.
+LUCENT_HD void raise_exception(int code, unsigned detail);
+/// Per-thread scratch that an out-of-bounds access reads and writes instead of memory.
+LUCENT_HD void* out_of_bounds_scratch();
+#else
+[[noreturn]] void raise_exception(int code, unsigned detail);
+#endif
 LUCENT_HD bool print_enabled_here();
 LUCENT_HD void print_text(const char* text);
 }  // namespace detail
@@ -65,7 +73,10 @@ LUCENT_HD float3 world_to_object_normal(float3 n);
 
 /// Raise a user exception: code must be >= kUserExceptionBase. Ends this launch index
 /// and calls the entry point's exception program.
-[[noreturn]] LUCENT_HD inline void throw_exception(int code, unsigned detail = 0) {
+#if !LUCENT_GPU_CODE
+[[noreturn]]
+#endif
+LUCENT_HD inline void throw_exception(int code, unsigned detail = 0) {
     detail::raise_exception(code < kUserExceptionBase ? kUserExceptionBase : code, detail);
 }
 
@@ -74,7 +85,7 @@ LUCENT_HD float3 world_to_object_normal(float3 n);
 template <class... Args>
 LUCENT_HD void print(const char* format, Args... args) {
 #if LUCENT_GPU_CODE
-    printf(format, args...);
+    if (detail::print_enabled_here()) printf(format, args...);
 #else
     if (!detail::print_enabled_here()) return;
     char text[1024];
@@ -89,22 +100,33 @@ LUCENT_HD void print(const char* format, Args... args) {
 
 // ---- buffer access with bounds checks --------------------------------------
 template <class T>
+LUCENT_HD T& BufferView<T>::out_of_bounds(unsigned linear) const {
+    detail::raise_exception(kExceptionBufferIndexOutOfBounds, linear);
+#if LUCENT_GPU_CODE
+    return *static_cast<T*>(detail::out_of_bounds_scratch());
+#endif
+}
+// Megakernels of scenes with exceptions off are generated without the checks.
+#if LUCENT_GPU_CODE && defined(LUCENT_GPU_EXCEPTIONS) && !LUCENT_GPU_EXCEPTIONS
+#define LUCENT_BOUNDS_CHECKED(flags) false
+#else
+#define LUCENT_BOUNDS_CHECKED(flags) ((flags) & kViewBoundsChecked)
+#endif
+template <class T>
 LUCENT_HD T& BufferView<T>::operator[](unsigned i) const {
-    if ((flags & kViewBoundsChecked) && i >= count())
-        detail::raise_exception(kExceptionBufferIndexOutOfBounds, i);
+    if (LUCENT_BOUNDS_CHECKED(flags) && i >= count()) return out_of_bounds(i);
     return data[i];
 }
 template <class T>
 LUCENT_HD T& BufferView<T>::operator[](uint2 i) const {
-    if ((flags & kViewBoundsChecked) && (i.x >= size.x || i.y >= size.y))
-        detail::raise_exception(kExceptionBufferIndexOutOfBounds, i.y * size.x + i.x);
+    if (LUCENT_BOUNDS_CHECKED(flags) && (i.x >= size.x || i.y >= size.y))
+        return out_of_bounds(i.y * size.x + i.x);
     return data[i.y * size.x + i.x];
 }
 template <class T>
 LUCENT_HD T& BufferView<T>::operator[](uint3 i) const {
-    if ((flags & kViewBoundsChecked) && (i.x >= size.x || i.y >= size.y || i.z >= size.z))
-        detail::raise_exception(kExceptionBufferIndexOutOfBounds,
-                                (i.z * size.y + i.y) * size.x + i.x);
+    if (LUCENT_BOUNDS_CHECKED(flags) && (i.x >= size.x || i.y >= size.y || i.z >= size.z))
+        return out_of_bounds((i.z * size.y + i.y) * size.x + i.x);
     return data[(i.z * size.y + i.y) * size.x + i.x];
 }
 

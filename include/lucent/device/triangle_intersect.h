@@ -11,11 +11,13 @@ namespace lucent {
 /// Per-ray constants of the watertight test: the axis permutation and the shear (Sec. 3).
 struct WatertightRay {
     float3 origin;
-    int kx, ky, kz;     // kz: dominant axis of the direction; kx, ky keep the winding
-    float sx, sy, sz;   // shear that maps the direction onto +z, scaled to unit length
+    int kx, ky, kz;    // kz: dominant axis of the direction; kx, ky keep the winding
+    float sx, sy, sz;  // shear that maps the direction onto +z, scaled to unit length
 };
 
-LUCENT_HD inline float lc_axis(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+LUCENT_HD inline float lc_axis(float3 v, int k) {
+    return k == 0 ? v.x : (k == 1 ? v.y : v.z);
+}
 
 /// Precomputes the permutation and shear of a ray (Fig. 1 of the paper).
 LUCENT_HD inline WatertightRay make_watertight_ray(float3 origin, float3 direction) {

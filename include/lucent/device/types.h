@@ -106,6 +106,9 @@ struct BufferView {
     LUCENT_HD T& operator[](uint3 i) const;
     LUCENT_HD T* begin() const { return data; }
     LUCENT_HD T* end() const { return data + count(); }
+
+private:
+    LUCENT_HD T& out_of_bounds(unsigned linear) const;  // raises the exception
 };
 
 enum class WrapMode : unsigned { kRepeat = 0, kClampToEdge = 1, kMirror = 2 };

@@ -1,0 +1,146 @@
+// `lucent bench ...`: turns flags into bench options; the measuring is in bench/.
+#include "bench_command.h"
+
+#include <filesystem>
+
+#include "bench/bench_commands.h"
+#include "cli_parse.h"
+#include "lucent/context.h"
+#include "lucent/error.h"
+
+namespace lucent::cli {
+namespace {
+
+/// A missing scene is a runtime error (exit 1) like an unreadable one, caught before timing.
+void check_scene_file(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw Error("--scene " + path + ": no such file (give an .obj file, e.g. " +
+                    "../shared/scenes/sponza.obj)");
+}
+
+/// The backend a benchmark measures: "cuda" for --backend cuda, else the CPU ("auto" too,
+/// so the default figures stay comparable). bench/ says why when CUDA cannot run.
+std::string bench_backend(const std::string& text) {
+    return parse_backend("--backend", text) == BackendKind::kCuda ? "cuda" : "cpu";
+}
+
+}  // namespace
+
+BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build) {
+    BenchCommands cmds;
+    cmds.bench = app.add_subcommand("bench", "Benchmarks: ray throughput and BVH build time");
+    cmds.bench->require_subcommand(1);
+    cmds.bench->footer(
+        "Examples:\n"
+        "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
+        "  lucent bench build --scene ../shared/scenes/sponza.obj --json\n");
+
+    CLI::App* r = cmds.bench->add_subcommand(
+        "rays", "Trace the primary, shadow and diffuse ray sets of shared/BENCH.md");
+    r->add_option("--scene", rays.scene, "OBJ file")->type_name("FILE")->required();
+    r->add_option("--eye", rays.eye, "Camera position x,y,z")->type_name("X,Y,Z");
+    r->add_option("--look", rays.look, "Point looked at x,y,z")->type_name("X,Y,Z");
+    r->add_option("--up", rays.up, "Up vector x,y,z")->type_name("X,Y,Z");
+    r->add_option("--fov", rays.fov, "Vertical field of view in degrees, (0, 180)")
+        ->type_name("DEG");
+    r->add_option("--light", rays.light, "Point light for shadow rays x,y,z")->type_name("X,Y,Z");
+    r->add_option("--size", rays.size, "Image size (default 1024x768; 3840x2160 with --backend cuda)")
+        ->type_name("WxH");
+    r->add_option("--repeat", rays.repeat, "Timed repeats (median reported)")
+        ->type_name("N")
+        ->check(CLI::Range(1, 1000).description(""))
+        ->capture_default_str();
+    r->add_option("--threads", rays.threads, "CPU worker threads, 0 = one per core")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 4096u).description(""))
+        ->capture_default_str();
+    r->add_flag("--no-peer", rays.no_peer, "Do not run the peer engine (Embree)");
+    r->add_flag("--json", rays.json, "Machine-readable output");
+    r->add_option("--backend", rays.backend, "cpu, auto or cuda")
+        ->type_name("KIND")
+        ->capture_default_str();
+    r->footer(
+        "The camera flags --eye --look --up --fov --light go together; without them the\n"
+        "viewpoint comes from cameras.txt beside the scene.\n"
+        "\nExamples:\n"
+        "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
+        "  lucent bench rays --scene ../shared/scenes/bunny.obj --size 512x384 --repeat 9\n"
+        "  lucent bench rays --scene my.obj --eye 0,1,5 --look 0,1,0 --up 0,1,0 --fov 45 "
+        "--light 0,5,0\n");
+
+    CLI::App* b = cmds.bench->add_subcommand("build", "Time the BVH build of a scene");
+    b->add_option("--scene", build.scene, "OBJ file")->type_name("FILE")->required();
+    b->add_option("--repeat", build.repeat, "Timed repeats (median reported)")
+        ->type_name("N")
+        ->check(CLI::Range(1, 1000).description(""))
+        ->capture_default_str();
+    b->add_option("--threads", build.threads, "CPU worker threads, 0 = one per core")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 4096u).description(""))
+        ->capture_default_str();
+    b->add_flag("--no-peer", build.no_peer, "Do not run the peer engine (Embree)");
+    b->add_flag("--json", build.json, "Machine-readable output");
+    b->add_option("--backend", build.backend, "cpu, auto or cuda")
+        ->type_name("KIND")
+        ->capture_default_str();
+    b->footer(
+        "Examples:\n"
+        "  lucent bench build --scene ../shared/scenes/sponza.obj\n"
+        "  lucent bench build --scene ../shared/scenes/dragon.obj --repeat 9 --json\n");
+    cmds.rays = r;
+    cmds.build = b;
+    return cmds;
+}
+
+int run_bench_rays_command(const BenchRaysArgs& args) {
+    bench::RaysOptions options;
+    options.scene = args.scene;
+    options.backend = bench_backend(args.backend);
+    const Size size = parse_size(
+        "--size", !args.size.empty() ? args.size
+                                     : (options.backend == "cuda" ? "3840x2160" : "1024x768"));
+    options.width = size.width;
+    options.height = size.height;
+    options.repeat = args.repeat;
+    options.threads = args.threads;
+    options.peer = !args.no_peer;
+    options.json = args.json;
+
+    // A partial camera would silently mix given and default values: refuse it.
+    const std::pair<const char*, const std::string*> camera[] = {{"--eye", &args.eye},
+                                                                 {"--look", &args.look},
+                                                                 {"--up", &args.up},
+                                                                 {"--fov", &args.fov},
+                                                                 {"--light", &args.light}};
+    std::string given, missing;
+    for (const auto& [flag, value] : camera)
+        (value->empty() ? missing : given) += std::string(" ") + flag;
+    if (!given.empty() && !missing.empty())
+        throw UsageError("the camera flags go together: given" + given + ", missing" + missing +
+                         " (or give none to use cameras.txt beside the scene)");
+    if (!given.empty()) {
+        options.has_camera = true;
+        options.eye = parse_vec3("--eye", args.eye);
+        options.look = parse_vec3("--look", args.look);
+        options.up = parse_vec3("--up", args.up);
+        options.fov = parse_float("--fov", args.fov, 0.f, 180.f, /*open=*/true);
+        options.light = parse_vec3("--light", args.light);
+    }
+    check_scene_file(args.scene);
+    return bench::run_bench_rays(options);
+}
+
+int run_bench_build_command(const BenchBuildArgs& args) {
+    check_scene_file(args.scene);
+    bench::BuildBenchOptions options;
+    options.scene = args.scene;
+    options.repeat = args.repeat;
+    options.threads = args.threads;
+    options.peer = !args.no_peer;
+    options.json = args.json;
+    options.backend = bench_backend(args.backend);
+    return bench::run_bench_build(options);
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,44 @@
+// `lucent bench rays` and `lucent bench build`: command-line front of bench/bench_commands.h.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace lucent::cli {
+
+/// `bench rays` options as typed; parsed and checked by run_bench_rays_command.
+struct BenchRaysArgs {
+    std::string scene;
+    std::string eye, look, up, fov, light;  // all or none
+    std::string size;  // default 1024x768, or 3840x2160 with --backend cuda (BENCH.md)
+    std::string backend = "cpu";
+    int repeat = 5;
+    unsigned threads = 0;
+    bool no_peer = false;
+    bool json = false;
+};
+
+/// `bench build` options as typed.
+struct BenchBuildArgs {
+    std::string scene;
+    int repeat = 5;
+    unsigned threads = 0;
+    bool no_peer = false;
+    bool json = false;
+    std::string backend = "cpu";
+};
+
+struct BenchCommands {
+    CLI::App* bench = nullptr;
+    CLI::App* rays = nullptr;
+    CLI::App* build = nullptr;
+};
+
+/// Adds `bench` with its `rays` and `build` subcommands to `app`.
+BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build);
+/// Runs a parsed `bench rays`; returns the exit code. Throws UsageError, lucent::Error.
+int run_bench_rays_command(const BenchRaysArgs& args);
+/// Runs a parsed `bench build`; returns the exit code.
+int run_bench_build_command(const BenchBuildArgs& args);
+
+}  // namespace lucent::cli

@@ -1,0 +1,42 @@
+// Parsing of the command line's value forms (WxH, x,y,z, name=value, backends), with
+// messages that name the flag, the value and the accepted form.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "lucent/context.h"
+#include "lucent/device/vector_math.h"
+
+namespace lucent::cli {
+
+/// Bad command-line input (exit code 2); the message names the flag and the accepted form.
+class UsageError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct Size {
+    unsigned width = 0, height = 0;
+};
+
+constexpr unsigned kMaxImageSide = 16384;
+
+/// "1024x768" → {1024, 768}; each side in [1, kMaxImageSide].
+Size parse_size(const std::string& flag, const std::string& text);
+/// "1,2.5,-3" → float3; three finite numbers.
+float3 parse_vec3(const std::string& flag, const std::string& text);
+/// A finite number in (lo, hi) when `open`, else [lo, hi].
+float parse_float(const std::string& flag, const std::string& text, float lo, float hi,
+                  bool open = false);
+/// "auto", "cpu" or "cuda".
+BackendKind parse_backend(const std::string& flag, const std::string& text);
+/// "sm_90" or "90" → 90; UsageError naming the flag otherwise.
+int parse_sm(const std::string& flag, const std::string& text);
+/// "name=value" → {name, value}; the name is non-empty, the value may be empty.
+std::pair<std::string, std::string> parse_set(const std::string& flag, const std::string& text);
+/// An image path that write_image accepts (.png or .pfm) in a directory that exists.
+void check_image_path(const std::string& flag, const std::string& path);
+
+}  // namespace lucent::cli

@@ -1,0 +1,71 @@
+// The `lucent` command line: render a sample, or run the benchmarks.
+// Exit codes: 0 success, 1 runtime error (engine, files), 2 bad command-line input.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "bench_command.h"
+#include "cli_parse.h"
+#include "lucent/error.h"
+#include "render_command.h"
+#include "samples/settings_error.h"
+
+namespace {
+
+constexpr int kRuntimeExit = 1;
+constexpr int kUsageExit = 2;
+
+int report(const std::string& where, const char* kind, const char* what, int code) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "%s: %s%s\n", where.c_str(), kind, what);
+    return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace lucent::cli;
+    CLI::App app{"Lucent: an open, programmable ray-tracing engine", "lucent"};
+    app.require_subcommand(1);
+    app.footer(
+        "Examples:\n"
+        "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"
+        "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
+        "Run `lucent render --help` for the samples and their options.\n");
+
+    RenderArgs render_args;
+    BenchRaysArgs rays_args;
+    BenchBuildArgs build_args;
+    std::string where = "lucent";
+    try {
+        CLI::App* render = add_render_command(app, render_args);
+        BenchCommands bench = add_bench_commands(app, rays_args, build_args);
+        try {
+            app.parse(argc, argv);
+        } catch (const CLI::ParseError& e) {
+            // --help exits 0; every other parse error is a usage error.
+            return app.exit(e) == 0 ? 0 : kUsageExit;
+        }
+        if (render->parsed()) {
+            where = "lucent render";
+            return run_render(render_args);
+        }
+        if (bench.rays->parsed()) {
+            where = "lucent bench rays";
+            return run_bench_rays_command(rays_args);
+        }
+        if (bench.build->parsed()) {
+            where = "lucent bench build";
+            return run_bench_build_command(build_args);
+        }
+        return report(where, "", "no command given; run `lucent --help`", kUsageExit);
+    } catch (const UsageError& e) {
+        return report(where, "", e.what(), kUsageExit);
+    } catch (const lucent::samples::SettingsError& e) {
+        return report(where, "", e.what(), kUsageExit);
+    } catch (const lucent::Error& e) {
+        return report(where, "error: ", e.what(), kRuntimeExit);
+    } catch (const std::exception& e) {
+        return report(where, "unexpected error: ", e.what(), kRuntimeExit);
+    }
+}

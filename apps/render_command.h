@@ -1,0 +1,28 @@
+// `lucent render`: runs a sample and writes its image.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace lucent::cli {
+
+/// The render options as typed; parsed and checked by run_render.
+struct RenderArgs {
+    std::string sample = "whitted";
+    std::string size = "1024x1024";
+    std::string out = "lucent.png";
+    std::string backend = "auto";
+    std::string scene;
+    std::vector<std::string> sets;
+    unsigned threads = 0;
+    bool verbose = false;
+    std::string jit_check;  // e.g. "sm_90": also compile the CUDA megakernel (no GPU needed)
+};
+
+/// Adds the `render` subcommand to `app`; its options fill `args`.
+CLI::App* add_render_command(CLI::App& app, RenderArgs& args);
+/// Runs a parsed `render`; returns the exit code. Throws UsageError, lucent::Error.
+int run_render(const RenderArgs& args);
+
+}  // namespace lucent::cli

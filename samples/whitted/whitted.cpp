@@ -1,0 +1,326 @@
+// Host setup of the Whitted sample (OptiX paper §6.1, Fig. 7), after the OptiX SDK's
+// "whitted": one GeometryGroup with a parallelogram floor, a metal sphere and a thin-shell
+// glass sphere, three materials, point lights, and two ray types (radiance, shadow).
+#include "samples/whitted/whitted.h"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "lucent.h"
+#include "samples/settings_error.h"
+#include "samples/whitted/whitted_programs.h"
+
+namespace lucent::samples {
+namespace {
+
+constexpr const char* kSceneName = "whitted";
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// The pinhole frame of the camera programs: W from the eye to the image centre, U and V
+/// from the centre to the right and top edges.
+struct CameraFrame {
+    float3 U, V, W;
+};
+
+CameraFrame camera_frame(const WhittedLayout& layout, float aspect) {
+    float3 W = layout.lookat - layout.eye;
+    float distance = length(W);
+    float3 U = normalize(cross(W, layout.up));
+    float3 V = normalize(cross(U, W));
+    float half_height =
+        distance * std::tan(0.5f * layout.vfov_degrees * std::numbers::pi_v<float> / 180.0f);
+    return {U * (half_height * aspect), V * half_height, W};
+}
+
+/// Up to three white point lights; their colours share one unit of intensity so the
+/// exposure stays the same whatever the count.
+std::vector<whitted::BasicLight> make_lights(const WhittedLayout& layout, int count) {
+    const float3 positions[3] = {layout.key_light, make_float3(-12.0f, 25.0f, 24.0f),
+                                 make_float3(30.0f, 20.0f, -30.0f)};
+    std::vector<whitted::BasicLight> lights;
+    for (int i = 0; i < count; ++i) {
+        whitted::BasicLight light{};
+        light.position = positions[i];
+        light.color = make_float3(layout.light_intensity / float(count));
+        light.casts_shadow = 1;
+        lights.push_back(light);
+    }
+    return lights;
+}
+
+RenderResult render_whitted(const RenderSettings& settings) {
+    const SampleInfo& info = whitted_sample_info();
+    check_options(settings, info);
+    if (!settings.scene.empty() && settings.scene != kSceneName)
+        throw SettingsError("--scene " + settings.scene +
+                            ": the whitted sample has one built-in scene; accepted names are "
+                            "'whitted' (or no --scene)");
+    const int antialiasing = get_int_option(settings, info, "aa", 0, 1);
+    const float aa_threshold = get_float_option(settings, info, "aa_threshold", 0.0f, 1.0f);
+    const int max_depth = get_int_option(settings, info, "max_depth", 1, 31);
+    const int shadows = get_int_option(settings, info, "shadows", 0, 1);
+    const int light_count = get_int_option(settings, info, "lights", 1, 3);
+    if (settings.width == 0 || settings.height == 0)
+        throw SettingsError("whitted: image size " + std::to_string(settings.width) + "x" +
+                            std::to_string(settings.height) + " is empty; give --size WxH");
+
+    const WhittedLayout& layout = whitted_layout();
+    RenderResult out;
+    const Clock::time_point setup_start = Clock::now();
+
+    Context ctx(settings.context_options());
+    out.backend = ctx.backend_name();
+    out.backend_notice = ctx.backend_notice();
+    ctx.set_ray_type<whitted::RadiancePayload>(whitted::kRadianceRay, "radiance");
+    // Shadow rays need only any-hit (attenuate or stop) and no miss program: a ray that
+    // reaches the light returns the attenuation the glass left it.
+    ctx.set_ray_type<whitted::ShadowPayload>(whitted::kShadowRay, "shadow",
+                                             /*expects_closest_hit=*/false);
+    // Radiance rays nest max_depth deep below the camera's; each may cast shadow rays.
+    ctx.set_max_recursion_depth(unsigned(max_depth) + 2);
+    ctx.set_exception_enabled(kExceptionStackOverflow, true);
+    ctx.set_exception_enabled(kExceptionBufferIndexOutOfBounds, true);
+
+    // ---- camera, exception and miss programs ----------------------------------------
+    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    output->set_name("output_buffer");
+    ctx["output_buffer"] = output;
+
+    ctx.set_entry_point_count(1);
+    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted_camera));
+    const CameraFrame frame = camera_frame(layout, float(settings.width) / float(settings.height));
+    (*camera)["eye"] = layout.eye;
+    (*camera)["U"] = frame.U;
+    (*camera)["V"] = frame.V;
+    (*camera)["W"] = frame.W;
+    (*camera)["antialiasing"] = antialiasing;
+    (*camera)["aa_threshold"] = aa_threshold;
+    ctx.set_ray_generation_program(0, camera);
+
+    auto exception = ctx.create_program(LUCENT_PROGRAM(whitted_exception));
+    (*exception)["bad_color"] = make_float3(1.0f, 0.0f, 1.0f);
+    ctx.set_exception_program(0, exception);
+
+    auto miss = ctx.create_program(LUCENT_PROGRAM(whitted_miss));
+    (*miss)["bg_color"] = layout.background;
+    ctx.set_miss_program(whitted::kRadianceRay, miss);
+
+    // ---- geometry: three primitive types, each with its own programs (§6.1) ------------
+    auto floor = ctx.create_geometry();
+    floor->set_name("floor");
+    floor->set_primitive_count(1);
+    floor->set_intersection_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_parallelogram_intersect)));
+    floor->set_bounding_box_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_parallelogram_bounds)));
+    {
+        const float3 anchor = make_float3(-20.0f, layout.floor_height, -22.0f);
+        const float3 v1 = make_float3(0.0f, 0.0f, 40.0f);  // (v1 x v2) points up
+        const float3 v2 = make_float3(40.0f, 0.0f, 0.0f);
+        const float3 normal = normalize(cross(v1, v2));
+        (*floor)["plane"] = make_float4(normal, dot(normal, anchor));
+        (*floor)["v1"] = v1 / dot(v1, v1);
+        (*floor)["v2"] = v2 / dot(v2, v2);
+        (*floor)["anchor"] = anchor;
+    }
+
+    auto metal_sphere = ctx.create_geometry();
+    metal_sphere->set_name("metal sphere");
+    metal_sphere->set_primitive_count(1);
+    metal_sphere->set_intersection_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_sphere_intersect)));
+    metal_sphere->set_bounding_box_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_sphere_bounds)));
+
+    auto glass_sphere = ctx.create_geometry();
+    glass_sphere->set_name("glass sphere");
+    glass_sphere->set_primitive_count(1);
+    glass_sphere->set_intersection_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_shell_intersect)));
+    glass_sphere->set_bounding_box_program(
+        ctx.create_program(LUCENT_PROGRAM(whitted_shell_bounds)));
+    (*glass_sphere)["center"] = layout.glass_center;
+    (*glass_sphere)["radius_outer"] = layout.glass_radius;
+    (*glass_sphere)["radius_inner"] = layout.glass_radius - layout.glass_thickness;
+
+    // ---- materials ------------------------------------------------------------------------
+    auto opaque_shadow = ctx.create_program(LUCENT_PROGRAM(whitted_opaque_shadow));
+
+    // Checker floor: the colours of Whitted's red and yellow checkers, 1 x 1 unit squares,
+    // from a 2 x 2 texture with nearest filtering and repeat wrap.
+    auto checker_texels = ctx.create_buffer<float4>(BufferType::kInput, 2, 2);
+    checker_texels->set_name("checker texels");
+    {
+        const float4 red = make_float4(0.75f, 0.18f, 0.08f, 1.0f);
+        const float4 yellow = make_float4(0.9f, 0.85f, 0.05f, 1.0f);
+        checker_texels->upload(std::vector<float4>{red, yellow, yellow, red});
+    }
+    auto checker = ctx.create_texture_sampler();
+    checker->set_name("checker");
+    checker->set_buffer(checker_texels);
+    checker->set_wrap_mode(WrapMode::kRepeat, WrapMode::kRepeat);
+    checker->set_filter(FilterMode::kNearest);
+
+    auto floor_material = ctx.create_material();
+    floor_material->set_name("checker floor");
+    floor_material->set_closest_hit(whitted::kRadianceRay,
+                                    ctx.create_program(LUCENT_PROGRAM(whitted_checker_radiance)));
+    floor_material->set_any_hit(whitted::kShadowRay, opaque_shadow);
+    (*floor_material)["checker"] = checker;
+    (*floor_material)["checker_scale"] = make_float2(20.0f, 20.0f);  // 40 x 40 squares
+    (*floor_material)["Ks"] = make_float3(0.0f);
+    (*floor_material)["phong_exp"] = 1.0f;
+    (*floor_material)["reflectivity"] = make_float3(0.0f);
+
+    auto metal_material = ctx.create_material();
+    metal_material->set_name("metal");
+    metal_material->set_closest_hit(whitted::kRadianceRay,
+                                    ctx.create_program(LUCENT_PROGRAM(whitted_metal_radiance)));
+    metal_material->set_any_hit(whitted::kShadowRay, opaque_shadow);
+    (*metal_material)["Ka"] = make_float3(0.2f, 0.5f, 0.5f);
+    (*metal_material)["Kd"] = make_float3(0.2f, 0.7f, 0.8f);
+    (*metal_material)["Ks"] = make_float3(0.9f);
+    (*metal_material)["phong_exp"] = 64.0f;
+    (*metal_material)["reflectivity"] = make_float3(0.5f);
+
+    auto glass_material = ctx.create_material();
+    glass_material->set_name("glass");
+    glass_material->set_closest_hit(whitted::kRadianceRay,
+                                    ctx.create_program(LUCENT_PROGRAM(whitted_glass_radiance)));
+    auto glass_shadow = ctx.create_program(LUCENT_PROGRAM(whitted_glass_shadow));
+    // On the program's scope: the any-hit program sees it before the material's.
+    (*glass_shadow)["shadow_attenuation"] = make_float3(layout.glass_shadow_transmission);
+    glass_material->set_any_hit(whitted::kShadowRay, glass_shadow);
+    (*glass_material)["fresnel_exponent"] = 3.0f;
+    (*glass_material)["fresnel_minimum"] = 0.1f;
+    (*glass_material)["fresnel_maximum"] = 1.0f;
+    (*glass_material)["refraction_index"] = 1.4f;
+    (*glass_material)["refraction_color"] = make_float3(1.0f);
+    (*glass_material)["reflection_color"] = make_float3(1.0f);
+    (*glass_material)["refraction_maxdepth"] = 10;
+    (*glass_material)["reflection_maxdepth"] = 5;
+    (*glass_material)["extinction_constant"] =
+        make_float3(std::log(0.83f), std::log(0.83f), std::log(0.83f));
+    (*glass_material)["cutoff_color"] = make_float3(0.034f, 0.055f, 0.085f);
+    (*glass_material)["importance_cutoff"] = 0.01f;
+
+    // ---- instances, one GeometryGroup ------------------------------------------------
+    auto floor_instance = ctx.create_geometry_instance();
+    floor_instance->set_name("floor");
+    floor_instance->set_geometry(floor);
+    floor_instance->add_material(floor_material);
+
+    auto metal_instance = ctx.create_geometry_instance();
+    metal_instance->set_name("metal sphere");
+    metal_instance->set_geometry(metal_sphere);
+    metal_instance->add_material(metal_material);
+    // On the instance: intersection programs see GeometryInstance scope before Geometry's.
+    (*metal_instance)["sphere"] = make_float4(layout.metal_center, layout.metal_radius);
+
+    auto glass_instance = ctx.create_geometry_instance();
+    glass_instance->set_name("glass sphere");
+    glass_instance->set_geometry(glass_sphere);
+    glass_instance->add_material(glass_material);
+
+    auto group = ctx.create_geometry_group();
+    group->set_name("whitted scene");
+    group->add_child(floor_instance);
+    group->add_child(metal_instance);
+    group->add_child(glass_instance);
+
+    // ---- context-wide variables ---------------------------------------------------------
+    const std::vector<whitted::BasicLight> lights = make_lights(layout, light_count);
+    auto light_buffer =
+        ctx.create_buffer<whitted::BasicLight>(BufferType::kInput, unsigned(lights.size()));
+    light_buffer->set_name("lights");
+    light_buffer->upload(lights);
+    ctx["lights"] = light_buffer;
+    ctx["top_object"] = group;
+    ctx["top_shadower"] = group;
+    ctx["ambient_light_color"] = make_float3(layout.ambient);
+    ctx["scene_epsilon"] = 1e-3f;
+    ctx["max_depth"] = max_depth;
+    ctx["shadows"] = shadows;
+
+    out.stages.push_back({"scene setup", ms_since(setup_start)});
+
+    ctx.launch(0, settings.width, settings.height);
+    out.report = ctx.last_launch();
+    out.stages.push_back({"compile + accel", out.report.compile_ms + out.report.accel_ms});
+    out.stages.push_back({"launch", out.report.launch_ms});
+
+    out.image.width = settings.width;
+    out.image.height = settings.height;
+    out.image.pixels.resize(size_t(settings.width) * settings.height);
+    const float4* pixels = output->data<float4>();
+    for (size_t i = 0; i < out.image.pixels.size(); ++i)
+        out.image.pixels[i] = make_float3(pixels[i]);
+    return out;
+}
+
+}  // namespace
+
+const WhittedLayout& whitted_layout() {
+    static const WhittedLayout layout = [] {
+        WhittedLayout l{};
+        l.eye = make_float3(11.9f, 3.6f, 1.35f);
+        l.lookat = make_float3(3.3f, 1.4f, -3.8f);
+        l.up = make_float3(0.0f, 1.0f, 0.0f);
+        l.vfov_degrees = 34.0f;
+        l.background = make_float3(0.38f, 0.5f, 0.68f);
+        l.metal_center = make_float3(2.0f, 1.5f, -2.5f);
+        l.metal_radius = 1.0f;
+        l.glass_center = make_float3(4.0f, 2.3f, -4.0f);
+        l.glass_radius = 1.0f;
+        l.glass_thickness = 0.04f;
+        l.floor_height = 0.01f;
+        l.key_light = make_float3(6.0f, 40.0f, 21.0f);
+        // With ambient 0.3 the lit floor stays below 1 (no clipped checkers).
+        l.light_intensity = 0.9f;
+        l.ambient = 0.3f;
+        // Four surfaces (the shell's two sides, twice) let 0.85^4 = 52 % through at the
+        // shadow's centre, less towards its rim where Fresnel reflection grows.
+        l.glass_shadow_transmission = 0.85f;
+        return l;
+    }();
+    return layout;
+}
+
+float2 whitted_project(float3 p, unsigned width, unsigned height) {
+    const WhittedLayout& layout = whitted_layout();
+    const CameraFrame frame = camera_frame(layout, float(width) / float(height));
+    // U, V, W are orthogonal: the coordinates of p - eye in that frame, then divide by depth.
+    const float3 q = p - layout.eye;
+    const float depth = dot(q, frame.W) / dot(frame.W, frame.W);
+    const float sx = dot(q, frame.U) / dot(frame.U, frame.U) / depth;
+    const float sy = dot(q, frame.V) / dot(frame.V, frame.V) / depth;
+    return make_float2(0.5f * (sx + 1.0f) * float(width), 0.5f * (1.0f - sy) * float(height));
+}
+
+const SampleInfo& whitted_sample_info() {
+    static const SampleInfo info{
+        kSceneName,
+        "Whitted's sphere scene (OptiX paper §6.1, Fig. 7): checkered floor, metal and "
+        "glass-shell spheres, shadow rays, optional adaptive antialiasing",
+        {
+            {"aa", "0",
+             "adaptive antialiasing: 0 = 1 ray per pixel, 1 = 4 rays, 16 where they differ"},
+            {"aa_threshold", "0.1",
+             "largest per-channel difference among the 4 rays before 16 are traced (0..1)"},
+            {"max_depth", "6", "deepest reflection/refraction ray tree (1..31)"},
+            {"shadows", "1", "shadow rays: 0 = off, 1 = on (glass casts a lighter shadow)"},
+            {"lights", "1", "number of point lights, sharing one intensity (1..3)"},
+        },
+        &render_whitted,
+    };
+    return info;
+}
+
+}  // namespace lucent::samples

@@ -1,0 +1,37 @@
+// The Whitted sample (OptiX paper §6.1, Fig. 7): Whitted's sphere scene, ray traced with a
+// pinhole camera, Phong/metal/glass materials, shadow rays and optional adaptive
+// antialiasing. Programs in whitted_programs.h, host setup in whitted.cpp.
+#pragma once
+
+#include "samples/sample.h"
+
+namespace lucent::samples {
+
+/// The sample's name, options and render function, for the registry.
+const SampleInfo& whitted_sample_info();
+
+/// Where things are in the Whitted scene (world units, y up), for tests that probe the image.
+struct WhittedLayout {
+    float3 eye, lookat, up;
+    float vfov_degrees;  // vertical field of view; the horizontal one follows the aspect
+    float3 background;   // the miss program's colour
+    float3 metal_center;
+    float metal_radius;
+    float3 glass_center;
+    float glass_radius;     // outer radius of the shell
+    float glass_thickness;  // inner radius = glass_radius - glass_thickness
+    float floor_height;
+    float3 key_light;                 // position of the first light (the only one with lights=1)
+    float light_intensity;            // white; shared among the lights when there are several
+    float ambient;                    // grey ambient light
+    float glass_shadow_transmission;  // of one glass surface at normal incidence
+};
+
+/// The scene's fixed layout.
+const WhittedLayout& whitted_layout();
+
+/// Image position (x right, y down, in pixels; pixel i covers [i, i + 1)) where the world
+/// point p appears in a width x height render.
+float2 whitted_project(float3 p, unsigned width, unsigned height);
+
+}  // namespace lucent::samples

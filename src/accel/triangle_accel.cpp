@@ -1,0 +1,194 @@
+// TriangleAccel: build (binned SAH over triangle boxes), collapse of the binary tree into
+// 8-wide nodes with SoA leaves, and refit. The queries are in triangle_traverse.cpp.
+#include <algorithm>
+#include <chrono>
+
+#include "accel/triangle_accel.h"
+#include "accel/wide_bvh.h"
+
+namespace lucent::accel {
+
+namespace {
+
+constexpr uint32_t kMaxBlockTriangles = 4;
+
+uint3 triangle(std::span<const uint3> indices, size_t i) {
+    if (!indices.empty()) return indices[i];
+    uint32_t b = (uint32_t)(3 * i);
+    return make_uint3(b, b + 1, b + 2);
+}
+
+std::vector<Aabb> triangle_boxes(std::span<const float3> vertices, std::span<const uint3> indices,
+                                 size_t count) {
+    std::vector<Aabb> boxes(count);
+    for (size_t i = 0; i < count; ++i) {
+        uint3 t = triangle(indices, i);
+        float3 a = vertices[t.x], b = vertices[t.y], c = vertices[t.z];
+        boxes[i].lo = fminf(a, fminf(b, c));
+        boxes[i].hi = fmaxf(a, fmaxf(b, c));
+    }
+    return boxes;
+}
+
+float half_area(float3 lo, float3 hi) {
+    float3 d = hi - lo;
+    if (!(d.x >= 0.0f)) return -1.0f;
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+}
+
+/// Depth-first emission of the wide tree: each node takes the two children of a binary
+/// node and repeatedly opens its largest internal child until it has kWideArity children
+/// (the collapse of Wald, Benthin and Boulos 2008, "Getting rid of packets").
+struct Collapser {
+    const Bvh& binary;
+    std::span<const float3> vertices;
+    std::span<const uint3> indices;
+    std::vector<WideNode>& nodes;
+    std::vector<TriangleBlock>& blocks;
+    unsigned max_depth = 0;
+
+    uint32_t emit_leaf(const BvhNode& leaf) {
+        uint32_t index = (uint32_t)blocks.size();
+        TriangleBlock& block = blocks.emplace_back();
+        for (uint32_t lane = 0; lane < 4; ++lane) {
+            // Padding lanes repeat the first triangle; traversal masks them by the count.
+            uint32_t prim = binary.prim_order()[leaf.first + (lane < leaf.count ? lane : 0)];
+            uint3 t = triangle(indices, prim);
+            const float3 v[3] = {vertices[t.x], vertices[t.y], vertices[t.z]};
+            for (int k = 0; k < 3; ++k) {
+                block.vertex[k][0][lane] = v[k].x;
+                block.vertex[k][1][lane] = v[k].y;
+                block.vertex[k][2][lane] = v[k].z;
+            }
+            block.prim[lane] = prim;
+        }
+        return kLeafBit | ((leaf.count - 1) << kLeafCountShift) | index;
+    }
+
+    uint32_t emit_node(uint32_t bnode, unsigned depth) {
+        max_depth = std::max(max_depth, depth);
+        const auto& bn = binary.nodes();
+        uint32_t kids[kWideArity];
+        int n = 0;
+        if (bn[bnode].count > 0) {
+            kids[n++] = bnode;
+        } else {
+            kids[n++] = bn[bnode].first;
+            kids[n++] = bn[bnode].first + 1;
+        }
+        while (n < kWideArity) {
+            int best = -1;
+            float best_area = -1.0f;
+            for (int i = 0; i < n; ++i) {
+                const BvhNode& c = bn[kids[i]];
+                if (c.count > 0) continue;
+                float a = half_area(c.lo, c.hi);
+                if (a > best_area) best_area = a, best = i;
+            }
+            if (best < 0) break;
+            uint32_t first = bn[kids[best]].first;
+            kids[best] = first;
+            kids[n++] = first + 1;
+        }
+        const uint32_t me = (uint32_t)nodes.size();
+        nodes.emplace_back();
+        for (int i = 0; i < kWideArity; ++i) {
+            WideNode& w = nodes[me];
+            if (i >= n) {
+                for (int k = 0; k < 3; ++k) {
+                    w.planes[k][0][i] = kInfinity;
+                    w.planes[k][1][i] = -kInfinity;
+                }
+                w.child[i] = kEmptyChild;
+                continue;
+            }
+            const BvhNode& c = bn[kids[i]];
+            w.planes[0][0][i] = c.lo.x, w.planes[0][1][i] = c.hi.x;
+            w.planes[1][0][i] = c.lo.y, w.planes[1][1][i] = c.hi.y;
+            w.planes[2][0][i] = c.lo.z, w.planes[2][1][i] = c.hi.z;
+            uint32_t ref = c.count > 0 ? emit_leaf(c) : emit_node(kids[i], depth + 1);
+            nodes[me].child[i] = ref;  // `w` may dangle: emit_node grows `nodes`
+        }
+        return me;
+    }
+};
+
+}  // namespace
+
+void TriangleAccel::Impl::collapse(std::span<const float3> vertices,
+                                   std::span<const uint3> indices) {
+    nodes.clear();
+    blocks.clear();
+    wide_depth = 0;
+    if (binary.empty()) {
+        WideNode& root = nodes.emplace_back();
+        for (int i = 0; i < kWideArity; ++i) {
+            for (int k = 0; k < 3; ++k) {
+                root.planes[k][0][i] = kInfinity;
+                root.planes[k][1][i] = -kInfinity;
+            }
+            root.child[i] = kEmptyChild;
+        }
+        return;
+    }
+    nodes.reserve(binary.nodes().size() / 4 + 1);
+    blocks.reserve(binary.nodes().size() / 2 + 1);
+    Collapser c{binary, vertices, indices, nodes, blocks};
+    c.emit_node(0, 1);
+    wide_depth = c.max_depth;
+}
+
+TriangleAccel::TriangleAccel() : m_impl(std::make_unique<Impl>()) {
+    m_impl->collapse({}, {});
+}
+TriangleAccel::~TriangleAccel() = default;
+TriangleAccel::TriangleAccel(TriangleAccel&&) noexcept = default;
+TriangleAccel& TriangleAccel::operator=(TriangleAccel&&) noexcept = default;
+
+void TriangleAccel::build(std::span<const float3> vertices, std::span<const uint3> indices,
+                          const BuildOptions& options, BuildStats* stats) {
+    auto start = std::chrono::steady_clock::now();
+    if (!m_impl) m_impl = std::make_unique<Impl>();
+    const size_t count = indices.empty() ? vertices.size() / 3 : indices.size();
+    m_impl->triangle_count = count;
+    std::vector<Aabb> boxes = triangle_boxes(vertices, indices, count);
+    BuildOptions opt = options;
+    // A leaf is one block of four triangles, tested in one SIMD pass.
+    opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, (int)kMaxBlockTriangles);
+    BuildStats binary_stats;
+    m_impl->binary.m_block_size = kMaxBlockTriangles;
+    m_impl->binary.build(boxes, opt, &binary_stats);
+    m_impl->sah_cost = binary_stats.sah_cost;
+    m_impl->collapse(vertices, indices);
+    if (stats) {
+        *stats = binary_stats;
+        stats->build_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        stats->node_count = m_impl->nodes.size();
+        stats->leaf_count = m_impl->blocks.size();
+    }
+}
+
+void TriangleAccel::refit(std::span<const float3> vertices, std::span<const uint3> indices) {
+    if (!m_impl) return;
+    std::vector<Aabb> boxes = triangle_boxes(vertices, indices, m_impl->triangle_count);
+    m_impl->binary.refit(boxes);
+    m_impl->sah_cost = m_impl->binary.sah_cost();
+    m_impl->collapse(vertices, indices);
+}
+
+size_t TriangleAccel::triangle_count() const {
+    return m_impl ? m_impl->triangle_count : 0;
+}
+
+Aabb TriangleAccel::bounds() const {
+    if (!m_impl) return Aabb{make_float3(kInfinity), make_float3(-kInfinity)};
+    return m_impl->binary.bounds();
+}
+
+double TriangleAccel::sah_cost() const {
+    return m_impl ? m_impl->sah_cost : 0.0;
+}
+
+}  // namespace lucent::accel

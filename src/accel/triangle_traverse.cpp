@@ -1,0 +1,338 @@
+// Single-ray traversal of TriangleAccel's 8-wide tree: one SIMD slab test for the eight
+// children of a node (AVX2) and one watertight test for the four triangles of a leaf
+// (SSE + FMA), the same arithmetic as lucent/device/triangle_intersect.h. Builds without
+// AVX2/FMA fall back to scalar loops over the same layout.
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "accel/triangle_accel.h"
+#include "accel/wide_bvh.h"
+#include "lucent/device/triangle_intersect.h"
+
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#define LUCENT_ACCEL_SIMD 1
+#else
+#define LUCENT_ACCEL_SIMD 0
+#endif
+
+namespace lucent::accel {
+
+namespace {
+
+// Box far distances are scaled up by 2 ulp so that rounding never culls a box the ray
+// touches (Ize 2013, "Robust BVH ray traversal").
+constexpr float kFarScale = 1.00000024f;
+constexpr int kStackSize = 512;  // 7 pushes per level; wide depth <= binary depth <= 60
+
+float safe_inverse(float d) {
+    return d != 0.0f ? 1.0f / d : (std::signbit(d) ? -kInfinity * 1e8f : kInfinity * 1e8f);
+}
+
+/// Everything a ray needs in the inner loops, computed once per query.
+struct RayState {
+    float org[3];
+    float rdir[3];
+    int near_plane[3], far_plane[3];  // offsets into WideNode::planes[axis]
+    WatertightRay wt;
+    float tmin;
+#if LUCENT_ACCEL_SIMD
+    __m256 org8[3], rdir8[3], tmin8;
+    __m128 ox4, oy4, oz4, sx4, sy4, sz4, tmin4;
+#endif
+    int vx, vy, vz;  // offsets of the permuted axes in TriangleBlock::vertex[v]
+
+    RayState(float3 o, float3 d, float t0) {
+        org[0] = o.x, org[1] = o.y, org[2] = o.z;
+        rdir[0] = safe_inverse(d.x), rdir[1] = safe_inverse(d.y), rdir[2] = safe_inverse(d.z);
+        for (int k = 0; k < 3; ++k) {
+            near_plane[k] = 16 * k + (rdir[k] >= 0.0f ? 0 : 8);
+            far_plane[k] = 16 * k + (rdir[k] >= 0.0f ? 8 : 0);
+        }
+        wt = make_watertight_ray(o, d);
+        tmin = t0;
+        vx = 4 * wt.kx, vy = 4 * wt.ky, vz = 4 * wt.kz;
+#if LUCENT_ACCEL_SIMD
+        for (int k = 0; k < 3; ++k) {
+            org8[k] = _mm256_set1_ps(org[k]);
+            rdir8[k] = _mm256_set1_ps(rdir[k]);
+        }
+        tmin8 = _mm256_set1_ps(t0);
+        ox4 = _mm_set1_ps(org[wt.kx]);
+        oy4 = _mm_set1_ps(org[wt.ky]);
+        oz4 = _mm_set1_ps(org[wt.kz]);
+        sx4 = _mm_set1_ps(wt.sx);
+        sy4 = _mm_set1_ps(wt.sy);
+        sz4 = _mm_set1_ps(wt.sz);
+        tmin4 = _mm_set1_ps(t0);
+#endif
+    }
+};
+
+/// Slab test of the eight children: returns the hit mask and writes entry distances.
+inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, float* dist) {
+    const float* p = &node.planes[0][0][0];
+#if LUCENT_ACCEL_SIMD
+    __m256 tn[3], tf[3];
+    for (int k = 0; k < 3; ++k) {
+        // (plane - o) * (1/d), not the fused plane/d - o/d: the fused form's error is absolute
+        // and lets rays through shared vertices on box faces slip past (kFarScale covers
+        // only this form's relative error).
+        tn[k] = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p + r.near_plane[k]), r.org8[k]),
+                              r.rdir8[k]);
+        tf[k] =
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p + r.far_plane[k]), r.org8[k]), r.rdir8[k]);
+    }
+    __m256 t_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), _mm256_max_ps(tn[2], r.tmin8));
+    __m256 t_far =
+        _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]), _mm256_min_ps(tf[2], _mm256_set1_ps(tmax)));
+    t_far = _mm256_mul_ps(t_far, _mm256_set1_ps(kFarScale));
+    _mm256_storeu_ps(dist, t_near);
+    return (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ));
+#else
+    unsigned mask = 0;
+    for (int i = 0; i < kWideArity; ++i) {
+        float t_near = r.tmin, t_far = tmax;
+        for (int k = 0; k < 3; ++k) {
+            t_near = lc_max(t_near, (p[r.near_plane[k] + i] - r.org[k]) * r.rdir[k]);
+            t_far = lc_min(t_far, (p[r.far_plane[k] + i] - r.org[k]) * r.rdir[k]);
+        }
+        dist[i] = t_near;
+        if (t_near <= t_far * kFarScale) mask |= 1u << i;
+    }
+    return mask;
+#endif
+}
+
+#if LUCENT_ACCEL_SIMD
+/// a*b - c*d, four lanes, with the same operations as difference_of_products().
+inline __m128 dop4(__m128 a, __m128 b, __m128 c, __m128 d) {
+    __m128 cd = _mm_mul_ps(c, d);
+    __m128 err = _mm_fnmadd_ps(c, d, cd);
+    __m128 dop = _mm_fmsub_ps(a, b, cd);
+    return _mm_add_ps(dop, err);
+}
+#endif
+
+/// Watertight test of the `count` triangles of a block against (tmin, tmax): returns the
+/// lanes hit and writes their distances.
+inline unsigned test_block(const TriangleBlock& block, uint32_t count, const RayState& r,
+                           float tmax, float* t_out) {
+#if LUCENT_ACCEL_SIMD
+    const float* v0 = &block.vertex[0][0][0];
+    const float* v1 = &block.vertex[1][0][0];
+    const float* v2 = &block.vertex[2][0][0];
+    const __m128 az = _mm_sub_ps(_mm_load_ps(v0 + r.vz), r.oz4);
+    const __m128 bz = _mm_sub_ps(_mm_load_ps(v1 + r.vz), r.oz4);
+    const __m128 cz = _mm_sub_ps(_mm_load_ps(v2 + r.vz), r.oz4);
+    const __m128 ax = _mm_fnmadd_ps(r.sx4, az, _mm_sub_ps(_mm_load_ps(v0 + r.vx), r.ox4));
+    const __m128 ay = _mm_fnmadd_ps(r.sy4, az, _mm_sub_ps(_mm_load_ps(v0 + r.vy), r.oy4));
+    const __m128 bx = _mm_fnmadd_ps(r.sx4, bz, _mm_sub_ps(_mm_load_ps(v1 + r.vx), r.ox4));
+    const __m128 by = _mm_fnmadd_ps(r.sy4, bz, _mm_sub_ps(_mm_load_ps(v1 + r.vy), r.oy4));
+    const __m128 cx = _mm_fnmadd_ps(r.sx4, cz, _mm_sub_ps(_mm_load_ps(v2 + r.vx), r.ox4));
+    const __m128 cy = _mm_fnmadd_ps(r.sy4, cz, _mm_sub_ps(_mm_load_ps(v2 + r.vy), r.oy4));
+    const __m128 e0 = dop4(cx, by, cy, bx);
+    const __m128 e1 = dop4(ax, cy, ay, cx);
+    const __m128 e2 = dop4(bx, ay, by, ax);
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 neg =
+        _mm_or_ps(_mm_or_ps(_mm_cmp_ps(e0, zero, _CMP_LT_OQ), _mm_cmp_ps(e1, zero, _CMP_LT_OQ)),
+                  _mm_cmp_ps(e2, zero, _CMP_LT_OQ));
+    const __m128 pos =
+        _mm_or_ps(_mm_or_ps(_mm_cmp_ps(e0, zero, _CMP_GT_OQ), _mm_cmp_ps(e1, zero, _CMP_GT_OQ)),
+                  _mm_cmp_ps(e2, zero, _CMP_GT_OQ));
+    const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
+    const __m128 inside = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmp_ps(det, zero, _CMP_NEQ_UQ));
+    unsigned mask = (unsigned)_mm_movemask_ps(inside) & ((1u << count) - 1);
+    if (mask == 0) return 0;
+    const __m128 scaled = _mm_fmadd_ps(
+        e2, _mm_mul_ps(r.sz4, cz),
+        _mm_fmadd_ps(e1, _mm_mul_ps(r.sz4, bz), _mm_mul_ps(e0, _mm_mul_ps(r.sz4, az))));
+    const __m128 t = _mm_div_ps(scaled, det);
+    const __m128 in_range = _mm_and_ps(_mm_cmp_ps(t, r.tmin4, _CMP_GT_OQ),
+                                       _mm_cmp_ps(t, _mm_set1_ps(tmax), _CMP_LT_OQ));
+    mask &= (unsigned)_mm_movemask_ps(in_range);
+    _mm_storeu_ps(t_out, t);
+    return mask;
+#else
+    unsigned mask = 0;
+    for (uint32_t lane = 0; lane < count; ++lane) {
+        float3 p[3];
+        for (int k = 0; k < 3; ++k)
+            p[k] = make_float3(block.vertex[k][0][lane], block.vertex[k][1][lane],
+                               block.vertex[k][2][lane]);
+        float u, v;
+        if (intersect_triangle_watertight(r.wt, p[0], p[1], p[2], r.tmin, tmax, t_out[lane], u, v))
+            mask |= 1u << lane;
+    }
+    return mask;
+#endif
+}
+
+/// Barycentrics of one lane, recomputed with the scalar test (same bits as the SIMD one).
+void lane_barycentrics(const TriangleBlock& block, int lane, const RayState& r, TriangleHit& hit) {
+    float3 p[3];
+    for (int k = 0; k < 3; ++k)
+        p[k] = make_float3(block.vertex[k][0][lane], block.vertex[k][1][lane],
+                           block.vertex[k][2][lane]);
+    float t, u, v;
+    if (intersect_triangle_watertight(r.wt, p[0], p[1], p[2], -kInfinity, kInfinity, t, u, v)) {
+        hit.u = u;
+        hit.v = v;
+    } else {
+        hit.u = hit.v = 0.0f;
+    }
+}
+
+enum class Query { kClosest, kAny, kFiltered };
+
+/// The one traversal loop, specialized per query. Closest and filtered queries visit the
+/// children nearest first and drop stack entries beyond the current closest hit.
+template <Query kQuery>
+bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
+              float tmax, TriangleHit* hit, HitDecision (*thunk)(void*, const TriangleHit&),
+              void* filter) {
+    const RayState r(origin, direction, tmin);
+    uint32_t stack_ref[kStackSize];
+    float stack_dist[kStackSize];
+    int sp = 0;
+    uint32_t ref = 0;
+    bool found = false;
+    const TriangleBlock* best_block = nullptr;
+    int best_lane = 0;
+    alignas(32) float dist[kWideArity];
+    alignas(16) float t_lane[4];
+    for (;;) {
+        if (!is_leaf(ref)) {
+            const WideNode& node = accel.nodes[ref];
+            unsigned mask = test_node(node, r, tmax, dist);
+            if (mask != 0) {
+                unsigned c0 = (unsigned)std::countr_zero(mask);
+                mask &= mask - 1;
+                if (mask == 0) {
+                    ref = node.child[c0];
+                    continue;
+                }
+                if constexpr (kQuery == Query::kAny) {
+                    // Order does not matter for occlusion: go down the first, keep the rest.
+                    do {
+                        unsigned c = (unsigned)std::countr_zero(mask);
+                        mask &= mask - 1;
+                        stack_ref[sp] = node.child[c];
+                        stack_dist[sp++] = dist[c];
+                    } while (mask != 0);
+                    ref = node.child[c0];
+                    continue;
+                } else {
+                    unsigned c1 = (unsigned)std::countr_zero(mask);
+                    mask &= mask - 1;
+                    if (mask == 0) {
+                        if (dist[c1] < dist[c0]) std::swap(c0, c1);
+                        stack_ref[sp] = node.child[c1];
+                        stack_dist[sp++] = dist[c1];
+                        ref = node.child[c0];
+                        continue;
+                    }
+                    // Three or more: push all, sort them far to near, continue with the nearest.
+                    const int base = sp;
+                    stack_ref[sp] = node.child[c0];
+                    stack_dist[sp++] = dist[c0];
+                    stack_ref[sp] = node.child[c1];
+                    stack_dist[sp++] = dist[c1];
+                    do {
+                        unsigned c = (unsigned)std::countr_zero(mask);
+                        mask &= mask - 1;
+                        stack_ref[sp] = node.child[c];
+                        stack_dist[sp++] = dist[c];
+                    } while (mask != 0);
+                    for (int i = base + 1; i < sp; ++i) {
+                        float d = stack_dist[i];
+                        uint32_t c = stack_ref[i];
+                        int j = i - 1;
+                        while (j >= base && stack_dist[j] < d) {
+                            stack_dist[j + 1] = stack_dist[j];
+                            stack_ref[j + 1] = stack_ref[j];
+                            --j;
+                        }
+                        stack_dist[j + 1] = d;
+                        stack_ref[j + 1] = c;
+                    }
+                    ref = stack_ref[--sp];
+                    continue;
+                }
+            }
+        } else if (ref != kEmptyChild) {
+            const TriangleBlock& block = accel.blocks[leaf_block(ref)];
+            unsigned mask = test_block(block, leaf_count(ref), r, tmax, t_lane);
+            if (mask != 0) {
+                if constexpr (kQuery == Query::kAny) {
+                    return true;
+                } else if constexpr (kQuery == Query::kClosest) {
+                    do {
+                        int lane = std::countr_zero(mask);
+                        mask &= mask - 1;
+                        if (t_lane[lane] < tmax) {
+                            tmax = t_lane[lane];
+                            best_block = &block;
+                            best_lane = lane;
+                        }
+                    } while (mask != 0);
+                    found = true;
+                } else {
+                    do {
+                        int lane = std::countr_zero(mask);
+                        mask &= mask - 1;
+                        if (!(t_lane[lane] < tmax)) continue;
+                        TriangleHit candidate;
+                        candidate.t = t_lane[lane];
+                        candidate.prim = block.prim[lane];
+                        lane_barycentrics(block, lane, r, candidate);
+                        HitDecision decision = thunk(filter, candidate);
+                        if (decision == HitDecision::kIgnore) continue;
+                        *hit = candidate;
+                        found = true;
+                        tmax = candidate.t;
+                        if (decision == HitDecision::kAcceptAndStop) return true;
+                    } while (mask != 0);
+                }
+            }
+        }
+        // Pop the next entry that may still hold a nearer hit.
+        for (;;) {
+            if (sp == 0) {
+                if constexpr (kQuery == Query::kClosest) {
+                    if (found) {
+                        hit->t = tmax;
+                        hit->prim = best_block->prim[best_lane];
+                        lane_barycentrics(*best_block, best_lane, r, *hit);
+                    }
+                }
+                return found;
+            }
+            --sp;
+            if (kQuery == Query::kAny || stack_dist[sp] <= tmax) break;
+        }
+        ref = stack_ref[sp];
+    }
+}
+
+}  // namespace
+
+bool TriangleAccel::intersect(float3 origin, float3 direction, float tmin, float tmax,
+                              TriangleHit& hit) const {
+    return traverse<Query::kClosest>(*m_impl, origin, direction, tmin, tmax, &hit, nullptr,
+                                     nullptr);
+}
+
+bool TriangleAccel::occluded(float3 origin, float3 direction, float tmin, float tmax) const {
+    return traverse<Query::kAny>(*m_impl, origin, direction, tmin, tmax, nullptr, nullptr, nullptr);
+}
+
+bool TriangleAccel::intersect_filtered_impl(float3 origin, float3 direction, float tmin, float tmax,
+                                            TriangleHit& hit, FilterThunk thunk,
+                                            void* filter) const {
+    return traverse<Query::kFiltered>(*m_impl, origin, direction, tmin, tmax, &hit, thunk, filter);
+}
+
+}  // namespace lucent::accel

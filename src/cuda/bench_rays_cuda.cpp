@@ -1,0 +1,526 @@
+#include "cuda/bench_rays_cuda.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "accel/triangle_accel.h"
+#include "cuda/device_buffer.h"
+#include "cuda/driver_api.h"
+#include "cuda/embedded_sources.h"
+#include "cuda/gpu_triangle_bvh.h"
+#include "cuda/nvrtc_compiler.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+
+const DriverApi& require_driver() {
+    std::string why;
+    const DriverApi* d = driver(&why);
+    if (!d)
+        throw Error("--backend cuda: no NVIDIA driver or GPU usable (" + why +
+                    "); run with --backend cpu");
+    return *d;
+}
+
+/// The primary context of device 0, current while this object lives.
+class ContextScope {
+  public:
+    explicit ContextScope(const DriverApi& api) : m_api(api) {
+        check(api.cuDeviceGet(&m_device, 0), "cuDeviceGet");
+        check(api.cuDevicePrimaryCtxRetain(&m_context, m_device), "cuDevicePrimaryCtxRetain");
+        check(api.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+    }
+    ~ContextScope() { m_api.cuDevicePrimaryCtxRelease(m_device); }
+    ContextScope(const ContextScope&) = delete;
+    ContextScope& operator=(const ContextScope&) = delete;
+
+    CUdevice device() const { return m_device; }
+    int attribute(CUdevice_attribute a) const {
+        int v = 0;
+        check(m_api.cuDeviceGetAttribute(&v, a, m_device), "cuDeviceGetAttribute");
+        return v;
+    }
+    std::string name() const {
+        char buf[256] = {};
+        check(m_api.cuDeviceGetName(buf, sizeof buf, m_device), "cuDeviceGetName");
+        return buf;
+    }
+
+  private:
+    const DriverApi& m_api;
+    CUdevice m_device = 0;
+    CUcontext m_context = nullptr;
+};
+
+class Module {
+  public:
+    Module(const DriverApi& api, const std::string& cubin) : m_api(api) {
+        check(api.cuModuleLoadData(&m_module, cubin.data()), "cuModuleLoadData");
+    }
+    ~Module() { m_api.cuModuleUnload(m_module); }
+    Module(const Module&) = delete;
+    Module& operator=(const Module&) = delete;
+    CUfunction function(const char* name) const {
+        CUfunction f = nullptr;
+        check(m_api.cuModuleGetFunction(&f, m_module, name), name);
+        return f;
+    }
+
+  private:
+    const DriverApi& m_api;
+    CUmodule m_module = nullptr;
+};
+
+class Event {
+  public:
+    explicit Event(const DriverApi& api) : m_api(api) {
+        check(api.cuEventCreate(&m_event, CU_EVENT_DEFAULT), "cuEventCreate");
+    }
+    ~Event() { m_api.cuEventDestroy(m_event); }
+    Event(const Event&) = delete;
+    Event& operator=(const Event&) = delete;
+    CUevent get() const { return m_event; }
+
+  private:
+    const DriverApi& m_api;
+    CUevent m_event = nullptr;
+};
+
+std::vector<std::string> split_options(const char* text) {
+    std::vector<std::string> out;
+    if (!text) return out;
+    std::istringstream in(text);
+    for (std::string word; in >> word;) out.push_back(word);
+    return out;
+}
+
+bool env_flag(const char* name, bool fallback) {
+    const char* v = std::getenv(name);
+    if (!v || !*v) return fallback;
+    return std::strcmp(v, "0") != 0 && std::strcmp(v, "off") != 0;
+}
+
+GpuBvhBuildOptions gpu_build_options() {
+    GpuBvhBuildOptions o;
+    if (const char* v = std::getenv("LUCENT_GPU_LEAF_SIZE"); v && *v) {
+        o.max_leaf_size = std::atoi(v);
+        if (o.max_leaf_size < 1 || o.max_leaf_size > gpu::kGpuMaxLeafSize)
+            throw Error("LUCENT_GPU_LEAF_SIZE=" + std::string(v) + ": expected 1.." +
+                        std::to_string(gpu::kGpuMaxLeafSize));
+    }
+    return o;
+}
+
+double median_of(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t m = v.size();
+    return m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+}
+
+struct Rate {
+    double median = 0, min = 0, max = 0;
+};
+
+Rate rate_of(const std::vector<double>& mrays) {
+    Rate r;
+    if (mrays.empty()) return r;
+    r.median = median_of(mrays);
+    r.min = *std::min_element(mrays.begin(), mrays.end());
+    r.max = *std::max_element(mrays.begin(), mrays.end());
+    return r;
+}
+
+/// Checksums of one engine on the three ray sets (as the CPU bench computes them).
+struct Checksums {
+    size_t primary_hits = 0, shadow_rays = 0, occluded = 0, diffuse_rays = 0, diffuse_hits = 0;
+    double primary_sum_t = 0, diffuse_sum_t = 0;
+};
+
+bool close(double a, double b) {
+    return std::fabs(a - b) <= 1e-6 * std::max(std::fabs(a), std::fabs(b));
+}
+
+std::string checksum_differences(const Checksums& a, const Checksums& b) {
+    std::string out;
+    auto add = [&](const char* what, double x, double y, bool ok) {
+        if (ok) return;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%s%s %.9g (gpu) vs %.9g (cpu)", out.empty() ? "" : ", ",
+                      what, x, y);
+        out += buf;
+    };
+    add("primary hits", a.primary_hits, b.primary_hits, a.primary_hits == b.primary_hits);
+    add("primary sum_t", a.primary_sum_t, b.primary_sum_t, close(a.primary_sum_t, b.primary_sum_t));
+    add("shadow occluded", a.occluded, b.occluded, a.occluded == b.occluded);
+    add("diffuse hits", a.diffuse_hits, b.diffuse_hits, a.diffuse_hits == b.diffuse_hits);
+    add("diffuse sum_t", a.diffuse_sum_t, b.diffuse_sum_t, close(a.diffuse_sum_t, b.diffuse_sum_t));
+    return out;
+}
+
+/// Runs body(i) for i in [0, count) on `threads` threads, in chunks from an atomic counter.
+template <class Body>
+void parallel_for(size_t count, unsigned threads, Body&& body) {
+    std::atomic<size_t> next{0};
+    auto worker = [&] {
+        for (;;) {
+            const size_t begin = next.fetch_add(256, std::memory_order_relaxed);
+            if (begin >= count) return;
+            const size_t end = std::min(count, begin + 256);
+            for (size_t i = begin; i < end; ++i) body(i);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+}
+
+float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+
+/// The compiled bench module and how to launch its trace kernels.
+struct BenchKernels {
+    CUfunction closest = nullptr, any = nullptr, primary_rays = nullptr, secondary_rays = nullptr;
+    bool persistent = true;
+    int block = 128;
+    int grid_closest = 0, grid_any = 0;  // persistent grids: SMs x resident blocks
+    std::string describe;
+};
+
+CompileResult compile_bench_kernels(int sm, bool persistent) {
+    CompileRequest req;
+    req.name = "lucent_bench_kernels.cu";
+    req.source = "#include \"lucent_gpu/bench_kernels.cuh\"\n";
+    for (const EmbeddedSource& s : embedded_sources())
+        req.headers.emplace_back(std::string(s.name), std::string(s.text));
+    // --fmad=false: ray generation rounds each operation as the host does; traversal and the
+    // watertight test already spell out every fused multiply-add they use (fmaf).
+    req.options = {"--std=c++17", "--fmad=false", "-DLUCENT_BENCH_PERSISTENT=" +
+                                                      std::string(persistent ? "1" : "0")};
+    for (std::string& o : split_options(std::getenv("LUCENT_BENCH_NVRTC_OPTIONS")))
+        req.options.push_back(std::move(o));
+    req.sm = sm;
+    return compile_cubin(req);
+}
+
+}  // namespace
+
+int run_bench_rays_cuda(const CudaRaysInput& in) {
+    if (in.width == 0 || in.height == 0)
+        throw Error("bench rays: the image size must be at least 1x1");
+    if (in.repeat < 1) throw Error("bench rays: --repeat must be at least 1");
+    const DriverApi& api = require_driver();
+    ContextScope ctx(api);
+    const int sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
+                   ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+    const int sm_count = ctx.attribute(CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT);
+    const unsigned threads =
+        in.threads ? in.threads : std::max(1u, std::thread::hardware_concurrency());
+
+    // Kernels.
+    BenchKernels k;
+    k.persistent = env_flag("LUCENT_BENCH_PERSISTENT", true);
+    const CompileResult compiled = compile_bench_kernels(sm, k.persistent);
+    Module module(api, compiled.cubin);
+    k.closest = module.function("lucent_bench_closest");
+    k.any = module.function("lucent_bench_any");
+    k.primary_rays = module.function("lucent_bench_primary_rays");
+    k.secondary_rays = module.function("lucent_bench_secondary_rays");
+    auto attr = [&](CUfunction f, CUfunction_attribute a) {
+        int v = 0;
+        check(api.cuFuncGetAttribute(&v, a, f), "cuFuncGetAttribute");
+        return v;
+    };
+    k.block = std::min(attr(k.closest, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK),
+                       attr(k.any, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
+    auto resident = [&](CUfunction f) {
+        int blocks = 0;
+        check(api.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, f, k.block, 0),
+              "cuOccupancyMaxActiveBlocksPerMultiprocessor");
+        return std::max(1, blocks);
+    };
+    const int res_closest = resident(k.closest), res_any = resident(k.any);
+    k.grid_closest = sm_count * res_closest;
+    k.grid_any = sm_count * res_any;
+    {
+        char buf[512];
+        std::snprintf(buf, sizeof buf,
+                      "%s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
+                      "local %d blocks/SM; NVRTC %.0f ms%s",
+                      k.persistent ? "persistent threads + dynamic fetch" : "one thread per ray",
+                      k.block, attr(k.closest, CU_FUNC_ATTRIBUTE_NUM_REGS),
+                      attr(k.closest, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_closest,
+                      attr(k.any, CU_FUNC_ATTRIBUTE_NUM_REGS),
+                      attr(k.any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_any, compiled.ms,
+                      compiled.from_cache ? " (cache)" : "");
+        k.describe = buf;
+    }
+
+    // The BVH.
+    const GpuTriangleBvh bvh = build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
+    GpuTriangleBvhDevice dbvh;
+    upload_gpu_triangle_bvh(bvh, dbvh);
+    gpu::GpuTriangleBvhView view = dbvh.view();
+    const size_t tri_count = bvh.triangle_ids.size();
+    std::vector<float4> by_prim(3 * tri_count);
+    for (size_t i = 0; i < tri_count; ++i)
+        for (int v = 0; v < 3; ++v) by_prim[3 * bvh.triangle_ids[i] + v] = bvh.triangles[3 * i + v];
+    DeviceBuffer tris_by_prim;
+    tris_by_prim.upload(std::span<const float4>(by_prim));
+
+    DeviceBuffer counter(sizeof(unsigned));
+    Event start(api), stop(api);
+
+    // Launches a trace kernel `repeat` + 1 times (the first is the warm-up) and returns
+    // the Mrays/s of the timed ones (trace kernel alone, CUDA events).
+    auto time_trace = [&](CUfunction f, int grid_persistent, CUdeviceptr rays, unsigned count,
+                          CUdeviceptr out) {
+        std::vector<double> mrays;
+        if (count == 0) return Rate{};
+        CUdeviceptr counter_ptr = counter.ptr();
+        void* args[] = {&view, &rays, &count, &out, &counter_ptr};
+        const unsigned grid =
+            k.persistent ? (unsigned)grid_persistent : (count + k.block - 1) / k.block;
+        for (int run = -1; run < in.repeat; ++run) {
+            counter.fill(0);
+            check(api.cuEventRecord(start.get(), nullptr), "cuEventRecord");
+            check(api.cuLaunchKernel(f, grid, 1, 1, k.block, 1, 1, 0, nullptr, args, nullptr),
+                  "cuLaunchKernel (trace)");
+            check(api.cuEventRecord(stop.get(), nullptr), "cuEventRecord");
+            check(api.cuEventSynchronize(stop.get()), "trace kernel");
+            float ms = 0;
+            check(api.cuEventElapsedTime(&ms, start.get(), stop.get()), "cuEventElapsedTime");
+            if (run >= 0) mrays.push_back(count / (ms * 1e-3) * 1e-6);
+        }
+        return rate_of(mrays);
+    };
+    auto launch_1d = [&](CUfunction f, unsigned count, void** args, const char* what) {
+        if (count == 0) return;
+        check(api.cuLaunchKernel(f, (count + 255) / 256, 1, 1, 256, 1, 1, 0, nullptr, args,
+                                 nullptr),
+              what);
+        check(api.cuCtxSynchronize(), what);
+    };
+
+    // Primary rays (BENCH.md), generated on the GPU.
+    const unsigned n = in.width * in.height;
+    DeviceBuffer primary(sizeof(float4) * 2 * n), primary_hits(sizeof(uint2) * n);
+    {
+        const float3 fwd = normalize(in.look - in.eye);
+        const float3 right = normalize(cross(fwd, in.up));
+        const float3 up2 = cross(right, fwd);
+        float t = std::tan(in.fov / 2 * kPi / 180);
+        float a = (float)in.width / (float)in.height;
+        float p[12] = {in.eye.x, in.eye.y, in.eye.z, fwd.x, fwd.y, fwd.z,
+                       right.x,  right.y,  right.z,  up2.x, up2.y, up2.z};
+        unsigned w = in.width, h = in.height;
+        CUdeviceptr rays = primary.ptr();
+        void* args[] = {&p[0], &p[1], &p[2], &p[3], &p[4],  &p[5], &p[6], &p[7], &p[8],
+                        &p[9], &p[10], &p[11], &t, &a,   &w,    &h,    &rays};
+        launch_1d(k.primary_rays, n, args, "primary ray generation");
+    }
+    // The reference below traces the very rays the GPU made, so the comparison is exact
+    // even where the host compiler contracts the ray formulas differently.
+    Checksums gpu;
+    const Rate rate_primary =
+        time_trace(k.closest, k.grid_closest, primary.ptr(), n, primary_hits.ptr());
+    std::vector<uint2> hits_p(n);
+    primary_hits.download(hits_p.data(), sizeof(uint2) * n);
+    std::vector<unsigned> slot(n);
+    unsigned m = 0;
+    for (unsigned i = 0; i < n; ++i) {
+        const float t = std::bit_cast<float>(hits_p[i].x);
+        slot[i] = m;
+        if (t >= 0.0f) ++m, ++gpu.primary_hits, gpu.primary_sum_t += t;
+    }
+
+    // Shadow and diffuse rays from the GPU's primary hits, in pixel order.
+    DeviceBuffer slots, shadow(sizeof(float4) * 2 * std::max(m, 1u)),
+        diffuse(sizeof(float4) * 2 * std::max(m, 1u));
+    slots.upload(std::span<const unsigned>(slot));
+    {
+        CUdeviceptr a0 = primary.ptr(), a1 = primary_hits.ptr(), a2 = slots.ptr(),
+                    a3 = tris_by_prim.ptr(), a4 = shadow.ptr(), a5 = diffuse.ptr();
+        unsigned count = n;
+        float lx = in.light.x, ly = in.light.y, lz = in.light.z;
+        void* args[] = {&a0, &a1, &a2, &a3, &count, &lx, &ly, &lz, &a4, &a5};
+        launch_1d(k.secondary_rays, n, args, "secondary ray generation");
+    }
+    DeviceBuffer occluded(std::max(m, 1u)), diffuse_hits(sizeof(uint2) * std::max(m, 1u));
+    const Rate rate_shadow = time_trace(k.any, k.grid_any, shadow.ptr(), m, occluded.ptr());
+    const Rate rate_diffuse =
+        time_trace(k.closest, k.grid_closest, diffuse.ptr(), m, diffuse_hits.ptr());
+    std::vector<unsigned char> occ(m);
+    std::vector<uint2> hits_d(m);
+    occluded.download(occ.data(), m);
+    diffuse_hits.download(hits_d.data(), sizeof(uint2) * m);
+    gpu.shadow_rays = gpu.diffuse_rays = m;
+    for (unsigned char b : occ) gpu.occluded += b;
+    for (const uint2& h : hits_d) {
+        const float t = std::bit_cast<float>(h.x);
+        if (t >= 0.0f) ++gpu.diffuse_hits, gpu.diffuse_sum_t += t;
+    }
+
+    // The CPU backend (TriangleAccel, all threads) on the same rays.
+    std::vector<float4> rays_p(2 * (size_t)n), rays_s(2 * (size_t)m), rays_d(2 * (size_t)m);
+    primary.download(rays_p.data(), rays_p.size() * sizeof(float4));
+    shadow.download(rays_s.data(), rays_s.size() * sizeof(float4));
+    diffuse.download(rays_d.data(), rays_d.size() * sizeof(float4));
+    accel::TriangleAccel cpu_accel;
+    cpu_accel.build(in.positions, in.indices);
+    auto cpu_closest = [&](const std::vector<float4>& rays, size_t count) {
+        std::vector<float> t(count);
+        parallel_for(count, threads, [&](size_t i) {
+            accel::TriangleHit hit;
+            const float4 o = rays[2 * i], d = rays[2 * i + 1];
+            t[i] = cpu_accel.intersect(xyz(o), xyz(d), o.w, d.w, hit) ? hit.t : -1.0f;
+        });
+        return t;
+    };
+    Checksums cpu;
+    size_t differ_p = 0, differ_s = 0, differ_d = 0;
+    const std::vector<float> cpu_t = cpu_closest(rays_p, n);
+    for (unsigned i = 0; i < n; ++i) {
+        if (cpu_t[i] >= 0.0f) ++cpu.primary_hits, cpu.primary_sum_t += cpu_t[i];
+        differ_p += std::bit_cast<float>(hits_p[i].x) != cpu_t[i];
+    }
+    std::vector<unsigned char> cpu_occ(m);
+    parallel_for(m, threads, [&](size_t i) {
+        const float4 o = rays_s[2 * i], d = rays_s[2 * i + 1];
+        cpu_occ[i] = cpu_accel.occluded(xyz(o), xyz(d), o.w, d.w);
+    });
+    cpu.shadow_rays = cpu.diffuse_rays = m;
+    for (unsigned i = 0; i < m; ++i) {
+        cpu.occluded += cpu_occ[i];
+        differ_s += cpu_occ[i] != occ[i];
+    }
+    const std::vector<float> cpu_td = cpu_closest(rays_d, m);
+    for (unsigned i = 0; i < m; ++i) {
+        if (cpu_td[i] >= 0.0f) ++cpu.diffuse_hits, cpu.diffuse_sum_t += cpu_td[i];
+        differ_d += std::bit_cast<float>(hits_d[i].x) != cpu_td[i];
+    }
+    const std::string differences = checksum_differences(gpu, cpu);
+
+    if (in.json) {
+        auto rate = [](const Rate& x) {
+            char b[128];
+            std::snprintf(b, sizeof b, "\"mrays\": %.4f, \"min\": %.4f, \"max\": %.4f", x.median,
+                          x.min, x.max);
+            return std::string(b);
+        };
+        std::printf(
+            "{\"scene\": \"%s\", \"backend\": \"cuda\", \"device\": \"%s\", \"sm\": %d, "
+            "\"triangles\": %zu, \"width\": %u, \"height\": %u, \"repeat\": %d, "
+            "\"persistent\": %s, \"build_ms\": %.3f, \"bvh_nodes\": %zu, \"sah_cost\": %.4f,\n"
+            " \"lucent\": {\"primary\": {%s, \"hits\": %zu, \"sum_t\": %.9e}, "
+            "\"shadow\": {%s, \"rays\": %zu, \"occluded\": %zu}, "
+            "\"diffuse\": {%s, \"rays\": %zu, \"hits\": %zu, \"sum_t\": %.9e}},\n"
+            " \"cpu\": {\"primary\": {\"hits\": %zu, \"sum_t\": %.9e}, \"shadow\": {\"occluded\": "
+            "%zu}, \"diffuse\": {\"hits\": %zu, \"sum_t\": %.9e}},\n"
+            " \"rays_differing\": {\"primary\": %zu, \"shadow\": %zu, \"diffuse\": %zu}, "
+            "\"checksums_agree\": %s}\n",
+            in.scene.c_str(), ctx.name().c_str(), sm, tri_count, in.width, in.height, in.repeat,
+            k.persistent ? "true" : "false", bvh.stats.build_ms + bvh.stats.convert_ms,
+            bvh.stats.node_count, bvh.stats.sah_cost, rate(rate_primary).c_str(),
+            gpu.primary_hits, gpu.primary_sum_t, rate(rate_shadow).c_str(), gpu.shadow_rays,
+            gpu.occluded, rate(rate_diffuse).c_str(), gpu.diffuse_rays, gpu.diffuse_hits,
+            gpu.diffuse_sum_t, cpu.primary_hits, cpu.primary_sum_t, cpu.occluded,
+            cpu.diffuse_hits, cpu.diffuse_sum_t, differ_p, differ_s, differ_d,
+            differences.empty() ? "true" : "false");
+        return 0;
+    }
+    auto rate_text = [](const Rate& r) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%.2f Mrays/s (min %.2f, max %.2f)", r.median, r.min, r.max);
+        return std::string(buf);
+    };
+    std::printf(
+        "scene %s: %zu triangles, %ux%u, GPU %s (sm_%d, %d SMs), median of %d repeats, trace "
+        "kernel alone (CUDA events)\n",
+        in.scene.c_str(), tri_count, in.width, in.height, ctx.name().c_str(), sm, sm_count,
+        in.repeat);
+    std::printf("kernels: %s\n", k.describe.c_str());
+    std::printf("build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u)\n",
+                bvh.stats.build_ms, bvh.stats.convert_ms, bvh.stats.sah_cost,
+                bvh.stats.node_count, bvh.stats.leaf_count, bvh.stats.depth);
+    std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(rate_primary).c_str(),
+                gpu.primary_hits, gpu.primary_sum_t);
+    std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(rate_shadow).c_str(),
+                gpu.shadow_rays, gpu.occluded);
+    std::printf("diffuse %s rays=%zu hits=%zu sum_t=%.6e\n", rate_text(rate_diffuse).c_str(),
+                gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t);
+    std::printf("cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
+                "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",
+                cpu.primary_hits, cpu.primary_sum_t, cpu.occluded, cpu.diffuse_hits,
+                cpu.diffuse_sum_t, threads);
+    if (differences.empty())
+        std::printf("checksums: equal to the CPU backend\n");
+    else
+        std::printf("checksums: differ from the CPU backend: %s\n", differences.c_str());
+    if (differ_p || differ_s || differ_d)
+        std::printf("rays whose result differs from the CPU: primary %zu, shadow %zu, diffuse %zu\n",
+                    differ_p, differ_s, differ_d);
+    return 0;
+}
+
+int run_bench_build_cuda(const CudaBuildInput& in) {
+    if (in.repeat < 1) throw Error("bench build: --repeat must be at least 1");
+    const DriverApi& api = require_driver();
+    ContextScope ctx(api);
+    const GpuBvhBuildOptions options = gpu_build_options();
+    std::vector<double> total, build, convert, upload;
+    GpuBvhStats stats;
+    for (int run = -1; run < in.repeat; ++run) {
+        const auto t0 = std::chrono::steady_clock::now();
+        GpuTriangleBvh bvh = build_gpu_triangle_bvh(in.positions, in.indices, options);
+        const auto t1 = std::chrono::steady_clock::now();
+        GpuTriangleBvhDevice fresh;  // allocation is part of the cost, as for a new scene
+        upload_gpu_triangle_bvh(bvh, fresh);
+        check(api.cuCtxSynchronize(), "upload");
+        const auto t2 = std::chrono::steady_clock::now();
+        stats = bvh.stats;
+        if (run < 0) continue;
+        total.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
+        build.push_back(bvh.stats.build_ms);
+        convert.push_back(bvh.stats.convert_ms);
+        upload.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    }
+    const size_t tris = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
+    const double ms = median_of(total);
+    const double lo = *std::min_element(total.begin(), total.end());
+    const double hi = *std::max_element(total.begin(), total.end());
+    if (in.json) {
+        std::printf(
+            "{\"scene\": \"%s\", \"backend\": \"cuda\", \"device\": \"%s\", \"triangles\": %zu, "
+            "\"build_ms\": %.3f, \"min_ms\": %.3f, \"max_ms\": %.3f, \"sah_build_ms\": %.3f, "
+            "\"convert_ms\": %.3f, \"upload_ms\": %.3f, \"mtris_per_s\": %.3f, \"sah_cost\": %.4f, "
+            "\"nodes\": %zu, \"leaves\": %zu, \"depth\": %u}\n",
+            in.scene.c_str(), ctx.name().c_str(), tris, ms, lo, hi, median_of(build),
+            median_of(convert), median_of(upload), tris / ms * 1e-3, stats.sah_cost,
+            stats.node_count, stats.leaf_count, stats.depth);
+        return 0;
+    }
+    std::printf("scene %s: %zu triangles, GPU %s, median of %d builds (host build + convert + "
+                "upload)\n",
+                in.scene.c_str(), tris, ctx.name().c_str(), in.repeat);
+    std::printf(
+        "build %.2f ms (min %.2f, max %.2f) %.2f Mtris/s sah=%.3f nodes=%zu leaves=%zu depth=%u "
+        "(sah build %.2f ms, convert %.2f ms, upload %.2f ms)\n",
+        ms, lo, hi, tris / ms * 1e-3, stats.sah_cost, stats.node_count, stats.leaf_count,
+        stats.depth, median_of(build), median_of(convert), median_of(upload));
+    return 0;
+}
+
+}  // namespace lucent::cuda

@@ -1,0 +1,150 @@
+// The CUDA backend (ARCHITECTURE §4): at launch, if the compiled scene changed shape,
+// generate the megakernel, compile it with NVRTC (or load it from the disk cache), load it
+// with the driver API and run it with persistent threads.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include "core/backend.h"
+#include "cuda/cuda_backend.h"
+#include "cuda/driver_api.h"
+#include "cuda/gpu_scene.h"
+#include "cuda/megakernel_compiler.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+
+constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
+
+class CudaBackend final : public core::Backend {
+public:
+    explicit CudaBackend(const DriverApi& d) : m_driver(d) {
+        check(d.cuDeviceGet(&m_device, 0), "cuDeviceGet");
+        char name[256] = {};
+        d.cuDeviceGetName(name, sizeof name, m_device);
+        m_device_name = name;
+        int major = 0, minor = 0;
+        d.cuDeviceGetAttribute(&major, CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR, m_device);
+        d.cuDeviceGetAttribute(&minor, CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR, m_device);
+        d.cuDeviceGetAttribute(&m_sm_count, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, m_device);
+        m_sm = major * 10 + minor;
+        check(d.cuDevicePrimaryCtxRetain(&m_context, m_device), "cuDevicePrimaryCtxRetain");
+        check(d.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+    }
+    ~CudaBackend() override {
+        m_scene.reset();
+        if (m_module) m_driver.cuModuleUnload(m_module);
+        m_driver.cuDevicePrimaryCtxRelease(m_device);
+    }
+
+    std::string name() const override {
+        return "cuda (" + m_device_name + ", sm_" + std::to_string(m_sm) + ")";
+    }
+
+    void launch(const core::CompiledScene& scene, unsigned entry, uint3 size,
+                LaunchReport& report) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
+            if (!m_scene) m_scene = std::make_unique<GpuScene>();
+            m_scene->update(scene);
+            m_last_scene = &scene;
+            m_last_generation = scene.generation;
+            prepare_kernel(scene, report);
+        } else {
+            m_scene->sync_buffers();
+        }
+
+        gpu::LaunchParams p = m_scene->params();
+        p.ray_generation = m_scene->ray_generation(entry);
+        p.exception = m_scene->exception(entry);
+        p.launch_size = size;
+        p.launch_count = uint64_t(size.x) * size.y * size.z;
+        m_counter.alloc(sizeof(unsigned long long));
+        m_counter.fill(0);
+        std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
+        for (auto& s : slots) s = {0, 0, 0, ~0ull};
+        m_exceptions.upload(slots.data(), slots.size() * sizeof slots[0]);
+        p.work_counter = const_cast<unsigned long long*>(m_counter.as<unsigned long long>());
+        p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
+        const unsigned threads = unsigned(m_grid) * kBlock;
+        if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
+            m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
+        p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
+        check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
+
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_grid), 1, 1, kBlock, 1, 1, 0, nullptr,
+                                      nullptr, nullptr),
+              "launch the megakernel");
+        check(m_driver.cuCtxSynchronize(), "run the megakernel");
+
+        m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
+        for (const auto& s : slots) {
+            if (s.code == 0) continue;
+            uint64_t linear = s.first_linear;
+            uint3 first{unsigned(linear % size.x), unsigned(linear / size.x % size.y),
+                        unsigned(linear / (uint64_t(size.x) * size.y))};
+            report.exceptions[s.code] = {s.count, first};
+        }
+        m_scene->download_outputs();
+    }
+
+    /// Generates the kernel for this scene; compiles it only when the source changed.
+    void prepare_kernel(const core::CompiledScene& scene, LaunchReport& report) {
+        Megakernel kernel = generate_megakernel(scene, m_scene->programs());
+        if (kernel.source == m_source && m_module) return;  // same shape: keep the kernel
+        compile_megakernel(kernel, m_sm);
+        report.jit_ms = kernel.binary.ms;
+        report.jit_cached = kernel.binary.from_cache;
+        const KernelShape& shape = kernel.shape;
+        const CompileResult& compiled = kernel.binary;
+
+        if (m_module) m_driver.cuModuleUnload(m_module);
+        m_module = nullptr;
+        check(m_driver.cuModuleLoadData(&m_module, compiled.cubin.data()), "load the megakernel");
+        check(m_driver.cuModuleGetFunction(&m_kernel, m_module, "lucent_megakernel"),
+              "find lucent_megakernel");
+        size_t bytes = 0;
+        check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
+                                         "_ZN6lucent3gpu6paramsE"),
+              "find the launch parameters");
+        int blocks_per_sm = 0;
+        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks_per_sm, m_kernel, kBlock, 0),
+              "occupancy");
+        m_grid = std::max(1, blocks_per_sm) * m_sm_count;
+        // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
+        size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
+        check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
+        m_source = std::move(kernel.source);
+    }
+
+private:
+    const DriverApi& m_driver;
+    CUdevice m_device = 0;
+    CUcontext m_context = nullptr;
+    CUmodule m_module = nullptr;
+    CUfunction m_kernel = nullptr;
+    CUdeviceptr m_params_global = 0;
+    std::string m_device_name, m_source;
+    int m_sm = 0, m_sm_count = 0, m_grid = 0;
+    std::unique_ptr<GpuScene> m_scene;
+    const core::CompiledScene* m_last_scene = nullptr;
+    uint64_t m_last_generation = 0;
+    DeviceBuffer m_counter, m_exceptions, m_scratch;
+};
+
+}  // namespace
+
+std::unique_ptr<core::Backend> make_cuda_backend(std::string* why) {
+    const DriverApi* d = driver(why);
+    if (!d) return nullptr;
+    std::string nvrtc_why;
+    if (nvrtc_version(&nvrtc_why).empty()) {
+        if (why) *why = nvrtc_why;
+        return nullptr;
+    }
+    return std::make_unique<CudaBackend>(*d);
+}
+
+}  // namespace lucent::cuda

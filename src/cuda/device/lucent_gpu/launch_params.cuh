@@ -1,0 +1,107 @@
+// The compiled scene as the megakernel sees it: flat arrays in device memory, indexed by
+// integers. Shared by the host (which fills it, src/cuda/gpu_scene.cpp) and the device.
+#pragma once
+
+#include "lucent/device/types.h"
+#include "lucent_gpu/triangle_bvh.cuh"
+
+namespace lucent::gpu {
+
+/// A bound program: its id in the generated dispatch (< 0: none) and its record's offset
+/// in the record blob.
+struct ProgramRef {
+    int id;
+    unsigned record;
+};
+
+enum GpuNodeKind : unsigned { kGpuGroup = 0, kGpuGeometryGroup = 1, kGpuTransform = 2, kGpuSelector = 3 };
+
+struct GpuNode {
+    unsigned kind;
+    unsigned first;   // children[first .. first + count) for Group, Selector, Transform
+    unsigned count;
+    unsigned accel;   // Group: bvhs index (~0u: brute force); GeometryGroup: accels index
+    ProgramRef visit;
+    Matrix4x3 to_world, to_object;
+};
+
+/// Binary BVH node, the layout of lucent::accel::BvhNode.
+struct GpuBvhNode {
+    float3 lo;
+    unsigned first;
+    float3 hi;
+    unsigned count;
+};
+
+struct GpuBvh {
+    unsigned node_offset;  // into bvh_nodes; ~0u when empty
+    unsigned prim_offset;  // into prim_order
+};
+
+struct GpuGeometryAccel {
+    unsigned triangles_only;
+    unsigned brute_force;
+    unsigned any_hit_mask;      // bit r: some material has an any-hit for ray type r
+    unsigned instance_offset;   // accel_instances[instance_offset + k]: CompiledInstance index
+    unsigned instance_count;
+    unsigned prim_first_offset; // accel_prim_first[...]: first global primitive per instance
+    unsigned prim_total;
+    GpuBvh bvh;                 // generic path
+    GpuTriangleBvhView triangles;  // triangles_only path (triangle ids are global primitives)
+};
+
+struct GpuInstance {
+    unsigned triangles;
+    unsigned prim_count;
+    ProgramRef intersection;
+    ProgramRef attribute;
+    const float3* vertices;
+    const uint3* indices;
+    const unsigned* material_indices;
+    unsigned material_offset;  // materials[(material_offset + m) * ray_type_count + r]
+    unsigned material_count;
+};
+
+struct GpuMaterialSlot {
+    ProgramRef closest;
+    ProgramRef any;
+};
+
+constexpr unsigned kGpuExceptionSlots = 32;
+struct GpuExceptionSlot {
+    int code;  // 0: free
+    unsigned pad;
+    unsigned long long count;
+    unsigned long long first_linear;
+};
+
+struct LaunchParams {
+    const GpuNode* nodes;
+    const unsigned* children;
+    const GpuBvhNode* bvh_nodes;
+    const unsigned* prim_order;
+    const GpuBvh* bvhs;
+    const GpuGeometryAccel* accels;
+    const unsigned* accel_instances;
+    const unsigned* accel_prim_first;
+    const GpuInstance* instances;
+    const GpuMaterialSlot* materials;
+    const unsigned char* records;
+    const ProgramRef* miss;
+    unsigned ray_type_count;
+    unsigned max_depth;
+    ProgramRef ray_generation;
+    ProgramRef exception;
+    uint3 launch_size;
+    unsigned exception_mask;  // bit c (1..6): engine code c runs the exception program; bit 31: user codes
+    unsigned long long launch_count;
+    unsigned long long* work_counter;
+    GpuExceptionSlot* exceptions;
+    unsigned char* scratch;  // per-thread out-of-bounds scratch, kGpuScratchBytes each
+    int3 print_index;
+    unsigned print_enabled;
+};
+
+constexpr unsigned kGpuScratchBytes = 256;
+
+}  // namespace lucent::gpu

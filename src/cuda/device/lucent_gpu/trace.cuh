@@ -1,0 +1,419 @@
+// trace() on the GPU and the megakernel entry point (included after the generated
+// dispatch). The same algorithm as the CPU backend (src/cpu/traversal.cpp): Traverse the
+// graph, running intersection and any-hit programs, then Shade with closest hit or miss.
+#pragma once
+
+#include "lucent/device/triangle_intersect.h"
+#include "lucent_gpu/runtime.cuh"
+
+namespace lucent::gpu {
+
+__device__ inline Matrix4x3 compose(const Matrix4x3& a, const Matrix4x3& b) {
+    Matrix4x3 r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) {
+            float v = a.m[i * 4 + 0] * b.m[j] + a.m[i * 4 + 1] * b.m[4 + j] + a.m[i * 4 + 2] * b.m[8 + j];
+            r.m[i * 4 + j] = j == 3 ? v + a.m[i * 4 + 3] : v;
+        }
+    return r;
+}
+
+__device__ inline uint3 triangle_of(const GpuInstance& inst, unsigned prim) {
+    return inst.indices ? inst.indices[prim] : make_uint3(3 * prim, 3 * prim + 1, 3 * prim + 2);
+}
+
+__device__ inline const GpuMaterialSlot& material_slot(const GpuInstance& inst, unsigned material,
+                                                       unsigned ray_type) {
+    return params.materials[(inst.material_offset + material) * params.ray_type_count + ray_type];
+}
+
+__device__ inline void triangle_attributes(Frame& f, const GpuInstance& inst, unsigned prim,
+                                           float2 bary, Attributes& out) {
+    if (inst.attribute.id >= 0) {
+        unsigned saved = f.context;
+        f.context = kCtxAttribute;
+        dispatch_attribute(inst.attribute.id, record(inst.attribute), prim, bary, out.bytes);
+        f.context = saved;
+        return;
+    }
+    uint3 t = triangle_of(inst, prim);
+    float3 p0 = inst.vertices[t.x], p1 = inst.vertices[t.y], p2 = inst.vertices[t.z];
+    TriangleAttributes* a = reinterpret_cast<TriangleAttributes*>(out.bytes);
+    a->barycentrics = bary;
+    a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
+}
+
+__device__ inline void commit(Frame& f, unsigned instance, unsigned prim, float t, unsigned material) {
+    f.has_hit = true;
+    f.closest = t;
+    f.hit_t = t;
+    f.hit_instance = instance;
+    f.hit_prim = prim;
+    f.hit_material = material;
+    f.hit_pending = false;
+#if LUCENT_GPU_TRANSFORMS
+    f.hit_transformed = f.transformed;
+    if (f.transformed) {
+        f.hit_to_world = f.to_world;
+        f.hit_to_object = f.to_object;
+    }
+#endif
+}
+
+__device__ inline void copy_attributes(Attributes& dst, const Attributes& src) {
+    const uint4* s = reinterpret_cast<const uint4*>(src.bytes);
+    uint4* d = reinterpret_cast<uint4*>(dst.bytes);
+    for (int i = 0; i < LUCENT_GPU_ATTRIBUTE_BYTES / 16; ++i) d[i] = s[i];
+}
+
+/// Runs the any-hit program on the candidate; false when it called ignore_intersection.
+__device__ inline bool run_any_hit(Frame& f, ProgramRef any) {
+    unsigned saved = f.context;
+    f.context = kCtxAnyHit;
+    f.ignore_requested = false;
+    f.terminate_requested = false;
+    dispatch_any_hit(any.id, record(any), f.payload, f.scratch.bytes);
+    f.context = saved;
+    if (f.ignore_requested) return false;
+    if (f.terminate_requested) f.terminated = true;
+    return true;
+}
+
+/// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
+__device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, unsigned prim, float t,
+                                          float2 bary) {
+    const GpuInstance& inst = params.instances[instance_index];
+    unsigned material = inst.material_indices ? inst.material_indices[prim] : 0u;
+    ProgramRef any = material_slot(inst, material, f.ray_type).any;
+    if (any.id >= 0) {
+        f.instance = instance_index;
+        f.prim = prim;
+        triangle_attributes(f, inst, prim, bary, f.scratch);
+        f.candidate_t = t;
+        if (!run_any_hit(f, any)) return false;
+        commit(f, instance_index, prim, t, material);
+        copy_attributes(f.hit_attr, f.scratch);
+        return true;
+    }
+    commit(f, instance_index, prim, t, material);
+    f.hit_bary = bary;
+    f.hit_pending = true;
+    return true;
+}
+
+/// The instance (position k in the accel) owning global primitive `ref`.
+__device__ inline unsigned locate(const GpuGeometryAccel& ga, unsigned ref) {
+    unsigned lo = 0, hi = ga.instance_count;
+    while (hi - lo > 1) {
+        unsigned mid = (lo + hi) / 2;
+        if (params.accel_prim_first[ga.prim_first_offset + mid] <= ref) lo = mid;
+        else hi = mid;
+    }
+    return lo;
+}
+
+__device__ void traverse_node(Frame& f, unsigned node, float3 origin, float3 direction);
+
+__device__ inline void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
+                                      float3 direction) {
+    f.object_ray.origin = origin;
+    f.object_ray.direction = direction;
+    const float tmin = f.world_ray.tmin;
+    if (ga.triangles_only) {
+        GpuHit hit;
+        if (!((ga.any_hit_mask >> f.ray_type) & 1u)) {
+            if (gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit)) {
+                unsigned k = locate(ga, hit.prim);
+                unsigned local = hit.prim - params.accel_prim_first[ga.prim_first_offset + k];
+                triangle_candidate(f, params.accel_instances[ga.instance_offset + k], local, hit.t,
+                                   make_float2(hit.u, hit.v));
+            }
+            return;
+        }
+        gpu_bvh_filtered(ga.triangles, origin, direction, tmin, f.closest, hit,
+                         [&](const GpuHit& c) -> int {
+                             if (!(c.t < f.closest)) return 0;
+                             unsigned k = locate(ga, c.prim);
+                             unsigned local = c.prim - params.accel_prim_first[ga.prim_first_offset + k];
+                             if (!triangle_candidate(f, params.accel_instances[ga.instance_offset + k],
+                                                     local, c.t, make_float2(c.u, c.v)))
+                                 return 0;
+                             return f.terminated ? 2 : 1;
+                         });
+        return;
+    }
+#if LUCENT_GPU_GENERIC_GEOMETRY
+    WatertightRay wray = make_watertight_ray(origin, direction);
+    auto visit = [&](unsigned ref) {
+        unsigned k = locate(ga, ref);
+        unsigned local = ref - params.accel_prim_first[ga.prim_first_offset + k];
+        unsigned instance_index = params.accel_instances[ga.instance_offset + k];
+        const GpuInstance& inst = params.instances[instance_index];
+        if (inst.triangles) {
+            uint3 t = triangle_of(inst, local);
+            float th, u, v;
+            if (intersect_triangle_watertight(wray, inst.vertices[t.x], inst.vertices[t.y],
+                                              inst.vertices[t.z], tmin, f.closest, th, u, v))
+                triangle_candidate(f, instance_index, local, th, make_float2(u, v));
+        } else {
+            f.instance = instance_index;
+            f.prim = local;
+            unsigned saved = f.context;
+            f.context = kCtxIntersection;
+            dispatch_intersection(inst.intersection.id, record(inst.intersection), local, f.scratch.bytes);
+            f.context = saved;
+        }
+        return f.terminated || self().exception_code != 0;
+    };
+    if (ga.brute_force || ga.bvh.node_offset == ~0u) {
+        if (ga.brute_force)
+            for (unsigned ref = 0; ref < ga.prim_total; ++ref)
+                if (visit(ref)) return;
+        return;
+    }
+    const GpuBvhNode* nodes = params.bvh_nodes + ga.bvh.node_offset;
+    const unsigned* order = params.prim_order + ga.bvh.prim_offset;
+    float3 inv = make_float3(1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z);
+    unsigned stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const GpuBvhNode n = nodes[stack[--top]];
+        float3 t0 = (n.lo - origin) * inv, t1 = (n.hi - origin) * inv;
+        float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), tmin));
+        float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), f.closest));
+        if (tn > tf * 1.00000024f) continue;
+        if (n.count > 0) {
+            for (unsigned i = 0; i < n.count; ++i)
+                if (visit(order[n.first + i])) return;
+        } else {
+            stack[top++] = n.first + 1;
+            stack[top++] = n.first;
+        }
+    }
+#endif
+}
+
+__device__ inline void group(Frame& f, const GpuNode& n, float3 origin, float3 direction) {
+    if (n.accel == ~0u) {
+        for (unsigned c = 0; c < n.count; ++c) {
+            traverse_node(f, params.children[n.first + c], origin, direction);
+            if (f.terminated || self().exception_code) return;
+        }
+        return;
+    }
+    const GpuBvh& bvh = params.bvhs[n.accel];
+    if (bvh.node_offset == ~0u) return;
+    const GpuBvhNode* nodes = params.bvh_nodes + bvh.node_offset;
+    const unsigned* order = params.prim_order + bvh.prim_offset;
+    float3 inv = make_float3(1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z);
+    unsigned stack[32];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const GpuBvhNode b = nodes[stack[--top]];
+        float3 t0 = (b.lo - origin) * inv, t1 = (b.hi - origin) * inv;
+        float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), f.world_ray.tmin));
+        float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), f.closest));
+        if (tn > tf * 1.00000024f) continue;
+        if (b.count > 0) {
+            for (unsigned i = 0; i < b.count; ++i) {
+                traverse_node(f, params.children[n.first + order[b.first + i]], origin, direction);
+                if (f.terminated || self().exception_code) return;
+            }
+        } else {
+            stack[top++] = b.first + 1;
+            stack[top++] = b.first;
+        }
+    }
+}
+
+__device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 direction) {
+    const GpuNode& n = params.nodes[index];
+    switch (n.kind) {
+        case kGpuGeometryGroup: geometry_group(f, params.accels[n.accel], origin, direction); return;
+        case kGpuGroup: group(f, n, origin, direction); return;
+#if LUCENT_GPU_TRANSFORMS
+        case kGpuTransform: {
+            const bool was = f.transformed;
+            const Matrix4x3 to_world = f.to_world, to_object = f.to_object;
+            f.to_world = was ? compose(to_world, n.to_world) : n.to_world;
+            f.to_object = was ? compose(n.to_object, to_object) : n.to_object;
+            f.transformed = true;
+            traverse_node(f, params.children[n.first], transform_point(n.to_object, origin),
+                          transform_vector(n.to_object, direction));
+            f.transformed = was;
+            f.to_world = to_world;
+            f.to_object = to_object;
+            return;
+        }
+#endif
+#if LUCENT_GPU_SELECTORS
+        case kGpuSelector: {
+            f.object_ray.origin = origin;
+            f.object_ray.direction = direction;
+            unsigned saved = f.context;
+            f.context = kCtxVisit;
+            unsigned child = dispatch_visit(n.visit.id, record(n.visit));
+            f.context = saved;
+            if (child < n.count) traverse_node(f, params.children[n.first + child], origin, direction);
+            return;
+        }
+#endif
+        default: return;
+    }
+}
+
+__device__ void trace_ray(Handle root, const Ray& ray, void* payload) {
+    ThreadState& s = self();
+    if (s.exception_code) return;  // an exception ends the launch index's work
+    if (ray.ray_type >= params.ray_type_count) {
+        detail::raise_exception(kExceptionInvalidRayType, ray.ray_type);
+        return;
+    }
+    if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
+        detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
+        return;
+    }
+    Frame f;
+    f.world_ray = ray;
+    f.object_ray = ray;
+    f.payload = payload;
+    f.ray_type = ray.ray_type;
+    f.closest = ray.tmax;
+    f.has_hit = false;
+    f.terminated = false;
+    f.candidate_open = false;
+    f.context = kCtxIntersection;
+#if LUCENT_GPU_TRANSFORMS
+    f.transformed = false;
+#endif
+    Frame* outer = s.frame;
+    s.frame = &f;
+    ++s.depth;
+    traverse_node(f, root.index, ray.origin, ray.direction);
+    if (!s.exception_code) {
+        if (f.has_hit) {
+            const GpuInstance& inst = params.instances[f.hit_instance];
+            if (f.hit_pending) {
+                // The attribute program runs as at the hit: its primitive, transform and ray.
+                f.object_ray = ray;
+                f.instance = f.hit_instance;
+                f.prim = f.hit_prim;
+#if LUCENT_GPU_TRANSFORMS
+                f.transformed = f.hit_transformed;
+                if (f.hit_transformed) {
+                    f.to_world = f.hit_to_world;
+                    f.to_object = f.hit_to_object;
+                    f.object_ray.origin = transform_point(f.hit_to_object, ray.origin);
+                    f.object_ray.direction = transform_vector(f.hit_to_object, ray.direction);
+                }
+#endif
+                triangle_attributes(f, inst, f.hit_prim, f.hit_bary, f.hit_attr);
+            }
+            f.object_ray = ray;
+            ProgramRef closest = material_slot(inst, f.hit_material, f.ray_type).closest;
+            if (closest.id >= 0) {
+                f.context = kCtxClosestHit;
+                dispatch_closest_hit(closest.id, record(closest), payload, f.hit_attr.bytes);
+            }
+        } else {
+            ProgramRef miss = params.miss[f.ray_type];
+            if (miss.id >= 0) {
+                f.context = kCtxMiss;
+                dispatch_miss(miss.id, record(miss), payload);
+            }
+        }
+    }
+    --s.depth;
+    s.frame = outer;
+}
+
+/// Records an exception in the slot of its code (slots are claimed with atomicCAS).
+__device__ inline void count_exception(int code, unsigned long long linear) {
+    for (unsigned i = 0; i < kGpuExceptionSlots; ++i) {
+        GpuExceptionSlot& slot = params.exceptions[i];
+        int seen = atomicCAS(&slot.code, 0, code);
+        if (seen == 0 || seen == code) {
+            atomicAdd(&slot.count, 1ull);
+            atomicMin(&slot.first_linear, linear);
+            return;
+        }
+    }
+}
+
+}  // namespace lucent::gpu
+
+namespace lucent {
+namespace detail {
+LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void*) {
+    gpu::trace_ray(root, ray, payload);
+}
+}  // namespace detail
+
+LUCENT_HD bool report_intersection(unsigned material) {
+    gpu::Frame& f = *gpu::self().frame;
+    if (f.context != gpu::kCtxIntersection || !f.candidate_open) return false;
+    f.candidate_open = false;
+    const gpu::GpuInstance& inst = gpu::params.instances[f.instance];
+    if (material >= inst.material_count) {
+        detail::raise_exception(kExceptionMaterialIndexOutOfRange, material);
+        return false;
+    }
+    gpu::ProgramRef any = gpu::material_slot(inst, material, f.ray_type).any;
+    if (any.id >= 0 && !gpu::run_any_hit(f, any)) return false;
+    gpu::commit(f, f.instance, f.prim, f.candidate_t, material);
+    gpu::copy_attributes(f.hit_attr, f.scratch);
+    return true;
+}
+}  // namespace lucent
+
+/// The megakernel: persistent threads take launch indices from a global counter, a warp's
+/// worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
+extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK) lucent_megakernel() {
+    using namespace lucent;
+    using namespace lucent::gpu;
+    ThreadState& s = self();
+    const LaunchParams& p = params;
+    const unsigned lane = threadIdx.x & 31u;
+    for (;;) {
+        unsigned long long base = 0;
+        if (lane == 0) base = atomicAdd(p.work_counter, 32ull);
+        base = __shfl_sync(0xffffffffu, base, 0);
+        if (base >= p.launch_count) return;
+        unsigned long long linear = base + lane;
+        if (linear >= p.launch_count) continue;
+        unsigned x = unsigned(linear % p.launch_size.x);
+        unsigned long long rest = linear / p.launch_size.x;
+        unsigned y = unsigned(rest % p.launch_size.y);
+        unsigned z = unsigned(rest / p.launch_size.y);
+        s.launch_index = make_uint3(x, y, z);
+        s.depth = 0;
+        s.exception_code = 0;
+        s.frame = nullptr;
+        s.context = kCtxRayGeneration;
+#if LUCENT_GPU_PRINT
+        s.print_here = p.print_enabled && (p.print_index.x < 0 || unsigned(p.print_index.x) == x) &&
+                       (p.print_index.y < 0 || unsigned(p.print_index.y) == y) &&
+                       (p.print_index.z < 0 || unsigned(p.print_index.z) == z);
+#else
+        s.print_here = 0;
+#endif
+        dispatch_ray_generation(p.ray_generation.id, record(p.ray_generation));
+        if (s.exception_code) {
+            int code = s.exception_code;
+            count_exception(code, linear);
+            bool enabled = code >= kUserExceptionBase ? (p.exception_mask >> 31) & 1u
+                                                      : (p.exception_mask >> code) & 1u;
+            if (enabled && p.exception.id >= 0) {
+                s.exception_code = 0;  // the exception program runs normally
+                s.depth = 0;
+                s.frame = nullptr;
+                s.context = kCtxException;
+                ExceptionInfo info{code, s.launch_index, s.exception_detail};
+                dispatch_exception(p.exception.id, record(p.exception), info);
+                if (s.exception_code) count_exception(s.exception_code, linear);
+            }
+        }
+    }
+}

@@ -1,0 +1,51 @@
+// The CUDA driver API, loaded at run time (dlopen of libcuda.so.1), so the `lucent` binary
+// starts on machines without an NVIDIA driver and `--backend auto` can fall back to the CPU.
+#pragma once
+
+#include <cuda.h>
+
+#include <string>
+
+namespace lucent::cuda {
+
+struct DriverApi {
+#define LUCENT_CU_FN(name) decltype(&::name) name = nullptr;
+    LUCENT_CU_FN(cuInit)
+    LUCENT_CU_FN(cuDriverGetVersion)
+    LUCENT_CU_FN(cuDeviceGetCount)
+    LUCENT_CU_FN(cuDeviceGet)
+    LUCENT_CU_FN(cuDeviceGetName)
+    LUCENT_CU_FN(cuDeviceGetAttribute)
+    LUCENT_CU_FN(cuDevicePrimaryCtxRetain)
+    LUCENT_CU_FN(cuDevicePrimaryCtxRelease)
+    LUCENT_CU_FN(cuCtxSetCurrent)
+    LUCENT_CU_FN(cuCtxSynchronize)
+    LUCENT_CU_FN(cuCtxSetLimit)
+    LUCENT_CU_FN(cuModuleLoadData)
+    LUCENT_CU_FN(cuModuleUnload)
+    LUCENT_CU_FN(cuModuleGetFunction)
+    LUCENT_CU_FN(cuModuleGetGlobal)
+    LUCENT_CU_FN(cuLaunchKernel)
+    LUCENT_CU_FN(cuMemAlloc)
+    LUCENT_CU_FN(cuMemFree)
+    LUCENT_CU_FN(cuMemcpyHtoD)
+    LUCENT_CU_FN(cuMemcpyDtoH)
+    LUCENT_CU_FN(cuMemsetD8)
+    LUCENT_CU_FN(cuEventCreate)
+    LUCENT_CU_FN(cuEventDestroy)
+    LUCENT_CU_FN(cuEventRecord)
+    LUCENT_CU_FN(cuEventSynchronize)
+    LUCENT_CU_FN(cuEventElapsedTime)
+    LUCENT_CU_FN(cuGetErrorString)
+    LUCENT_CU_FN(cuFuncGetAttribute)
+    LUCENT_CU_FN(cuOccupancyMaxActiveBlocksPerMultiprocessor)
+#undef LUCENT_CU_FN
+};
+
+/// The driver, loaded and initialised once; null when there is none (`why` says what failed).
+const DriverApi* driver(std::string* why = nullptr);
+
+/// Throws lucent::Error "<what>: <CUDA error string>" when result is not CUDA_SUCCESS.
+void check(CUresult result, const char* what);
+
+}  // namespace lucent::cuda

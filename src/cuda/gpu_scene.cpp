@@ -1,0 +1,252 @@
+#include "cuda/gpu_scene.h"
+
+#include <cstring>
+
+#include "cuda/megakernel_compiler.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+template <class T>
+void put(DeviceBuffer& memory, const std::vector<T>& values) {
+    if (values.empty()) memory.reset();
+    else memory.upload(values.data(), values.size() * sizeof(T));
+}
+
+const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
+    return inst.triangles ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
+                          : nullptr;
+}
+
+void append_bvh(const accel::Bvh& bvh, std::vector<gpu::GpuBvhNode>& nodes,
+                std::vector<unsigned>& order, gpu::GpuBvh& out) {
+    if (bvh.empty()) {
+        out = {~0u, 0};
+        return;
+    }
+    out = {unsigned(nodes.size()), unsigned(order.size())};
+    for (const accel::BvhNode& n : bvh.nodes()) nodes.push_back({n.lo, n.first, n.hi, n.count});
+    order.insert(order.end(), bvh.prim_order().begin(), bvh.prim_order().end());
+}
+}  // namespace
+
+CUdeviceptr GpuScene::device_pointer(const Buffer* buffer) {
+    if (!buffer) return 0;
+    auto found = m_buffers.find(buffer);
+    if (found == m_buffers.end()) {
+        // Used by the new compile: reuse the previous compile's copy when there is one.
+        auto previous = m_previous_buffers.find(buffer);
+        found = m_buffers.emplace(buffer, previous != m_previous_buffers.end()
+                                              ? std::move(previous->second)
+                                              : BufferMirror{}).first;
+    }
+    BufferMirror& m = found->second;
+    m.buffer = buffer;
+    size_t bytes = buffer->count() * buffer->element().size;
+    if (m.version != buffer->version() || m.memory.size() != bytes) {
+        m.memory.upload(buffer->raw(), bytes);
+        m.version = buffer->version();
+    }
+    return m.memory.ptr();
+}
+
+void GpuScene::patch_record(unsigned char* bytes, const core::CompiledProgram& program) {
+    // Host pointers in the packed record become device pointers of the same buffers.
+    auto device_of = [&](const void* host) -> CUdeviceptr {
+        for (const Buffer* b : program.buffers)
+            if (b->raw() == host) return device_pointer(b);
+        return 0;
+    };
+    for (const FieldInfo& field : program.desc->record->fields) {
+        unsigned char* at = bytes + field.offset;
+        switch (field.kind) {
+            case FieldKind::kBuffer: {
+                void* host;
+                std::memcpy(&host, at, sizeof host);
+                CUdeviceptr d = device_of(host);
+                std::memcpy(at, &d, sizeof d);
+                break;
+            }
+            case FieldKind::kTexture: {
+                TextureView view;
+                std::memcpy(&view, at, sizeof view);
+                view.texels = reinterpret_cast<const float4*>(device_of(view.texels));
+                std::memcpy(at, &view, sizeof view);
+                break;
+            }
+            case FieldKind::kCallable:
+                throw Error(program.label + ": callable programs are not supported by the CUDA "
+                            "backend yet; use --backend cpu for this scene");
+            default: break;
+        }
+    }
+}
+
+gpu::ProgramRef GpuScene::add_program(const core::CompiledProgram& program) {
+    if (!program) return {-1, 0};
+    size_t offset = (m_records.size() + 15) / 16 * 16;
+    size_t size = program.desc->record->size;
+    m_records.resize(offset + std::max<size_t>(size, 16));
+    std::memcpy(m_records.data() + offset, program.rec(), size);
+    patch_record(m_records.data() + offset, program);
+    return {m_programs.id(program), unsigned(offset)};
+}
+
+void GpuScene::update(const core::CompiledScene& scene) {
+    // Only buffers this compile uses stay mirrored: others may no longer exist.
+    m_previous_buffers = std::move(m_buffers);
+    m_buffers.clear();
+    m_programs = build_program_table(scene);
+    m_records.clear();
+    m_entries.clear();
+    for (const core::CompiledEntry& e : scene.entries)
+        m_entries.emplace_back(add_program(e.ray_generation), add_program(e.exception));
+    std::vector<gpu::ProgramRef> miss;
+    for (const core::CompiledProgram& m : scene.miss) miss.push_back(add_program(m));
+
+    // Instances and their material slots.
+    const unsigned ray_types = unsigned(scene.ray_types.size());
+    std::vector<gpu::GpuInstance> instances;
+    std::vector<gpu::GpuMaterialSlot> materials;
+    for (const core::CompiledInstance& inst : scene.instances) {
+        gpu::GpuInstance g{};
+        g.triangles = inst.triangles;
+        g.prim_count = inst.primitive_count;
+        g.intersection = add_program(inst.intersection);
+        g.attribute = add_program(inst.attribute);
+        if (const GeometryTriangles* tris = triangles_of(inst)) {
+            g.vertices = reinterpret_cast<const float3*>(device_pointer(tris->vertices().get()));
+            g.indices = reinterpret_cast<const uint3*>(device_pointer(tris->indices().get()));
+            g.material_indices =
+                reinterpret_cast<const unsigned*>(device_pointer(tris->material_indices().get()));
+        }
+        g.material_offset = unsigned(materials.size() / std::max(1u, ray_types));
+        g.material_count = unsigned(inst.materials.size());
+        for (const core::CompiledMaterial& m : inst.materials)
+            for (unsigned r = 0; r < ray_types; ++r)
+                materials.push_back({add_program(m.closest_hit[r]), add_program(m.any_hit[r])});
+        instances.push_back(g);
+    }
+
+    // Nodes, their children and acceleration structures.
+    std::vector<gpu::GpuNode> nodes;
+    std::vector<unsigned> children, accel_instances, accel_prim_first, order;
+    std::vector<gpu::GpuBvhNode> bvh_nodes;
+    std::vector<gpu::GpuBvh> bvhs;
+    std::vector<gpu::GpuGeometryAccel> accels;
+    for (const core::CompiledNode& n : scene.nodes) {
+        gpu::GpuNode g{};
+        g.kind = unsigned(n.kind);
+        g.first = unsigned(children.size());
+        g.count = unsigned(n.children.size());
+        children.insert(children.end(), n.children.begin(), n.children.end());
+        g.visit = add_program(n.visit);
+        g.to_world = n.to_world;
+        g.to_object = n.to_object;
+        g.accel = ~0u;
+        if (n.kind == NodeKind::kGroup && !n.brute_force) {
+            g.accel = unsigned(bvhs.size());
+            bvhs.emplace_back();
+            append_bvh(n.child_bvh, bvh_nodes, order, bvhs.back());
+        } else if (n.kind == NodeKind::kGeometryGroup) {
+            const core::GeometryAccel& ga = *n.geometry;
+            gpu::GpuGeometryAccel a{};
+            a.triangles_only = 0;  // the generic layout serves triangles too, for now
+            a.brute_force = n.brute_force;
+            for (unsigned r = 0; r < n.any_hit_for_ray_type.size(); ++r)
+                if (n.any_hit_for_ray_type[r]) a.any_hit_mask |= 1u << r;
+            a.instance_offset = unsigned(accel_instances.size());
+            a.instance_count = unsigned(n.instances.size());
+            accel_instances.insert(accel_instances.end(), n.instances.begin(), n.instances.end());
+            a.prim_first_offset = unsigned(accel_prim_first.size());
+            accel_prim_first.insert(accel_prim_first.end(), ga.prim_first.begin(), ga.prim_first.end());
+            a.prim_total = 0;
+            for (unsigned i : n.instances) a.prim_total += scene.instances[i].primitive_count;
+            if (ga.triangles_only) {
+                // The CPU keeps a wide layout; the GPU gets a binary BVH over the same
+                // triangles, rebuilt only when they change.
+                GeometryMirror& mirror = m_geometry[&ga];
+                if (mirror.structure != ga.structure_signature || mirror.content != ga.content_signature ||
+                    mirror.nodes.empty()) {
+                    std::vector<Aabb> boxes(ga.indices.size());
+                    for (size_t t = 0; t < ga.indices.size(); ++t) {
+                        float3 p0 = ga.vertices[ga.indices[t].x], p1 = ga.vertices[ga.indices[t].y],
+                               p2 = ga.vertices[ga.indices[t].z];
+                        boxes[t] = {fminf(p0, fminf(p1, p2)), fmaxf(p0, fmaxf(p1, p2))};
+                    }
+                    accel::Bvh bvh;
+                    bvh.build(boxes);
+                    mirror.nodes.clear();
+                    mirror.order.clear();
+                    gpu::GpuBvh unused;
+                    append_bvh(bvh, mirror.nodes, mirror.order, unused);
+                    mirror.structure = ga.structure_signature;
+                    mirror.content = ga.content_signature;
+                }
+                if (mirror.nodes.empty()) {
+                    a.bvh = {~0u, 0};
+                } else {
+                    a.bvh = {unsigned(bvh_nodes.size()), unsigned(order.size())};
+                    bvh_nodes.insert(bvh_nodes.end(), mirror.nodes.begin(), mirror.nodes.end());
+                    order.insert(order.end(), mirror.order.begin(), mirror.order.end());
+                }
+            } else {
+                append_bvh(ga.bvh, bvh_nodes, order, a.bvh);
+            }
+            g.accel = unsigned(accels.size());
+            accels.push_back(a);
+        }
+        nodes.push_back(g);
+    }
+
+    put(m_nodes, nodes);
+    put(m_children, children);
+    put(m_bvh_nodes, bvh_nodes);
+    put(m_prim_order, order);
+    put(m_bvhs, bvhs);
+    put(m_accels, accels);
+    put(m_accel_instances, accel_instances);
+    put(m_accel_prim_first, accel_prim_first);
+    put(m_instances, instances);
+    put(m_materials, materials);
+    put(m_record_blob, m_records);
+    put(m_miss, miss);
+
+    m_params = gpu::LaunchParams{};
+    m_params.nodes = m_nodes.as<gpu::GpuNode>();
+    m_params.children = m_children.as<unsigned>();
+    m_params.bvh_nodes = m_bvh_nodes.as<gpu::GpuBvhNode>();
+    m_params.prim_order = m_prim_order.as<unsigned>();
+    m_params.bvhs = m_bvhs.as<gpu::GpuBvh>();
+    m_params.accels = m_accels.as<gpu::GpuGeometryAccel>();
+    m_params.accel_instances = m_accel_instances.as<unsigned>();
+    m_params.accel_prim_first = m_accel_prim_first.as<unsigned>();
+    m_params.instances = m_instances.as<gpu::GpuInstance>();
+    m_params.materials = m_materials.as<gpu::GpuMaterialSlot>();
+    m_params.records = m_record_blob.as<unsigned char>();
+    m_params.miss = m_miss.as<gpu::ProgramRef>();
+    m_params.ray_type_count = ray_types;
+    m_params.max_depth = scene.max_depth;
+    m_params.print_enabled = scene.print_enabled;
+    m_params.print_index = scene.print_index;
+    for (int code : scene.enabled_exceptions) {
+        if (code == kAllExceptions) m_params.exception_mask = ~0u;
+        else if (code >= kUserExceptionBase) m_params.exception_mask |= 1u << 31;
+        else if (code > 0 && code < 31) m_params.exception_mask |= 1u << code;
+    }
+    m_previous_buffers.clear();
+}
+
+void GpuScene::sync_buffers() {
+    for (auto& [buffer, mirror] : m_buffers) device_pointer(buffer);
+}
+
+void GpuScene::download_outputs() {
+    for (auto& [buffer, mirror] : m_buffers)
+        if (buffer->type() != BufferType::kInput)
+            mirror.memory.download(const_cast<void*>(buffer->raw()),
+                                   buffer->count() * buffer->element().size);
+}
+
+}  // namespace lucent::cuda

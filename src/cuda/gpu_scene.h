@@ -1,0 +1,59 @@
+// The compiled scene in device memory: flat arrays, records with device pointers, and a
+// mirror of every Buffer the programs use. Uploads only what changed since the last launch.
+#pragma once
+
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "core/compiled_scene.h"
+#include "cuda/device_buffer.h"
+#include "cuda/megakernel_generator.h"
+#include "lucent_gpu/launch_params.cuh"
+
+namespace lucent::cuda {
+
+class GpuScene {
+public:
+    /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
+    /// buffers whose host contents changed.
+    void update(const core::CompiledScene& scene);
+    /// Uploads buffers changed by the host since the last launch (same compile).
+    void sync_buffers();
+    /// Copies buffers that programs may write (output, input-output) back to the host.
+    void download_outputs();
+
+    /// The scene part of the launch parameters (per-launch fields left for the caller).
+    const gpu::LaunchParams& params() const { return m_params; }
+    const ProgramTable& programs() const { return m_programs; }
+    gpu::ProgramRef ray_generation(unsigned entry) const { return m_entries[entry].first; }
+    gpu::ProgramRef exception(unsigned entry) const { return m_entries[entry].second; }
+
+private:
+    struct BufferMirror {
+        DeviceBuffer memory;
+        uint64_t version = 0;
+        const Buffer* buffer = nullptr;
+    };
+    struct GeometryMirror {
+        uint64_t structure = 0, content = 0;
+        std::vector<gpu::GpuBvhNode> nodes;  // binary BVH over the triangles (generic layout)
+        std::vector<uint32_t> order;
+    };
+
+    CUdeviceptr device_pointer(const Buffer* buffer);
+    gpu::ProgramRef add_program(const core::CompiledProgram& program);
+    void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
+
+    ProgramTable m_programs;
+    std::vector<unsigned char> m_records;
+    std::vector<std::pair<gpu::ProgramRef, gpu::ProgramRef>> m_entries;
+    std::unordered_map<const Buffer*, BufferMirror> m_buffers, m_previous_buffers;
+    std::unordered_map<const core::GeometryAccel*, GeometryMirror> m_geometry;
+    gpu::LaunchParams m_params{};
+    // Device copies of the flat arrays.
+    DeviceBuffer m_nodes, m_children, m_bvh_nodes, m_prim_order, m_bvhs, m_accels,
+        m_accel_instances, m_accel_prim_first, m_instances, m_materials, m_record_blob, m_miss;
+};
+
+}  // namespace lucent::cuda

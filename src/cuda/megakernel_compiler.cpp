@@ -1,0 +1,53 @@
+#include "cuda/megakernel_compiler.h"
+
+#include <cstdlib>
+#include <fstream>
+
+#include "cuda/embedded_sources.h"
+
+namespace lucent::cuda {
+
+ProgramTable build_program_table(const core::CompiledScene& scene) {
+    ProgramTable table;
+    for (const core::CompiledEntry& e : scene.entries) {
+        table.id(e.ray_generation);
+        table.id(e.exception);
+    }
+    for (const core::CompiledProgram& m : scene.miss) table.id(m);
+    for (const core::CompiledInstance& inst : scene.instances) {
+        table.id(inst.intersection);
+        table.id(inst.attribute);
+        for (const core::CompiledMaterial& m : inst.materials)
+            for (size_t r = 0; r < m.closest_hit.size(); ++r) {
+                table.id(m.closest_hit[r]);
+                table.id(m.any_hit[r]);
+            }
+    }
+    for (const core::CompiledNode& n : scene.nodes) table.id(n.visit);
+    return table;
+}
+
+Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTable& table) {
+    Megakernel k;
+    k.shape = kernel_shape(scene);
+    k.source = generate_megakernel(table, k.shape);
+    // LUCENT_DUMP_MEGAKERNEL=file: keep the generated source for inspection.
+    if (const char* dump = std::getenv("LUCENT_DUMP_MEGAKERNEL")) {
+        std::ofstream out(dump);
+        out << k.source;
+    }
+    return k;
+}
+
+void compile_megakernel(Megakernel& k, int sm) {
+    CompileRequest request;
+    request.name = "lucent_megakernel.cu";
+    request.source = k.source;
+    for (const EmbeddedSource& s : embedded_sources())
+        request.headers.emplace_back(std::string(s.name), std::string(s.text));
+    request.options = {"--std=c++20", "-default-device", "--use_fast_math"};
+    request.sm = sm;
+    k.binary = compile_cubin(request);
+}
+
+}  // namespace lucent::cuda

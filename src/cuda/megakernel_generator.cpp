@@ -1,0 +1,118 @@
+#include "cuda/megakernel_generator.h"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "cuda/embedded_sources.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+int ProgramTable::id(const core::CompiledProgram& program) {
+    if (!program) return -1;
+    size_t kind = size_t(program.desc->kind);
+    auto [it, inserted] = m_ids[kind].emplace(program.desc, int(m_lists[kind].size()));
+    if (inserted) m_lists[kind].push_back(program.desc);
+    return it->second;
+}
+
+KernelShape kernel_shape(const core::CompiledScene& scene) {
+    KernelShape shape;
+    for (const core::CompiledNode& n : scene.nodes) {
+        shape.transforms |= n.kind == NodeKind::kTransform;
+        shape.selectors |= n.kind == NodeKind::kSelector;
+        if (n.kind == NodeKind::kGeometryGroup && n.geometry)
+            shape.generic_geometry |= !n.geometry->triangles_only;
+    }
+    size_t attributes = 16;
+    for (const core::CompiledInstance& inst : scene.instances)
+        attributes = std::max(attributes, inst.attributes->size);
+    shape.attribute_bytes = unsigned((attributes + 15) / 16 * 16);
+    shape.exceptions = !scene.enabled_exceptions.empty();
+    shape.print = scene.print_enabled;
+    shape.max_depth = scene.max_depth;
+    return shape;
+}
+
+namespace {
+const char* kind_function(ProgramKind kind) {
+    switch (kind) {
+        case ProgramKind::kRayGeneration: return "__device__ void dispatch_ray_generation(int id, const void* rec)";
+        case ProgramKind::kException: return "__device__ void dispatch_exception(int id, const void* rec, const ExceptionInfo& ex)";
+        case ProgramKind::kMiss: return "__device__ void dispatch_miss(int id, const void* rec, void* prd)";
+        case ProgramKind::kClosestHit: return "__device__ void dispatch_closest_hit(int id, const void* rec, void* prd, const void* attr)";
+        case ProgramKind::kAnyHit: return "__device__ void dispatch_any_hit(int id, const void* rec, void* prd, const void* attr)";
+        case ProgramKind::kIntersection: return "__device__ void dispatch_intersection(int id, const void* rec, unsigned prim, void* attr)";
+        case ProgramKind::kVisit: return "__device__ unsigned dispatch_visit(int id, const void* rec)";
+        case ProgramKind::kAttribute: return "__device__ void dispatch_attribute(int id, const void* rec, unsigned prim, float2 bary, void* attr)";
+        default: return nullptr;
+    }
+}
+const char* kind_call(ProgramKind kind) {
+    switch (kind) {
+        case ProgramKind::kRayGeneration: return "invoke(&::%s, rec)";
+        case ProgramKind::kException: return "invoke(&::%s, rec, ex)";
+        case ProgramKind::kMiss: return "invoke(&::%s, rec, prd)";
+        case ProgramKind::kClosestHit:
+        case ProgramKind::kAnyHit: return "invoke(&::%s, rec, prd, attr)";
+        case ProgramKind::kIntersection: return "invoke(&::%s, rec, prim, attr)";
+        case ProgramKind::kVisit: return "return invoke_visit(&::%s, rec)";
+        case ProgramKind::kAttribute: return "invoke(&::%s, rec, prim, bary, attr)";
+        default: return nullptr;
+    }
+}
+std::string format_call(const char* pattern, std::string_view name) {
+    std::string s(pattern);
+    s.replace(s.find("%s"), 2, name);
+    return s;
+}
+}  // namespace
+
+std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape) {
+    std::ostringstream out;
+    out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
+        << "#define LUCENT_GPU_TRANSFORMS " << shape.transforms << "\n"
+        << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
+        << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
+        << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
+        << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
+        << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
+        << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
+        << "#include \"lucent_gpu/runtime.cuh\"\n"
+        << "#include \"lucent_gpu/invoke.cuh\"\n";
+
+    // The program modules actually bound, each once.
+    std::set<std::string> modules;
+    for (size_t k = 0; k <= size_t(ProgramKind::kCallable); ++k)
+        for (const ProgramDesc* desc : table.programs(ProgramKind(k))) {
+            const EmbeddedSource* module = find_embedded_source(desc->file);
+            if (!module)
+                throw Error(std::string(program_kind_name(desc->kind)) + " program '" +
+                            std::string(desc->name) + "' is defined in " + desc->file +
+                            ", which the CUDA backend does not have as source; keep program "
+                            "modules in samples/<name>/<name>_programs.h (embedded at build "
+                            "time) or use --backend cpu");
+            modules.insert(std::string(module->name));
+        }
+    for (const std::string& m : modules) out << "#include \"" << m << "\"\n";
+
+    out << "\nnamespace lucent::gpu {\n";
+    for (size_t k = 0; k < size_t(ProgramKind::kCallable); ++k) {
+        ProgramKind kind = ProgramKind(k);
+        const char* fn = kind_function(kind);
+        if (!fn) continue;
+        out << fn << " {\n    switch (id) {\n";
+        const auto& list = table.programs(kind);
+        for (size_t i = 0; i < list.size(); ++i)
+            out << "        case " << i << ": " << format_call(kind_call(kind), list[i]->name)
+                << "; break;\n";
+        out << "        default: break;\n    }\n";
+        if (kind == ProgramKind::kVisit) out << "    return ~0u;\n";
+        out << "}\n";
+    }
+    out << "}  // namespace lucent::gpu\n\n#include \"lucent_gpu/trace.cuh\"\n";
+    return out.str();
+}
+
+}  // namespace lucent::cuda

@@ -1,0 +1,46 @@
+// Generates the CUDA source of one megakernel for a compiled scene (OptiX paper §4-5;
+// ARCHITECTURE §4): the engine's runtime and traversal, the program modules actually
+// bound, and switch statements that dispatch to them, specialised on what the scene uses.
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/compiled_scene.h"
+
+namespace lucent::cuda {
+
+/// Dispatch ids of the bound programs, one numbering per program kind.
+class ProgramTable {
+public:
+    /// The program's id in its kind's switch (assigned on first sight); -1 for none.
+    int id(const core::CompiledProgram& program);
+    const std::vector<const ProgramDesc*>& programs(ProgramKind kind) const {
+        return m_lists[size_t(kind)];
+    }
+
+private:
+    static constexpr size_t kKinds = size_t(ProgramKind::kCallable) + 1;
+    std::array<std::map<const ProgramDesc*, int>, kKinds> m_ids;
+    std::array<std::vector<const ProgramDesc*>, kKinds> m_lists;
+};
+
+/// What the generated kernel is specialised on.
+struct KernelShape {
+    bool transforms = false;
+    bool selectors = false;
+    bool generic_geometry = false;  // custom primitives, or a group not made only of triangles
+    bool exceptions = false;        // any exception enabled (else bounds checks are compiled out)
+    bool print = false;
+    unsigned max_depth = 1;
+    unsigned attribute_bytes = 16;
+};
+
+KernelShape kernel_shape(const core::CompiledScene& scene);
+
+/// The megakernel source; Error if a bound program's module is not embedded.
+std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape);
+
+}  // namespace lucent::cuda

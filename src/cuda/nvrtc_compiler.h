@@ -1,0 +1,37 @@
+// Run-time compilation of CUDA C++ to a CUBIN with NVRTC (loaded at run time), behind a
+// disk cache keyed on everything that decides the output (HIPRT's impl/Compiler.cpp idea).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lucent::cuda {
+
+struct CompileRequest {
+    std::string name;                                        // e.g. "megakernel.cu"
+    std::string source;
+    std::vector<std::pair<std::string, std::string>> headers;  // include name → text
+    std::vector<std::string> options;                        // besides the architecture
+    int sm = 90;                                             // compute capability * 10
+};
+
+struct CompileResult {
+    std::string cubin;
+    bool from_cache = false;
+    double ms = 0;        // compile (cold) or cache load time
+    std::string log;      // NVRTC's log, even on success
+};
+
+/// Compiles (or loads from the cache) a CUBIN. Throws lucent::Error with NVRTC's log on
+/// failure. Cache directory: $LUCENT_CACHE_DIR, else $XDG_CACHE_HOME/lucent, else
+/// ~/.cache/lucent; LUCENT_CACHE_DIR=off disables it.
+CompileResult compile_cubin(const CompileRequest& request);
+
+/// NVRTC's version as "13.0", or an empty string (with `why`) when it cannot be loaded.
+std::string nvrtc_version(std::string* why = nullptr);
+
+/// The cache directory in use (empty when disabled).
+std::string kernel_cache_dir();
+
+}  // namespace lucent::cuda

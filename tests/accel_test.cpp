@@ -1,0 +1,571 @@
+// Acceleration structures against brute force: the binary Bvh (generic traversal, refit,
+// depth bound), TriangleAccel (closest, any, filtered, refit, watertightness) on random
+// soups and on the benchmark scenes, and the OBJ loader's errors.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "accel/triangle_accel.h"
+#include "lucent/device/triangle_intersect.h"
+#include "lucent/error.h"
+#include "scene/obj_mesh.h"
+
+namespace lucent::accel {
+namespace {
+
+struct Mesh {
+    std::vector<float3> positions;
+    std::vector<uint3> indices;
+};
+
+struct BruteHit {
+    bool hit = false;
+    float t = 0, u = 0, v = 0;
+    uint32_t prim = 0;
+};
+
+/// Closest hit over all triangles with the scalar watertight test; `keep(prim)` filters.
+template <class Keep>
+BruteHit brute_force(const Mesh& m, float3 o, float3 d, float tmin, float tmax, Keep&& keep) {
+    const WatertightRay r = make_watertight_ray(o, d);
+    BruteHit best;
+    for (uint32_t i = 0; i < m.indices.size(); ++i) {
+        if (!keep(i)) continue;
+        uint3 t = m.indices[i];
+        float th, u, v;
+        if (intersect_triangle_watertight(r, m.positions[t.x], m.positions[t.y], m.positions[t.z],
+                                          tmin, best.hit ? best.t : tmax, th, u, v))
+            best = BruteHit{true, th, u, v, i};
+    }
+    return best;
+}
+BruteHit brute_force(const Mesh& m, float3 o, float3 d, float tmin, float tmax) {
+    return brute_force(m, o, d, tmin, tmax, [](uint32_t) { return true; });
+}
+
+/// t of one triangle along the ray, or -1.
+float triangle_t(const Mesh& m, uint32_t prim, float3 o, float3 d) {
+    float t, u, v;
+    uint3 tri = m.indices[prim];
+    if (!intersect_triangle_watertight(make_watertight_ray(o, d), m.positions[tri.x],
+                                       m.positions[tri.y], m.positions[tri.z], -kInfinity,
+                                       kInfinity, t, u, v))
+        return -1.0f;
+    return t;
+}
+
+/// Random soup in [0,1]^3: ordinary, long thin, degenerate (collinear, repeated vertex)
+/// and axis-aligned triangles.
+Mesh random_soup(uint32_t seed, int count) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    Mesh m;
+    for (int i = 0; i < count; ++i) {
+        float3 c = make_float3(uni(rng), uni(rng), uni(rng));
+        float s = 0.02f + 0.2f * uni(rng) * uni(rng);
+        float3 a = c + s * make_float3(uni(rng) - .5f, uni(rng) - .5f, uni(rng) - .5f);
+        float3 b = c + s * make_float3(uni(rng) - .5f, uni(rng) - .5f, uni(rng) - .5f);
+        float3 e = c + s * make_float3(uni(rng) - .5f, uni(rng) - .5f, uni(rng) - .5f);
+        switch (i % 10) {
+            case 0:
+                e = a + 0.37f * (b - a);
+                break;  // collinear
+            case 1:
+                e = b;
+                break;  // repeated vertex
+            case 2:
+                b = a + make_float3(0.6f * uni(rng), 1e-4f, 0);
+                break;  // thin sliver
+            case 3:
+                a.z = b.z = e.z = c.z;
+                break;  // axis-aligned
+            default:
+                break;
+        }
+        uint32_t base = (uint32_t)m.positions.size();
+        m.positions.insert(m.positions.end(), {a, b, e});
+        m.indices.push_back(make_uint3(base, base + 1, base + 2));
+    }
+    return m;
+}
+
+struct TestRay {
+    float3 o, d;
+    float tmin, tmax;
+};
+
+std::vector<TestRay> random_rays(uint32_t seed, int count) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    const float3 axes[6] = {make_float3(1, 0, 0),  make_float3(-1, 0, 0), make_float3(0, 1, 0),
+                            make_float3(0, -1, 0), make_float3(0, 0, 1),  make_float3(0, 0, -1)};
+    std::vector<TestRay> rays;
+    for (int i = 0; i < count; ++i) {
+        TestRay r;
+        bool inside = i % 2 == 0;  // half start inside the soup
+        r.o = inside ? make_float3(uni(rng), uni(rng), uni(rng))
+                     : make_float3(uni(rng) * 3 - 1, uni(rng) * 3 - 1, uni(rng) * 3 - 1);
+        float3 target = make_float3(uni(rng), uni(rng), uni(rng));
+        r.d = i % 7 == 0 ? axes[i % 6] : normalize(target - r.o);
+        if (i % 11 == 0) r.d = r.d * 3.5f;  // unnormalized directions
+        r.tmin = i % 5 == 0 ? 0.05f : 0.0f;
+        r.tmax = i % 3 == 0 ? 0.4f : kInfinity;
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+/// The accel's closest hit must be brute force's: same t (same arithmetic), and a
+/// triangle that really is hit at that t (ties may pick either triangle).
+void expect_same_closest(const Mesh& m, const TriangleAccel& accel, const TestRay& r) {
+    TriangleHit hit;
+    const bool found = accel.intersect(r.o, r.d, r.tmin, r.tmax, hit);
+    const BruteHit ref = brute_force(m, r.o, r.d, r.tmin, r.tmax);
+    ASSERT_EQ(found, ref.hit);
+    if (!found) return;
+    EXPECT_EQ(hit.t, ref.t);
+    EXPECT_EQ(triangle_t(m, hit.prim, r.o, r.d), hit.t);
+    if (hit.prim == ref.prim) {
+        EXPECT_EQ(hit.u, ref.u);
+        EXPECT_EQ(hit.v, ref.v);
+    }
+}
+
+TEST(Bvh, EmptyInputGivesEmptyTree) {
+    Bvh bvh;
+    bvh.build({});
+    EXPECT_TRUE(bvh.empty());
+    float tmax = kInfinity;
+    int visits = 0;
+    bvh.traverse(make_float3(0), make_float3(1, 0, 0), 0.0f, tmax, [&](uint32_t) {
+        ++visits;
+        return false;
+    });
+    EXPECT_EQ(visits, 0);
+    TriangleAccel accel;
+    accel.build({}, {});
+    TriangleHit hit;
+    EXPECT_FALSE(accel.intersect(make_float3(0), make_float3(1, 0, 0), 0, kInfinity, hit));
+    EXPECT_FALSE(accel.occluded(make_float3(0), make_float3(1, 0, 0), 0, kInfinity));
+}
+
+TEST(Bvh, StructureIsValid) {
+    Mesh m = random_soup(7, 3000);
+    std::vector<Aabb> boxes;
+    for (uint3 t : m.indices) {
+        float3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+        boxes.push_back(Aabb{fminf(a, fminf(b, c)), fmaxf(a, fmaxf(b, c))});
+    }
+    Bvh bvh;
+    BuildStats stats;
+    bvh.build(boxes, {}, &stats);
+    std::vector<int> seen(boxes.size(), 0);
+    for (const BvhNode& n : bvh.nodes()) {
+        if (n.count > 0) {
+            EXPECT_LE(n.count, 4u);
+            for (uint32_t i = 0; i < n.count; ++i) {
+                uint32_t p = bvh.prim_order()[n.first + i];
+                ++seen[p];
+                EXPECT_LE(n.lo.x, boxes[p].lo.x);
+                EXPECT_GE(n.hi.y, boxes[p].hi.y);
+            }
+        } else {
+            for (int c = 0; c < 2; ++c) {
+                const BvhNode& k = bvh.nodes()[n.first + c];
+                EXPECT_LE(n.lo.x, k.lo.x);
+                EXPECT_LE(n.lo.z, k.lo.z);
+                EXPECT_GE(n.hi.y, k.hi.y);
+            }
+        }
+    }
+    for (int s : seen) EXPECT_EQ(s, 1);
+    EXPECT_EQ(stats.node_count, bvh.nodes().size());
+    EXPECT_GT(stats.sah_cost, 0.0);
+    EXPECT_DOUBLE_EQ(stats.sah_cost, bvh.sah_cost());
+}
+
+TEST(Bvh, DepthStaysWithinTheStackOnAdversarialInput) {
+    // Boxes at 2^-i: every SAH split peels off one box, so the tree would be a list.
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < 4000; ++i) {
+        float x = std::ldexp(1.0f, -(i % 120)) + i * 1e-30f;
+        boxes.push_back(Aabb{make_float3(x, 0, 0), make_float3(x, 1, 1)});
+    }
+    for (int i = 0; i < 200; ++i) boxes.push_back(Aabb{make_float3(0.5f), make_float3(0.5f)});
+    Bvh bvh;
+    BuildStats stats;
+    bvh.build(boxes, {}, &stats);
+    EXPECT_LE(stats.depth, 60u);
+    TriangleAccel accel;  // and the triangle accel over the same kind of input
+    Mesh m;
+    for (int i = 0; i < 3000; ++i) {
+        float x = std::ldexp(1.0f, -(i % 120));
+        uint32_t b = (uint32_t)m.positions.size();
+        m.positions.insert(m.positions.end(),
+                           {make_float3(x, 0, 0), make_float3(x, 1, 0), make_float3(x, 0, 1)});
+        m.indices.push_back(make_uint3(b, b + 1, b + 2));
+    }
+    accel.build(m.positions, m.indices, {}, &stats);
+    EXPECT_LE(stats.depth, 60u);
+    TriangleHit hit;
+    ASSERT_TRUE(
+        accel.intersect(make_float3(2, 0.25f, 0.25f), make_float3(-1, 0, 0), 0, kInfinity, hit));
+    EXPECT_EQ(hit.t, 1.0f);
+}
+
+TEST(Bvh, GenericTraversalEqualsBruteForce) {
+    for (uint32_t seed : {1u, 2u, 3u}) {
+        Mesh m = random_soup(seed, 1500);
+        std::vector<Aabb> boxes;
+        for (uint3 t : m.indices) {
+            float3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+            boxes.push_back(Aabb{fminf(a, fminf(b, c)), fmaxf(a, fmaxf(b, c))});
+        }
+        Bvh bvh;
+        bvh.build(boxes);
+        for (const TestRay& r : random_rays(seed + 100, 400)) {
+            // Every box the ray overlaps must be visited, each primitive at most once.
+            std::vector<int> visited(boxes.size(), 0);
+            float tmax = r.tmax;
+            bvh.traverse(r.o, r.d, r.tmin, tmax, [&](uint32_t p) {
+                ++visited[p];
+                return false;
+            });
+            for (size_t i = 0; i < boxes.size(); ++i) {
+                ASSERT_LE(visited[i], 1);
+                float t0 = r.tmin, t1 = r.tmax;
+                bool overlap = true;
+                for (int k = 0; k < 3; ++k) {
+                    float o = k == 0 ? r.o.x : (k == 1 ? r.o.y : r.o.z);
+                    float d = k == 0 ? r.d.x : (k == 1 ? r.d.y : r.d.z);
+                    float lo = k == 0 ? boxes[i].lo.x : (k == 1 ? boxes[i].lo.y : boxes[i].lo.z);
+                    float hi = k == 0 ? boxes[i].hi.x : (k == 1 ? boxes[i].hi.y : boxes[i].hi.z);
+                    if (d == 0.0f) {
+                        if (o < lo || o > hi) overlap = false;
+                        continue;
+                    }
+                    float a = (lo - o) / d, b = (hi - o) / d;
+                    t0 = std::max(t0, std::min(a, b));
+                    t1 = std::min(t1, std::max(a, b));
+                }
+                // Only clear overlaps: boxes grazed within rounding may go either way.
+                if (overlap && t0 < t1 * 0.9999f - 1e-6f) {
+                    EXPECT_EQ(visited[i], 1) << i;
+                }
+            }
+            // Closest hit through the callback, shortening tmax as it goes.
+            BruteHit ref = brute_force(m, r.o, r.d, r.tmin, r.tmax);
+            WatertightRay wr = make_watertight_ray(r.o, r.d);
+            float best = r.tmax;
+            bool found = false;
+            bvh.traverse(r.o, r.d, r.tmin, best, [&](uint32_t p) {
+                uint3 t = m.indices[p];
+                float th, u, v;
+                if (intersect_triangle_watertight(wr, m.positions[t.x], m.positions[t.y],
+                                                  m.positions[t.z], r.tmin, best, th, u, v))
+                    best = th, found = true;
+                return false;
+            });
+            ASSERT_EQ(found, ref.hit);
+            if (found) {
+                EXPECT_EQ(best, ref.t);
+            }
+        }
+    }
+}
+
+TEST(TriangleAccel, ClosestAndAnyHitEqualBruteForce) {
+    for (uint32_t seed : {11u, 12u, 13u, 14u}) {
+        Mesh m = random_soup(seed, 2000);
+        TriangleAccel accel;
+        accel.build(m.positions, m.indices);
+        EXPECT_EQ(accel.triangle_count(), m.indices.size());
+        for (const TestRay& r : random_rays(seed * 7, 600)) {
+            expect_same_closest(m, accel, r);
+            EXPECT_EQ(accel.occluded(r.o, r.d, r.tmin, r.tmax),
+                      brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
+        }
+    }
+}
+
+TEST(TriangleAccel, NonIndexedInputAndSmallMeshes) {
+    for (int count : {1, 2, 3, 4, 5, 9, 33}) {
+        Mesh m = random_soup(50 + count, count);
+        TriangleAccel accel;
+        accel.build(m.positions, {});  // vertices 3i..3i+2, as random_soup lays them out
+        for (const TestRay& r : random_rays(count, 300)) expect_same_closest(m, accel, r);
+    }
+}
+
+TEST(TriangleAccel, FilterIgnoringOddPrimitivesEqualsBruteForceWithoutThem) {
+    Mesh m = random_soup(21, 2500);
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices);
+    for (const TestRay& r : random_rays(22, 600)) {
+        int calls = 0;
+        TriangleHit hit;
+        bool found =
+            accel.intersect_filtered(r.o, r.d, r.tmin, r.tmax, hit, [&](const TriangleHit& c) {
+                ++calls;
+                // Every candidate is a real hit.
+                EXPECT_EQ(triangle_t(m, c.prim, r.o, r.d), c.t);
+                EXPECT_GT(c.t, r.tmin);
+                EXPECT_LT(c.t, r.tmax);
+                return c.prim % 2 ? HitDecision::kIgnore : HitDecision::kAccept;
+            });
+        BruteHit ref =
+            brute_force(m, r.o, r.d, r.tmin, r.tmax, [](uint32_t p) { return p % 2 == 0; });
+        ASSERT_EQ(found, ref.hit);
+        if (found) {
+            EXPECT_EQ(hit.t, ref.t);
+            EXPECT_EQ(hit.prim % 2, 0u);
+        }
+        if (ref.hit) {
+            EXPECT_GE(calls, 1);
+        }
+    }
+}
+
+TEST(TriangleAccel, AcceptAndStopEndsTheSearch) {
+    Mesh m = random_soup(31, 2500);
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices);
+    for (const TestRay& r : random_rays(32, 400)) {
+        int calls = 0;
+        TriangleHit first{}, hit{};
+        bool found =
+            accel.intersect_filtered(r.o, r.d, r.tmin, r.tmax, hit, [&](const TriangleHit& c) {
+                if (calls++ == 0) first = c;
+                return HitDecision::kAcceptAndStop;
+            });
+        EXPECT_EQ(found, brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
+        EXPECT_LE(calls, 1);
+        if (found) {
+            EXPECT_EQ(hit.prim, first.prim);
+            EXPECT_EQ(hit.t, first.t);
+        }
+        // Accepting everything gives the plain closest hit.
+        TriangleHit all, plain;
+        bool a = accel.intersect_filtered(r.o, r.d, r.tmin, r.tmax, all,
+                                          [](const TriangleHit&) { return HitDecision::kAccept; });
+        ASSERT_EQ(a, accel.intersect(r.o, r.d, r.tmin, r.tmax, plain));
+        if (a) {
+            EXPECT_EQ(all.t, plain.t);
+        }
+    }
+}
+
+TEST(TriangleAccel, RefitEqualsFreshBuild) {
+    Mesh m = random_soup(41, 2000);
+    TriangleAccel refitted;
+    refitted.build(m.positions, m.indices);
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> jitter(-0.15f, 0.15f);
+    for (float3& p : m.positions) p = p + make_float3(jitter(rng), jitter(rng) + 0.3f, jitter(rng));
+    refitted.refit(m.positions, m.indices);
+    TriangleAccel fresh;
+    fresh.build(m.positions, m.indices);
+    Aabb a = refitted.bounds(), b = fresh.bounds();
+    EXPECT_EQ(a.lo.x, b.lo.x);
+    EXPECT_EQ(a.hi.y, b.hi.y);
+    for (TestRay r : random_rays(43, 600)) {
+        r.o.y += 0.3f;
+        TriangleHit h1, h2;
+        bool f1 = refitted.intersect(r.o, r.d, r.tmin, r.tmax, h1);
+        bool f2 = fresh.intersect(r.o, r.d, r.tmin, r.tmax, h2);
+        ASSERT_EQ(f1, f2);
+        if (f1) {
+            EXPECT_EQ(h1.t, h2.t);
+        }
+        EXPECT_EQ(refitted.occluded(r.o, r.d, r.tmin, r.tmax), f2);
+        expect_same_closest(m, refitted, r);
+    }
+}
+
+/// A closed, finely tessellated sphere (lat-long grid) around `center`.
+Mesh closed_sphere(float3 center, float radius, int rings, int segments) {
+    Mesh m;
+    const float pi = 3.14159265f;
+    m.positions.push_back(center + make_float3(0, radius, 0));
+    for (int i = 1; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            float th = pi * i / rings, ph = 2 * pi * j / segments;
+            m.positions.push_back(center + radius * make_float3(std::sin(th) * std::cos(ph),
+                                                                std::cos(th),
+                                                                std::sin(th) * std::sin(ph)));
+        }
+    m.positions.push_back(center + make_float3(0, -radius, 0));
+    const uint32_t south = (uint32_t)m.positions.size() - 1;
+    auto ring = [&](int i, int j) { return 1 + (uint32_t)((i - 1) * segments + j % segments); };
+    for (int j = 0; j < segments; ++j) {
+        m.indices.push_back(make_uint3(0, ring(1, j + 1), ring(1, j)));
+        m.indices.push_back(make_uint3(south, ring(rings - 1, j), ring(rings - 1, j + 1)));
+    }
+    for (int i = 1; i + 1 < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            m.indices.push_back(make_uint3(ring(i, j), ring(i, j + 1), ring(i + 1, j)));
+            m.indices.push_back(make_uint3(ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)));
+        }
+    return m;
+}
+
+TEST(TriangleAccel, WatertightOnSharedEdgesAndVertices) {
+    const float3 center = make_float3(0.3f, -0.2f, 0.7f);
+    Mesh m = closed_sphere(center, 1.3f, 40, 64);
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices);
+    int rays = 0;
+    const float3 origins[3] = {center, center + make_float3(0.11f, 0.23f, -0.31f),
+                               center + make_float3(5.0f, 3.0f, -4.0f)};
+    for (const float3& o : origins) {
+        const bool inside = length(o - center) < 1.3f;
+        for (uint3 t : m.indices) {
+            const float3 p[3] = {m.positions[t.x], m.positions[t.y], m.positions[t.z]};
+            // Aim at each vertex and at each edge's midpoint: points shared by triangles.
+            const float3 targets[6] = {
+                p[0], p[1], p[2], 0.5f * (p[0] + p[1]), 0.5f * (p[1] + p[2]), 0.5f * (p[2] + p[0])};
+            for (const float3& target : targets) {
+                const float3 d = target - o;
+                // From outside, keep clear of the silhouette: there a ray through a vertex
+                // may rightly pass beside the fold of front- and back-facing triangles.
+                if (!inside && dot(normalize(d), normalize(target - center)) > -0.3f) continue;
+                TriangleHit hit;
+                ASSERT_TRUE(accel.intersect(o, d, 0.0f, kInfinity, hit))
+                    << "ray slipped through: o " << o.x << " " << o.y << " " << o.z << " d " << d.x
+                    << " " << d.y << " " << d.z;
+                ASSERT_TRUE(accel.occluded(o, d, 0.0f, kInfinity));
+                ++rays;
+            }
+        }
+    }
+    EXPECT_GT(rays, 40000);
+}
+
+// ---- the benchmark scenes -------------------------------------------------------------
+
+std::filesystem::path scenes_dir() {
+    return LUCENT_SCENES_DIR;
+}
+
+struct View {
+    float3 eye, look, up, light;
+    float fov;
+};
+
+bool find_view(const std::string& name, View& view) {
+    std::ifstream in(scenes_dir() / "cameras.txt");
+    std::string line;
+    auto f3 = [](const std::string& s) {
+        float3 v;
+        std::sscanf(s.c_str(), "%f,%f,%f", &v.x, &v.y, &v.z);
+        return v;
+    };
+    while (std::getline(in, line)) {
+        std::istringstream f(line);
+        std::string file, eye, look, up, light;
+        float fov;
+        if (!(f >> file) || file != name || !(f >> eye >> look >> up >> fov >> light)) continue;
+        view = View{f3(eye), f3(look), f3(up), f3(light), fov};
+        return true;
+    }
+    return false;
+}
+
+void check_scene(const std::string& name) {
+    const std::filesystem::path file = scenes_dir() / name;
+    View view{};
+    if (!std::filesystem::exists(file) || !find_view(name, view))
+        GTEST_SKIP() << "no " << file << " (or its line in cameras.txt): the scene test needs "
+                     << "../shared/scenes";
+    scene::ObjMesh obj = scene::load_obj_mesh(file.string());
+    Mesh m{obj.positions, obj.indices};
+    TriangleAccel accel;
+    BuildStats stats;
+    accel.build(m.positions, m.indices, {}, &stats);
+    EXPECT_LE(stats.depth, 60u);
+    // BENCH.md primary rays on a sparse pixel grid, and shadow + diffuse rays from the hits.
+    const unsigned w = 1024, h = 768;
+    const float3 fwd = normalize(view.look - view.eye);
+    const float3 right = normalize(cross(fwd, view.up)), up2 = cross(right, fwd);
+    const float tf = std::tan(view.fov / 2 * 3.14159265f / 180), a = (float)w / h;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    int hits = 0;
+    for (unsigned i = 0; i < 700; ++i) {
+        unsigned pixel = (i * 1123u) % (w * h), x = pixel % w, y = pixel / w;
+        float u = (2 * (x + 0.5f) / w - 1) * tf * a, v = (1 - 2 * (y + 0.5f) / h) * tf;
+        TestRay r{view.eye, normalize(fwd + u * right + v * up2), 0.0f, kInfinity};
+        expect_same_closest(m, accel, r);
+        TriangleHit hit;
+        if (!accel.intersect(r.o, r.d, 0.0f, kInfinity, hit)) continue;
+        ++hits;
+        uint3 t = m.indices[hit.prim];
+        float3 n = normalize(
+            cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+        if (dot(n, r.d) > 0) n = -n;
+        float3 o = r.o + hit.t * r.d + 1e-3f * n;
+        float3 to_light = view.light - o;
+        float dist = length(to_light);
+        EXPECT_EQ(accel.occluded(o, to_light / dist, 0.0f, dist),
+                  brute_force(m, o, to_light / dist, 0.0f, dist).hit);
+        float3 d = normalize(n + make_float3(uni(rng), uni(rng), uni(rng)) * 0.9f);
+        expect_same_closest(m, accel, TestRay{o, d, 0.0f, kInfinity});
+    }
+    EXPECT_GT(hits, 100);
+}
+
+TEST(TriangleAccelScenes, BunnyEqualsBruteForce) {
+    check_scene("bunny.obj");
+}
+TEST(TriangleAccelScenes, SponzaEqualsBruteForce) {
+    check_scene("sponza.obj");
+}
+
+// ---- the OBJ loader -------------------------------------------------------------------
+
+std::string write_temp(const std::string& name, const std::string& text) {
+    std::filesystem::path p = std::filesystem::temp_directory_path() / ("lucent_accel_" + name);
+    std::ofstream(p) << text;
+    return p.string();
+}
+
+std::string load_error(const std::string& path) {
+    try {
+        scene::load_obj_mesh(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(ObjMesh, LoadsAndFansPolygons) {
+    std::string path = write_temp("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    scene::ObjMesh mesh = scene::load_obj_mesh(path);
+    ASSERT_EQ(mesh.positions.size(), 4u);
+    ASSERT_EQ(mesh.indices.size(), 2u);
+    EXPECT_EQ(mesh.indices[1].x, 0u);
+    EXPECT_EQ(mesh.indices[1].z, 3u);
+}
+
+TEST(ObjMesh, ErrorsNameFileAndLine) {
+    std::string missing = (std::filesystem::temp_directory_path() / "lucent_no_such.obj").string();
+    EXPECT_NE(load_error(missing).find(missing + ":"), std::string::npos);
+    std::string nan = write_temp("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+    EXPECT_NE(load_error(nan).find(nan + ":3:"), std::string::npos) << load_error(nan);
+    std::string range = write_temp("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n# c\nf 1 2 9\n");
+    EXPECT_NE(load_error(range).find(range + ":5:"), std::string::npos) << load_error(range);
+    std::string empty = write_temp("empty.obj", "v 0 0 0\nv 1 0 0\n");
+    EXPECT_NE(load_error(empty).find("no triangles"), std::string::npos) << load_error(empty);
+}
+
+}  // namespace
+}  // namespace lucent::accel

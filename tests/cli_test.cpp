@@ -1,0 +1,197 @@
+// The `lucent` command line, run as a user would: bad input gives exit code 2 (1 for runtime
+// errors), a message naming the flag and the accepted form, and never an output file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "samples/sample.h"
+#include "scene/image_io.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+    int exit_code = -1;
+    std::string output;  // stdout and stderr together
+};
+
+CliRun run_cli(const std::string& args) {
+    const std::string command = std::string("'") + LUCENT_CLI + "' " + args + " 2>&1";
+    CliRun run;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return run;
+    char buffer[4096];
+    size_t n;
+    while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) run.output.append(buffer, n);
+    const int status = pclose(pipe);
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return run;
+}
+
+/// A fresh directory per test, so tests can run in parallel and check what was written.
+class CliTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+        m_dir = fs::temp_directory_path() /
+                ("lucent_cli_test_" + std::to_string(getpid()) + "_" + test->name());
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+
+    std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    bool dir_is_empty() const { return fs::is_empty(m_dir); }
+
+    /// Runs `lucent render <args> --out <dir>/out.png` and checks the usage-error contract.
+    CliRun expect_render_usage_error(const std::string& args) {
+        CliRun run = run_cli("render " + args + " --out '" + path("out.png") + "'");
+        EXPECT_EQ(run.exit_code, 2) << "lucent render " << args << "\n" << run.output;
+        EXPECT_TRUE(dir_is_empty()) << "lucent render " << args << " left a file behind";
+        return run;
+    }
+
+    fs::path m_dir;
+};
+
+const lucent::samples::SampleInfo& whitted() {
+    return lucent::samples::find_sample("whitted");
+}
+
+TEST_F(CliTest, ZeroSizeIsAUsageError) {
+    CliRun run = expect_render_usage_error("--size 0x5");
+    EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("0x5"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("WxH"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, NonNumericSizeIsAUsageError) {
+    CliRun run = expect_render_usage_error("--size abc");
+    EXPECT_NE(run.output.find("abc"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("WxH"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, UnknownFlagIsAUsageError) {
+    CliRun run = expect_render_usage_error("--no-such-flag");
+    EXPECT_NE(run.output.find("--no-such-flag"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, UnknownSampleListsTheSamples) {
+    CliRun run = expect_render_usage_error("--sample no_such_sample");
+    EXPECT_NE(run.output.find("no_such_sample"), std::string::npos) << run.output;
+    for (const auto& info : lucent::samples::all_samples())
+        EXPECT_NE(run.output.find(info.name), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, SetWithoutEqualsIsAUsageError) {
+    CliRun run = expect_render_usage_error("--set no_equals_sign");
+    EXPECT_NE(run.output.find("NAME=VALUE"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, UnknownSetNameListsTheOptions) {
+    CliRun run = expect_render_usage_error("--set no_such_option=1");
+    EXPECT_NE(run.output.find("no_such_option"), std::string::npos) << run.output;
+    for (const auto& option : whitted().options)
+        EXPECT_NE(run.output.find(option.name), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, BadSetValueNamesTheOptionAndRange) {
+    if (whitted().options.empty()) GTEST_SKIP() << "the whitted sample has no --set options";
+    const std::string name = whitted().options.front().name;
+    CliRun run = expect_render_usage_error("--set " + name + "=not_a_number");
+    EXPECT_NE(run.output.find(name + "=not_a_number"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("expected"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, UnknownExtensionNamesTheAcceptedOnes) {
+    CliRun run = run_cli("render --size 8x8 --out '" + path("out.jpg") + "'");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find(".png"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find(".pfm"), std::string::npos) << run.output;
+    EXPECT_TRUE(dir_is_empty());
+}
+
+TEST_F(CliTest, UnknownBackendIsAUsageError) {
+    CliRun run = expect_render_usage_error("--backend gpu");
+    EXPECT_NE(run.output.find("auto, cpu or cuda"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, CudaBackendRendersOrSaysWhyNot) {
+    CliRun run = run_cli("render --size 16x16 --backend cuda --out '" + path("out.png") + "'");
+    if (run.exit_code == 0) {  // a build with CUDA on a machine with a GPU
+        EXPECT_TRUE(fs::exists(path("out.png")));
+        return;
+    }
+    EXPECT_EQ(run.exit_code, 1) << run.output;
+    EXPECT_NE(run.output.find("error"), std::string::npos) << run.output;
+    EXPECT_TRUE(dir_is_empty());
+}
+
+TEST_F(CliTest, NoSubcommandIsAUsageError) {
+    CliRun run = run_cli("");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+}
+
+TEST_F(CliTest, BenchMissingSceneIsARuntimeError) {
+    CliRun run = run_cli("bench rays --scene '" + path("missing.obj") + "'");
+    EXPECT_EQ(run.exit_code, 1) << run.output;
+    EXPECT_NE(run.output.find("missing.obj"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, BenchPartialCameraNamesTheMissingFlags) {
+    CliRun run = run_cli("bench rays --scene '" + path("scene.obj") + "' --eye 1,2,3");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--look"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("--light"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, BenchBadVectorIsAUsageError) {
+    CliRun run = run_cli("bench rays --scene '" + path("scene.obj") +
+                         "' --eye 1,2 --look 0,0,0 --up 0,1,0 --fov 45 --light 0,5,0");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--eye"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("x,y,z"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, RenderHelpListsSamplesAndOptions) {
+    CliRun run = run_cli("render --help");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("Examples"), std::string::npos) << run.output;
+    for (const auto& info : lucent::samples::all_samples()) {
+        EXPECT_NE(run.output.find(info.name), std::string::npos) << run.output;
+        for (const auto& option : info.options)
+            EXPECT_NE(run.output.find(option.name + "=" + option.default_value), std::string::npos)
+                << run.output;
+    }
+}
+
+TEST_F(CliTest, RenderWritesAPngOfTheRequestedSize) {
+    const std::string out = path("whitted.png");
+    CliRun run = run_cli("render --sample whitted --size 64x48 --out '" + out + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("total"), std::string::npos) << run.output;
+    const lucent::scene::Image8 image = lucent::scene::read_png8(out);
+    EXPECT_EQ(image.width, 64u);
+    EXPECT_EQ(image.height, 48u);
+    // The write is atomic: the temporary file is gone, only the image is left.
+    EXPECT_EQ(std::distance(fs::directory_iterator(m_dir), fs::directory_iterator()), 1);
+}
+
+TEST_F(CliTest, RenderWritesAPfmByExtension) {
+    const std::string out = path("whitted.pfm");
+    CliRun run = run_cli("render --size 16x8 --out '" + out + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::ifstream file(out, std::ios::binary);
+    std::string header(12, '\0');
+    file.read(header.data(), std::streamsize(header.size()));
+    EXPECT_EQ(header, "PF\n16 8\n-1.0");
+    EXPECT_EQ(fs::file_size(out), 12 + 1 + 16u * 8u * 3u * sizeof(float));
+}
+
+}  // namespace
