@@ -17,6 +17,7 @@ struct RenderArgs {
     std::vector<std::string> sets;
     unsigned threads = 0;
     bool verbose = false;
+    unsigned repeat = 1;    // launches; >1 reports the median launch time
     std::string jit_check;  // e.g. "sm_90": also compile the CUDA megakernel (no GPU needed)
 };
 

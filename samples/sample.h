@@ -26,6 +26,7 @@ struct RenderSettings {
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
     bool verbose = false;
     int jit_check_sm = 0;                     // --jit-check: also compile the CUDA megakernel
+    unsigned repeat = 1;                      // --repeat: launches timed after the first
 
     /// The Context options these settings ask for.
     ContextOptions context_options() const { return ContextOptions{backend, threads, jit_check_sm}; }
@@ -34,6 +35,7 @@ struct RenderSettings {
 struct StageTiming {
     std::string name;
     double ms = 0;
+    std::string note;  // e.g. "median of 100 (min 0.81, max 0.95)"
 };
 
 struct RenderResult {
@@ -50,6 +52,12 @@ struct SampleInfo {
     std::vector<SampleOption> options;
     RenderResult (*render)(const RenderSettings& settings);
 };
+
+/// Launches `entry` over width x height, then `settings.repeat - 1` more times when asked,
+/// and fills `result`: report of the first launch, stages "compile + accel", "megakernel
+/// JIT" (when it ran) and "launch" (the first, or the median of the repeats with spread).
+void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
+                  RenderResult& result);
 
 /// Every sample, in the order `--help` lists them.
 const std::vector<SampleInfo>& all_samples();

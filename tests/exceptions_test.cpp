@@ -12,7 +12,7 @@ constexpr unsigned kNotRaised = 0;  // ExceptionInfo::code of a slot no exceptio
 
 class ExceptionsTest : public testing::Test {
 protected:
-    ExceptionsTest() : ctx(cpu_options()) {
+    ExceptionsTest() : ctx(test_context_options()) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<TestPayload>(0, "radiance");
         ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(common_miss)));

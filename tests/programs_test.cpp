@@ -31,7 +31,7 @@ constexpr float kEps = 1e-4f;
 
 class RayGenerationTest : public testing::Test {
 protected:
-    RayGenerationTest() : ctx(cpu_options()) { ctx.set_entry_point_count(1); }
+    RayGenerationTest() : ctx(test_context_options()) { ctx.set_entry_point_count(1); }
     Context ctx;
 };
 

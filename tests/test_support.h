@@ -13,16 +13,23 @@
 #include <string>
 #include <vector>
 
+#include <cstdlib>
+
 #include "lucent.h"
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
 
-/// Every test runs on the CPU backend: the machine has no GPU, and values must not
-/// depend on which backend `auto` picks.
-inline ContextOptions cpu_options() {
+/// The backend the suites run on: the CPU, so values never depend on what `auto` finds;
+/// LUCENT_TEST_BACKEND=cuda runs the same suites on the GPU (CPU/GPU parity runs).
+inline BackendKind test_backend() {
+    const char* env = std::getenv("LUCENT_TEST_BACKEND");
+    return env && std::string(env) == "cuda" ? BackendKind::kCuda : BackendKind::kCpu;
+}
+
+inline ContextOptions test_context_options() {
     ContextOptions options;
-    options.backend = BackendKind::kCpu;
+    options.backend = test_backend();
     options.threads = 2;
     return options;
 }
@@ -144,7 +151,7 @@ inline CastRay cast_ray(float3 origin, float3 direction) { return CastRay{origin
 /// TestPayload, and the shared miss program: cast(top, rays) traces and returns payloads.
 class CasterFixture : public testing::Test {
 protected:
-    CasterFixture() : ctx(cpu_options()) {
+    CasterFixture() : ctx(test_context_options()) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<TestPayload>(0, "radiance");
         ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(common_miss)));

@@ -47,7 +47,7 @@ TEST_F(ValidationTest, ValidSceneValidatesAndLaunches) {
 // ---- programs ----------------------------------------------------------------------
 
 TEST(ValidationStandaloneTest, UnboundRayGenerationProgramIsRejected) {
-    Context ctx(cpu_options());
+    Context ctx(test_context_options());
     ctx.set_entry_point_count(1);
     const std::string message = expect_error([&] { ctx.validate(); }, {"ray generation"}, "validate()");
     EXPECT_TRUE(mentions_any(message, {"entry", "set_ray_generation_program"})) << message;

@@ -13,7 +13,7 @@ namespace {
 
 class VariablesTest : public testing::Test {
 protected:
-    VariablesTest() : ctx(cpu_options()) {
+    VariablesTest() : ctx(test_context_options()) {
         ctx.set_entry_point_count(2);
         ctx.set_ray_type<VtPayload>(0, "radiance");
         miss = program(ctx, LUCENT_PROGRAM(vt_miss));

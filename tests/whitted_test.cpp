@@ -19,13 +19,19 @@
 namespace lucent::samples {
 namespace {
 
+/// CPU by default; LUCENT_TEST_BACKEND=cuda renders on the GPU against the same golden image.
+BackendKind lucent_tests_backend() {
+    const char* env = std::getenv("LUCENT_TEST_BACKEND");
+    return env && std::string(env) == "cuda" ? BackendKind::kCuda : BackendKind::kCpu;
+}
+
 constexpr unsigned kGoldenSize = 256;  // modest: the test runs on 2 cores in CI
 constexpr double kMaxDifferingFraction = 0.003;
 
 RenderResult render(unsigned size, std::map<std::string, std::string> sets) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = BackendKind::kCpu;
+    settings.backend = lucent_tests_backend();
     settings.sets = std::move(sets);
     return whitted_sample_info().render(settings);
 }
@@ -140,7 +146,7 @@ TEST(Whitted, GlassCastsALighterShadowThanMetal) {
 TEST(Whitted, RejectsUnknownSceneNamingTheAcceptedOne) {
     RenderSettings settings;
     settings.width = settings.height = 8;
-    settings.backend = BackendKind::kCpu;
+    settings.backend = lucent_tests_backend();
     settings.scene = "cornell";
     try {
         whitted_sample_info().render(settings);

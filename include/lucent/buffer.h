@@ -17,7 +17,7 @@ const char* buffer_type_name(BufferType type);
 /// A typed array. Element type is fixed at creation; map<T>() checks it.
 class Buffer : public ContextObject {
 public:
-    Buffer(detail::ContextShared* owner, std::string name, BufferType type,
+    Buffer(detail::OwnerRef owner, std::string name, BufferType type,
            const TypeInfo& element, unsigned dimensionality, uint3 size);
 
     BufferType type() const { return m_type; }
@@ -34,12 +34,14 @@ public:
     template <class T>
     T* map() {
         check_element(type_info_of<T>());
+        sync_from_device();
         m_mapped = true;
         return reinterpret_cast<T*>(bytes());
     }
     template <class T>
     const T* data() const {
         check_element(type_info_of<T>());
+        sync_from_device();
         return reinterpret_cast<const T*>(bytes());
     }
     /// Ends host access: programs see the new contents at the next launch.
@@ -55,12 +57,16 @@ public:
         unmap();
     }
 
+    /// The host copy, as it is (backends use these; applications use map/data).
     void* raw() { return bytes(); }
     const void* raw() const { return bytes(); }
     uint64_t version() const { return m_version; }
+    /// A GPU launch wrote the buffer: the host copy is refreshed on the next map or data.
+    void mark_device_newer() const { m_device_newer = true; }
 
 private:
     void check_element(const TypeInfo& requested) const;
+    void sync_from_device() const;
     struct alignas(16) Block {
         unsigned char bytes[16];
     };
@@ -72,6 +78,7 @@ private:
     uint3 m_size;
     std::vector<Block> m_blocks;  // 16-byte aligned backing store
     bool m_mapped = false;
+    mutable bool m_device_newer = false;
     uint64_t m_version = 1;
 };
 

@@ -47,8 +47,8 @@ private:
 
 class Node : public ContextObject {
 public:
-    Node(detail::ContextShared* owner, std::string name, NodeKind kind)
-        : ContextObject(owner, std::move(name)), m_kind(kind) {}
+    Node(detail::OwnerRef owner, std::string name, NodeKind kind)
+        : ContextObject(std::move(owner), std::move(name)), m_kind(kind) {}
     NodeKind kind() const { return m_kind; }
     std::string describe() const override;
 
@@ -76,8 +76,8 @@ protected:
 /// Children of any node kind, under an acceleration structure (top of a two-level scene).
 class Group : public NodeWithChildren {
 public:
-    Group(detail::ContextShared* owner, std::string name, std::shared_ptr<Acceleration> accel)
-        : NodeWithChildren(owner, std::move(name), NodeKind::kGroup), m_accel(std::move(accel)) {}
+    Group(detail::OwnerRef owner, std::string name, std::shared_ptr<Acceleration> accel)
+        : NodeWithChildren(std::move(owner), std::move(name), NodeKind::kGroup), m_accel(std::move(accel)) {}
     const std::shared_ptr<Acceleration>& acceleration() const { return m_accel; }
     void set_acceleration(std::shared_ptr<Acceleration> accel);
 
@@ -91,8 +91,8 @@ private:
 /// Children chosen per ray by a visit program.
 class Selector : public NodeWithChildren {
 public:
-    Selector(detail::ContextShared* owner, std::string name)
-        : NodeWithChildren(owner, std::move(name), NodeKind::kSelector) {}
+    Selector(detail::OwnerRef owner, std::string name)
+        : NodeWithChildren(std::move(owner), std::move(name), NodeKind::kSelector) {}
     void set_visit_program(std::shared_ptr<Program> visit);
     const std::shared_ptr<Program>& visit_program() const { return m_visit; }
 
@@ -103,7 +103,7 @@ private:
 /// One child moved by an affine 4x3 matrix (object to world).
 class Transform : public Node {
 public:
-    Transform(detail::ContextShared* owner, std::string name);
+    Transform(detail::OwnerRef owner, std::string name);
     void set_child(std::shared_ptr<Node> child);
     const std::shared_ptr<Node>& child() const { return m_child; }
     /// Row-major 3x4 (the last row 0 0 0 1 is implied); `transpose` for column-major input.
@@ -216,9 +216,9 @@ private:
 /// Leaves of the graph: geometry instances under one acceleration structure.
 class GeometryGroup : public Node {
 public:
-    GeometryGroup(detail::ContextShared* owner, std::string name,
+    GeometryGroup(detail::OwnerRef owner, std::string name,
                   std::shared_ptr<Acceleration> accel)
-        : Node(owner, std::move(name), NodeKind::kGeometryGroup), m_accel(std::move(accel)) {}
+        : Node(std::move(owner), std::move(name), NodeKind::kGeometryGroup), m_accel(std::move(accel)) {}
     unsigned add_child(std::shared_ptr<GeometryInstance> instance);
     void set_child(unsigned index, std::shared_ptr<GeometryInstance> instance);
     void remove_child(unsigned index);

@@ -3,21 +3,29 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 
 namespace lucent {
 
+class Buffer;
+
 namespace detail {
-/// State every object of one context shares: bumped on every change.
+/// State every object of one context shares: a generation bumped on every change, and the
+/// backend's hook that copies a buffer the GPU wrote back to the host when it is read.
+/// Objects hold it by shared_ptr, so they may outlive their Context safely.
 struct ContextShared {
     uint64_t generation = 1;
+    std::function<void(const Buffer&)> fetch_from_device;
 };
+using OwnerRef = std::shared_ptr<ContextShared>;
 }  // namespace detail
 
 class ContextObject {
 public:
-    ContextObject(detail::ContextShared* owner, std::string name)
-        : m_owner(owner), m_name(std::move(name)) {}
+    ContextObject(detail::OwnerRef owner, std::string name)
+        : m_owner(std::move(owner)), m_name(std::move(name)) {}
     virtual ~ContextObject() = default;
     ContextObject(const ContextObject&) = delete;
     ContextObject& operator=(const ContextObject&) = delete;
@@ -27,11 +35,11 @@ public:
     void set_name(std::string name) { m_name = std::move(name); }
     /// Type name plus name, for messages: "Material 'glass'".
     virtual std::string describe() const;
-    const detail::ContextShared* owner() const { return m_owner; }
+    const detail::OwnerRef owner() const { return m_owner; }
 
 protected:
     void changed() { ++m_owner->generation; }
-    detail::ContextShared* m_owner;
+    detail::OwnerRef m_owner;
 
 private:
     std::string m_name;

@@ -15,7 +15,7 @@ namespace lucent {
 
 class Program : public ContextObject, public VariableScope {
 public:
-    Program(detail::ContextShared* owner, const ProgramDesc& desc);
+    Program(detail::OwnerRef owner, const ProgramDesc& desc);
     const ProgramDesc& desc() const { return *m_desc; }
     ProgramKind kind() const { return m_desc->kind; }
     std::string describe() const override;

@@ -251,10 +251,7 @@ RenderResult render_whitted(const RenderSettings& settings) {
 
     out.stages.push_back({"scene setup", ms_since(setup_start)});
 
-    ctx.launch(0, settings.width, settings.height);
-    out.report = ctx.last_launch();
-    out.stages.push_back({"compile + accel", out.report.compile_ms + out.report.accel_ms});
-    out.stages.push_back({"launch", out.report.launch_ms});
+    timed_launch(ctx, 0, settings, out);
 
     out.image.width = settings.width;
     out.image.height = settings.height;

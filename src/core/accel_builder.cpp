@@ -84,7 +84,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         } else {
             triangles_only = false;
             content.add_bytes(inst.bounding_box.rec(), inst.bounding_box.desc->record->size);
-            for (const Buffer* b : inst.bounding_box.buffers) content.add(b).add(b->version());
+            for (const auto& b : inst.bounding_box.buffers) content.add(b.get()).add(b->version());
         }
     }
     structure.add(accel.builder());

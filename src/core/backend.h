@@ -16,6 +16,8 @@ public:
     /// Runs entry point `entry` over the grid `size`; fills the exception part of `report`.
     virtual void launch(const CompiledScene& scene, unsigned entry, uint3 size,
                         LaunchReport& report) = 0;
+    /// Brings the host copy of a buffer that the last launch wrote on a device up to date.
+    virtual void fetch(const Buffer& /*buffer*/) {}
 };
 
 /// The CPU backend: a worker per core (or `threads`), tiles of the launch grid.

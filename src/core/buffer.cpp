@@ -14,9 +14,9 @@ const char* buffer_type_name(BufferType type) {
 
 std::string ContextObject::describe() const { return "object '" + m_name + "'"; }
 
-Buffer::Buffer(detail::ContextShared* owner, std::string name, BufferType type,
+Buffer::Buffer(detail::OwnerRef owner, std::string name, BufferType type,
                const TypeInfo& element, unsigned dimensionality, uint3 size)
-    : ContextObject(owner, std::move(name)),
+    : ContextObject(std::move(owner), std::move(name)),
       m_type(type),
       m_element(&element),
       m_dimensionality(dimensionality),
@@ -42,6 +42,7 @@ void Buffer::resize(unsigned width, unsigned height, unsigned depth) {
                     std::to_string(m_dimensionality) +
                     "D buffer; leave the unused dimensions at 1");
     m_size = uint3{width, height, depth};
+    m_device_newer = false;
     size_t bytes = count() * m_element->size;
     m_blocks.assign((bytes + 15) / 16, Block{});
     ++m_version;
@@ -53,6 +54,12 @@ void Buffer::check_element(const TypeInfo& requested) const {
         throw Error(describe() + ": accessed as " + std::string(requested.name) +
                     " but its elements are " + std::string(m_element->name) +
                     "; map it with map<" + std::string(m_element->name) + ">()");
+}
+
+void Buffer::sync_from_device() const {
+    if (!m_device_newer) return;
+    m_device_newer = false;
+    if (m_owner->fetch_from_device) m_owner->fetch_from_device(*this);
 }
 
 void Buffer::unmap() {

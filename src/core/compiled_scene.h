@@ -33,7 +33,7 @@ struct CompiledProgram {
     const ProgramDesc* desc = nullptr;
     std::shared_ptr<PackedRecord> record;  // shared: callables point into it
     std::string label;                     // "closest hit 'phong' of Material 'glass'"
-    std::vector<const Buffer*> buffers;    // every buffer the record views
+    std::vector<std::shared_ptr<const Buffer>> buffers;  // every buffer the record views (kept alive)
 
     explicit operator bool() const { return desc != nullptr; }
     const void* rec() const { return record ? record->data() : nullptr; }

@@ -16,7 +16,7 @@
 namespace lucent {
 
 struct Context::Impl {
-    detail::ContextShared shared;
+    detail::OwnerRef shared = std::make_shared<detail::ContextShared>();
     core::ContextState state;
     core::AccelCache accel_cache;
     std::unique_ptr<core::Backend> backend;
@@ -55,6 +55,8 @@ Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
 #endif
     }
     if (!m_impl->backend) m_impl->backend = core::make_cpu_backend(options.threads);
+    core::Backend* backend = m_impl->backend.get();
+    m_impl->shared->fetch_from_device = [backend](const Buffer& b) { backend->fetch(b); };
     if (options.jit_check_sm) {
 #if LUCENT_HAVE_CUDA
         m_impl->jit_check_sm = options.jit_check_sm;
@@ -66,11 +68,14 @@ Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
 
 const std::string& Context::backend_notice() const { return m_impl->notice; }
 
-Context::~Context() = default;
+Context::~Context() {
+    // Buffers may outlive the Context: they must not call into its backend any more.
+    m_impl->shared->fetch_from_device = nullptr;
+}
 
 std::string Context::backend_name() const { return m_impl->backend->name(); }
 
-void Context::variables_changed() { ++m_impl->shared.generation; }
+void Context::variables_changed() { ++m_impl->shared->generation; }
 
 // ---- entry points and ray types ------------------------------------------------------
 namespace {
@@ -91,7 +96,7 @@ void check_kind(const std::shared_ptr<Program>& p, ProgramKind kind, const char*
 void Context::set_entry_point_count(unsigned count) {
     if (count == 0) throw Error("Context::set_entry_point_count: need at least one entry point");
     m_impl->state.entries.resize(count);
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 unsigned Context::entry_point_count() const { return unsigned(m_impl->state.entries.size()); }
 
@@ -100,13 +105,13 @@ void Context::set_ray_generation_program(unsigned entry, std::shared_ptr<Program
     check_kind(program, ProgramKind::kRayGeneration, "set_ray_generation_program",
                "LUCENT_RAY_GENERATION");
     m_impl->state.entries[entry].ray_generation = std::move(program);
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 void Context::set_exception_program(unsigned entry, std::shared_ptr<Program> program) {
     check_entry(m_impl->state, entry, "set_exception_program");
     check_kind(program, ProgramKind::kException, "set_exception_program", "LUCENT_EXCEPTION");
     m_impl->state.entries[entry].exception = std::move(program);
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 std::shared_ptr<Program> Context::ray_generation_program(unsigned entry) const {
     check_entry(m_impl->state, entry, "ray_generation_program");
@@ -128,7 +133,7 @@ void Context::set_ray_type(unsigned index, RayTypeDesc desc) {
         s.miss.resize(index + 1);
     }
     s.ray_types[index] = std::move(desc);
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 unsigned Context::ray_type_count() const { return unsigned(m_impl->state.ray_types.size()); }
 const RayTypeDesc& Context::ray_type(unsigned index) const {
@@ -145,7 +150,7 @@ void Context::set_miss_program(unsigned ray_type, std::shared_ptr<Program> progr
                     std::to_string(ray_type) + ", name)");
     check_kind(program, ProgramKind::kMiss, "set_miss_program", "LUCENT_MISS");
     s.miss[ray_type] = std::move(program);
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 std::shared_ptr<Program> Context::miss_program(unsigned ray_type) const {
     auto& s = m_impl->state;
@@ -158,7 +163,7 @@ void Context::set_max_recursion_depth(unsigned depth) {
         throw Error("Context::set_max_recursion_depth: " + std::to_string(depth) +
                     " is out of range; use 1..1024");
     m_impl->state.max_depth = depth;
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 unsigned Context::max_recursion_depth() const { return m_impl->state.max_depth; }
 
@@ -179,7 +184,7 @@ void Context::set_exception_enabled(int code, bool enabled) {
         }
         codes.erase(std::remove(codes.begin(), codes.end(), code), codes.end());
     }
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 bool Context::exception_enabled(int code) const {
     auto& codes = m_impl->state.enabled_exceptions;
@@ -191,12 +196,12 @@ bool Context::exception_enabled(int code) const {
 }
 void Context::set_print_enabled(bool enabled) {
     m_impl->state.print_enabled = enabled;
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 bool Context::print_enabled() const { return m_impl->state.print_enabled; }
 void Context::set_print_launch_index(int x, int y, int z) {
     m_impl->state.print_index = int3{x, y, z};
-    ++m_impl->shared.generation;
+    ++m_impl->shared->generation;
 }
 
 // ---- object creation -------------------------------------------------------------------
@@ -204,48 +209,48 @@ std::shared_ptr<Program> Context::create_program(std::string_view registered_nam
     return create_program(find_program(registered_name));
 }
 std::shared_ptr<Program> Context::create_program(const ProgramDesc& desc) {
-    return std::make_shared<Program>(&m_impl->shared, desc);
+    return std::make_shared<Program>(m_impl->shared, desc);
 }
 std::shared_ptr<Buffer> Context::create_buffer(BufferType type, const TypeInfo& element,
                                                unsigned width, unsigned height, unsigned depth) {
     unsigned dims = depth ? 3 : height ? 2 : 1;
     if ((dims >= 2 && height == 0) || (dims == 3 && depth == 0))
         throw Error("Context::create_buffer: a dimension is 0");
-    return std::make_shared<Buffer>(&m_impl->shared, m_impl->next_name("buffer"), type, element,
+    return std::make_shared<Buffer>(m_impl->shared, m_impl->next_name("buffer"), type, element,
                                     dims, uint3{width, height ? height : 1, depth ? depth : 1});
 }
 std::shared_ptr<TextureSampler> Context::create_texture_sampler() {
-    return std::make_shared<TextureSampler>(&m_impl->shared, m_impl->next_name("texture"));
+    return std::make_shared<TextureSampler>(m_impl->shared, m_impl->next_name("texture"));
 }
 std::shared_ptr<Acceleration> Context::create_acceleration(Builder builder) {
-    auto a = std::make_shared<Acceleration>(&m_impl->shared, m_impl->next_name("acceleration"));
+    auto a = std::make_shared<Acceleration>(m_impl->shared, m_impl->next_name("acceleration"));
     a->set_builder(builder);
     return a;
 }
 std::shared_ptr<Group> Context::create_group() {
-    return std::make_shared<Group>(&m_impl->shared, m_impl->next_name("group"), create_acceleration());
+    return std::make_shared<Group>(m_impl->shared, m_impl->next_name("group"), create_acceleration());
 }
 std::shared_ptr<GeometryGroup> Context::create_geometry_group() {
-    return std::make_shared<GeometryGroup>(&m_impl->shared, m_impl->next_name("geometry_group"),
+    return std::make_shared<GeometryGroup>(m_impl->shared, m_impl->next_name("geometry_group"),
                                            create_acceleration());
 }
 std::shared_ptr<Transform> Context::create_transform() {
-    return std::make_shared<Transform>(&m_impl->shared, m_impl->next_name("transform"));
+    return std::make_shared<Transform>(m_impl->shared, m_impl->next_name("transform"));
 }
 std::shared_ptr<Selector> Context::create_selector() {
-    return std::make_shared<Selector>(&m_impl->shared, m_impl->next_name("selector"));
+    return std::make_shared<Selector>(m_impl->shared, m_impl->next_name("selector"));
 }
 std::shared_ptr<GeometryInstance> Context::create_geometry_instance() {
-    return std::make_shared<GeometryInstance>(&m_impl->shared, m_impl->next_name("geometry_instance"));
+    return std::make_shared<GeometryInstance>(m_impl->shared, m_impl->next_name("geometry_instance"));
 }
 std::shared_ptr<Geometry> Context::create_geometry() {
-    return std::make_shared<Geometry>(&m_impl->shared, m_impl->next_name("geometry"));
+    return std::make_shared<Geometry>(m_impl->shared, m_impl->next_name("geometry"));
 }
 std::shared_ptr<GeometryTriangles> Context::create_geometry_triangles() {
-    return std::make_shared<GeometryTriangles>(&m_impl->shared, m_impl->next_name("triangles"));
+    return std::make_shared<GeometryTriangles>(m_impl->shared, m_impl->next_name("triangles"));
 }
 std::shared_ptr<Material> Context::create_material() {
-    return std::make_shared<Material>(&m_impl->shared, m_impl->next_name("material"));
+    return std::make_shared<Material>(m_impl->shared, m_impl->next_name("material"));
 }
 
 // ---- compile and launch ----------------------------------------------------------------
@@ -281,11 +286,11 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
                     " is empty; every dimension must be at least 1");
     LaunchReport report;
     auto t0 = Clock::now();
-    if (!m_impl->compiled || m_impl->compiled->generation != m_impl->shared.generation) {
+    if (!m_impl->compiled || m_impl->compiled->generation != m_impl->shared->generation) {
         m_impl->compiled.reset();  // a failed compile must not leave a stale scene behind
         core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache);
         m_impl->compiled = compiler.compile();
-        m_impl->compiled->generation = m_impl->shared.generation;
+        m_impl->compiled->generation = m_impl->shared->generation;
         report.accel_ms = compiler.accel_ms();
         report.compile_ms = ms_since(t0) - report.accel_ms;
         report.recompiled = true;
@@ -312,7 +317,7 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     }
     auto t1 = Clock::now();
     m_impl->backend->launch(scene, entry, uint3{width, height, depth}, report);
-    report.launch_ms = ms_since(t1);
+    report.launch_ms = ms_since(t1) - report.jit_ms;  // the kernel compile is reported apart
     m_impl->last = std::move(report);
 }
 

@@ -95,8 +95,8 @@ void Selector::set_visit_program(std::shared_ptr<Program> visit) {
     changed();
 }
 
-Transform::Transform(detail::ContextShared* owner, std::string name)
-    : Node(owner, std::move(name), NodeKind::kTransform),
+Transform::Transform(detail::OwnerRef owner, std::string name)
+    : Node(std::move(owner), std::move(name), NodeKind::kTransform),
       m_matrix{{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}} {}
 void Transform::set_child(std::shared_ptr<Node> child) {
     require(child, *this, "child");

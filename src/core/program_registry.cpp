@@ -87,8 +87,8 @@ const char* field_kind_name(FieldKind kind) {
     return "?";
 }
 
-Program::Program(detail::ContextShared* owner, const ProgramDesc& desc)
-    : ContextObject(owner, std::string(desc.name)), m_desc(&desc) {}
+Program::Program(detail::OwnerRef owner, const ProgramDesc& desc)
+    : ContextObject(std::move(owner), std::string(desc.name)), m_desc(&desc) {}
 
 std::string Program::describe() const {
     return std::string(program_kind_name(m_desc->kind)) + " program '" + name() + "'";

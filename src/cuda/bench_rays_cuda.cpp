@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "accel/triangle_accel.h"
+#include "cuda/device/lucent_gpu/ray_order.cuh"
 #include "cuda/device_buffer.h"
 #include "cuda/driver_api.h"
 #include "cuda/embedded_sources.h"
@@ -188,7 +189,9 @@ void parallel_for(size_t count, unsigned threads, Body&& body) {
     for (std::thread& t : pool) t.join();
 }
 
-float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+float3 xyz(float4 v) {
+    return make_float3(v.x, v.y, v.z);
+}
 
 /// The compiled bench module and how to launch its trace kernels.
 struct BenchKernels {
@@ -207,8 +210,8 @@ CompileResult compile_bench_kernels(int sm, bool persistent) {
         req.headers.emplace_back(std::string(s.name), std::string(s.text));
     // --fmad=false: ray generation rounds each operation as the host does; traversal and the
     // watertight test already spell out every fused multiply-add they use (fmaf).
-    req.options = {"--std=c++17", "--fmad=false", "-DLUCENT_BENCH_PERSISTENT=" +
-                                                      std::string(persistent ? "1" : "0")};
+    req.options = {"--std=c++17", "--fmad=false",
+                   "-DLUCENT_BENCH_PERSISTENT=" + std::string(persistent ? "1" : "0")};
     for (std::string& o : split_options(std::getenv("LUCENT_BENCH_NVRTC_OPTIONS")))
         req.options.push_back(std::move(o));
     req.sm = sm;
@@ -257,9 +260,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     {
         char buf[512];
         std::snprintf(buf, sizeof buf,
-                      "%s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
+                      "%s, %s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
                       "local %d blocks/SM; NVRTC %.0f ms%s",
                       k.persistent ? "persistent threads + dynamic fetch" : "one thread per ray",
+                      env_flag("LUCENT_BENCH_TILES", true) ? "rays in 8x4 tiles" : "rays in rows",
                       k.block, attr(k.closest, CU_FUNC_ATTRIBUTE_NUM_REGS),
                       attr(k.closest, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_closest,
                       attr(k.any, CU_FUNC_ATTRIBUTE_NUM_REGS),
@@ -269,7 +273,8 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     }
 
     // The BVH.
-    const GpuTriangleBvh bvh = build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
+    const GpuTriangleBvh bvh =
+        build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
     GpuTriangleBvhDevice dbvh;
     upload_gpu_triangle_bvh(bvh, dbvh);
     gpu::GpuTriangleBvhView view = dbvh.view();
@@ -308,14 +313,19 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     };
     auto launch_1d = [&](CUfunction f, unsigned count, void** args, const char* what) {
         if (count == 0) return;
-        check(api.cuLaunchKernel(f, (count + 255) / 256, 1, 1, 256, 1, 1, 0, nullptr, args,
-                                 nullptr),
-              what);
+        check(
+            api.cuLaunchKernel(f, (count + 255) / 256, 1, 1, 256, 1, 1, 0, nullptr, args, nullptr),
+            what);
         check(api.cuCtxSynchronize(), what);
     };
 
-    // Primary rays (BENCH.md), generated on the GPU.
+    // Primary rays (BENCH.md), generated on the GPU, in 8 x 4 tiles unless
+    // LUCENT_BENCH_TILES=0. Checksums are summed in pixel order, as the CPU bench does.
     const unsigned n = in.width * in.height;
+    unsigned tiled = env_flag("LUCENT_BENCH_TILES", true) ? 1 : 0;
+    std::vector<unsigned> ray_of_pixel(n);
+    for (unsigned r = 0; r < n; ++r)
+        ray_of_pixel[tiled ? gpu::gpu_tiled_pixel(r, in.width, in.height) : r] = r;
     DeviceBuffer primary(sizeof(float4) * 2 * n), primary_hits(sizeof(uint2) * n);
     {
         const float3 fwd = normalize(in.look - in.eye);
@@ -327,8 +337,8 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
                        right.x,  right.y,  right.z,  up2.x, up2.y, up2.z};
         unsigned w = in.width, h = in.height;
         CUdeviceptr rays = primary.ptr();
-        void* args[] = {&p[0], &p[1], &p[2], &p[3], &p[4],  &p[5], &p[6], &p[7], &p[8],
-                        &p[9], &p[10], &p[11], &t, &a,   &w,    &h,    &rays};
+        void* args[] = {&p[0], &p[1],  &p[2],  &p[3], &p[4], &p[5], &p[6], &p[7],  &p[8],
+                        &p[9], &p[10], &p[11], &t,    &a,    &w,    &h,    &tiled, &rays};
         launch_1d(k.primary_rays, n, args, "primary ray generation");
     }
     // The reference below traces the very rays the GPU made, so the comparison is exact
@@ -338,13 +348,23 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
         time_trace(k.closest, k.grid_closest, primary.ptr(), n, primary_hits.ptr());
     std::vector<uint2> hits_p(n);
     primary_hits.download(hits_p.data(), sizeof(uint2) * n);
-    std::vector<unsigned> slot(n);
+    std::vector<unsigned> slot(n);  // primary ray -> its secondary rays
     unsigned m = 0;
-    for (unsigned i = 0; i < n; ++i) {
-        const float t = std::bit_cast<float>(hits_p[i].x);
-        slot[i] = m;
-        if (t >= 0.0f) ++m, ++gpu.primary_hits, gpu.primary_sum_t += t;
+    for (unsigned r = 0; r < n; ++r) {
+        slot[r] = m;
+        if (std::bit_cast<float>(hits_p[r].x) >= 0.0f) ++m;
     }
+    for (unsigned p = 0; p < n; ++p) {
+        const float t = std::bit_cast<float>(hits_p[ray_of_pixel[p]].x);
+        if (t >= 0.0f) ++gpu.primary_hits, gpu.primary_sum_t += t;
+    }
+    // Visits the secondary rays in pixel order.
+    auto for_secondary_in_pixel_order = [&](auto&& visit) {
+        for (unsigned p = 0; p < n; ++p) {
+            const unsigned r = ray_of_pixel[p];
+            if (std::bit_cast<float>(hits_p[r].x) >= 0.0f) visit(slot[r]);
+        }
+    };
 
     // Shadow and diffuse rays from the GPU's primary hits, in pixel order.
     DeviceBuffer slots, shadow(sizeof(float4) * 2 * std::max(m, 1u)),
@@ -353,9 +373,9 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     {
         CUdeviceptr a0 = primary.ptr(), a1 = primary_hits.ptr(), a2 = slots.ptr(),
                     a3 = tris_by_prim.ptr(), a4 = shadow.ptr(), a5 = diffuse.ptr();
-        unsigned count = n;
+        unsigned w = in.width, h = in.height;
         float lx = in.light.x, ly = in.light.y, lz = in.light.z;
-        void* args[] = {&a0, &a1, &a2, &a3, &count, &lx, &ly, &lz, &a4, &a5};
+        void* args[] = {&a0, &a1, &a2, &a3, &w, &h, &tiled, &lx, &ly, &lz, &a4, &a5};
         launch_1d(k.secondary_rays, n, args, "secondary ray generation");
     }
     DeviceBuffer occluded(std::max(m, 1u)), diffuse_hits(sizeof(uint2) * std::max(m, 1u));
@@ -368,10 +388,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     diffuse_hits.download(hits_d.data(), sizeof(uint2) * m);
     gpu.shadow_rays = gpu.diffuse_rays = m;
     for (unsigned char b : occ) gpu.occluded += b;
-    for (const uint2& h : hits_d) {
-        const float t = std::bit_cast<float>(h.x);
+    for_secondary_in_pixel_order([&](unsigned s) {
+        const float t = std::bit_cast<float>(hits_d[s].x);
         if (t >= 0.0f) ++gpu.diffuse_hits, gpu.diffuse_sum_t += t;
-    }
+    });
 
     // The CPU backend (TriangleAccel, all threads) on the same rays.
     std::vector<float4> rays_p(2 * (size_t)n), rays_s(2 * (size_t)m), rays_d(2 * (size_t)m);
@@ -392,9 +412,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     Checksums cpu;
     size_t differ_p = 0, differ_s = 0, differ_d = 0;
     const std::vector<float> cpu_t = cpu_closest(rays_p, n);
-    for (unsigned i = 0; i < n; ++i) {
-        if (cpu_t[i] >= 0.0f) ++cpu.primary_hits, cpu.primary_sum_t += cpu_t[i];
-        differ_p += std::bit_cast<float>(hits_p[i].x) != cpu_t[i];
+    for (unsigned p = 0; p < n; ++p) {
+        const unsigned r = ray_of_pixel[p];
+        if (cpu_t[r] >= 0.0f) ++cpu.primary_hits, cpu.primary_sum_t += cpu_t[r];
+        differ_p += std::bit_cast<float>(hits_p[r].x) != cpu_t[r];
     }
     std::vector<unsigned char> cpu_occ(m);
     parallel_for(m, threads, [&](size_t i) {
@@ -407,10 +428,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
         differ_s += cpu_occ[i] != occ[i];
     }
     const std::vector<float> cpu_td = cpu_closest(rays_d, m);
-    for (unsigned i = 0; i < m; ++i) {
-        if (cpu_td[i] >= 0.0f) ++cpu.diffuse_hits, cpu.diffuse_sum_t += cpu_td[i];
-        differ_d += std::bit_cast<float>(hits_d[i].x) != cpu_td[i];
-    }
+    for_secondary_in_pixel_order([&](unsigned s) {
+        if (cpu_td[s] >= 0.0f) ++cpu.diffuse_hits, cpu.diffuse_sum_t += cpu_td[s];
+        differ_d += std::bit_cast<float>(hits_d[s].x) != cpu_td[s];
+    });
     const std::string differences = checksum_differences(gpu, cpu);
 
     if (in.json) {
@@ -433,12 +454,11 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
             "\"checksums_agree\": %s}\n",
             in.scene.c_str(), ctx.name().c_str(), sm, tri_count, in.width, in.height, in.repeat,
             k.persistent ? "true" : "false", bvh.stats.build_ms + bvh.stats.convert_ms,
-            bvh.stats.node_count, bvh.stats.sah_cost, rate(rate_primary).c_str(),
-            gpu.primary_hits, gpu.primary_sum_t, rate(rate_shadow).c_str(), gpu.shadow_rays,
-            gpu.occluded, rate(rate_diffuse).c_str(), gpu.diffuse_rays, gpu.diffuse_hits,
-            gpu.diffuse_sum_t, cpu.primary_hits, cpu.primary_sum_t, cpu.occluded,
-            cpu.diffuse_hits, cpu.diffuse_sum_t, differ_p, differ_s, differ_d,
-            differences.empty() ? "true" : "false");
+            bvh.stats.node_count, bvh.stats.sah_cost, rate(rate_primary).c_str(), gpu.primary_hits,
+            gpu.primary_sum_t, rate(rate_shadow).c_str(), gpu.shadow_rays, gpu.occluded,
+            rate(rate_diffuse).c_str(), gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t,
+            cpu.primary_hits, cpu.primary_sum_t, cpu.occluded, cpu.diffuse_hits, cpu.diffuse_sum_t,
+            differ_p, differ_s, differ_d, differences.empty() ? "true" : "false");
         return 0;
     }
     auto rate_text = [](const Rate& r) {
@@ -453,25 +473,27 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
         in.repeat);
     std::printf("kernels: %s\n", k.describe.c_str());
     std::printf("build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u)\n",
-                bvh.stats.build_ms, bvh.stats.convert_ms, bvh.stats.sah_cost,
-                bvh.stats.node_count, bvh.stats.leaf_count, bvh.stats.depth);
+                bvh.stats.build_ms, bvh.stats.convert_ms, bvh.stats.sah_cost, bvh.stats.node_count,
+                bvh.stats.leaf_count, bvh.stats.depth);
     std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(rate_primary).c_str(),
                 gpu.primary_hits, gpu.primary_sum_t);
     std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(rate_shadow).c_str(),
                 gpu.shadow_rays, gpu.occluded);
     std::printf("diffuse %s rays=%zu hits=%zu sum_t=%.6e\n", rate_text(rate_diffuse).c_str(),
                 gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t);
-    std::printf("cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
-                "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",
-                cpu.primary_hits, cpu.primary_sum_t, cpu.occluded, cpu.diffuse_hits,
-                cpu.diffuse_sum_t, threads);
+    std::printf(
+        "cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
+        "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",
+        cpu.primary_hits, cpu.primary_sum_t, cpu.occluded, cpu.diffuse_hits, cpu.diffuse_sum_t,
+        threads);
     if (differences.empty())
         std::printf("checksums: equal to the CPU backend\n");
     else
         std::printf("checksums: differ from the CPU backend: %s\n", differences.c_str());
     if (differ_p || differ_s || differ_d)
-        std::printf("rays whose result differs from the CPU: primary %zu, shadow %zu, diffuse %zu\n",
-                    differ_p, differ_s, differ_d);
+        std::printf(
+            "rays whose result differs from the CPU: primary %zu, shadow %zu, diffuse %zu\n",
+            differ_p, differ_s, differ_d);
     return 0;
 }
 
@@ -512,9 +534,10 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
             stats.node_count, stats.leaf_count, stats.depth);
         return 0;
     }
-    std::printf("scene %s: %zu triangles, GPU %s, median of %d builds (host build + convert + "
-                "upload)\n",
-                in.scene.c_str(), tris, ctx.name().c_str(), in.repeat);
+    std::printf(
+        "scene %s: %zu triangles, GPU %s, median of %d builds (host build + convert + "
+        "upload)\n",
+        in.scene.c_str(), tris, ctx.name().c_str(), in.repeat);
     std::printf(
         "build %.2f ms (min %.2f, max %.2f) %.2f Mtris/s sah=%.3f nodes=%zu leaves=%zu depth=%u "
         "(sah build %.2f ms, convert %.2f ms, upload %.2f ms)\n",

@@ -28,6 +28,7 @@ struct CudaRaysInput {
 /// line per ray kind in the CPU bench's format, and the comparison with the CPU backend on
 /// the same rays. Throws lucent::Error without a driver or GPU. Returns the exit code.
 /// Environment: LUCENT_BENCH_PERSISTENT=0 (plain grid instead of persistent threads),
+/// LUCENT_BENCH_TILES=0 (rays in pixel order instead of 8x4 tiles; checksums unchanged),
 /// LUCENT_GPU_LEAF_SIZE=1..8 (default 4), LUCENT_BENCH_NVRTC_OPTIONS (extra NVRTC options,
 /// e.g. "-DLUCENT_BENCH_MIN_BLOCKS=6 -DLUCENT_GPU_DYNAMIC_FETCH_THRESHOLD=16").
 int run_bench_rays_cuda(const CudaRaysInput& input);

@@ -87,7 +87,12 @@ public:
                         unsigned(linear / (uint64_t(size.x) * size.y))};
             report.exceptions[s.code] = {s.count, first};
         }
-        m_scene->download_outputs();
+        m_scene->mark_outputs_device_newer();  // copied back when the host reads them
+    }
+
+    void fetch(const Buffer& buffer) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        if (m_scene) m_scene->fetch(buffer);
     }
 
     /// Generates the kernel for this scene; compiles it only when the source changed.

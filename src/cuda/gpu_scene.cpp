@@ -1,6 +1,7 @@
 #include "cuda/gpu_scene.h"
 
 #include <cstring>
+#include <set>
 
 #include "cuda/megakernel_compiler.h"
 #include "lucent/error.h"
@@ -31,8 +32,9 @@ void append_bvh(const accel::Bvh& bvh, std::vector<gpu::GpuBvhNode>& nodes,
 }
 }  // namespace
 
-CUdeviceptr GpuScene::device_pointer(const Buffer* buffer) {
-    if (!buffer) return 0;
+CUdeviceptr GpuScene::device_pointer(const std::shared_ptr<const Buffer>& shared) {
+    if (!shared) return 0;
+    const Buffer* buffer = shared.get();
     auto found = m_buffers.find(buffer);
     if (found == m_buffers.end()) {
         // Used by the new compile: reuse the previous compile's copy when there is one.
@@ -42,7 +44,7 @@ CUdeviceptr GpuScene::device_pointer(const Buffer* buffer) {
                                               : BufferMirror{}).first;
     }
     BufferMirror& m = found->second;
-    m.buffer = buffer;
+    m.buffer = shared;
     size_t bytes = buffer->count() * buffer->element().size;
     if (m.version != buffer->version() || m.memory.size() != bytes) {
         m.memory.upload(buffer->raw(), bytes);
@@ -54,7 +56,7 @@ CUdeviceptr GpuScene::device_pointer(const Buffer* buffer) {
 void GpuScene::patch_record(unsigned char* bytes, const core::CompiledProgram& program) {
     // Host pointers in the packed record become device pointers of the same buffers.
     auto device_of = [&](const void* host) -> CUdeviceptr {
-        for (const Buffer* b : program.buffers)
+        for (const auto& b : program.buffers)
             if (b->raw() == host) return device_pointer(b);
         return 0;
     };
@@ -116,10 +118,10 @@ void GpuScene::update(const core::CompiledScene& scene) {
         g.intersection = add_program(inst.intersection);
         g.attribute = add_program(inst.attribute);
         if (const GeometryTriangles* tris = triangles_of(inst)) {
-            g.vertices = reinterpret_cast<const float3*>(device_pointer(tris->vertices().get()));
-            g.indices = reinterpret_cast<const uint3*>(device_pointer(tris->indices().get()));
+            g.vertices = reinterpret_cast<const float3*>(device_pointer(tris->vertices()));
+            g.indices = reinterpret_cast<const uint3*>(device_pointer(tris->indices()));
             g.material_indices =
-                reinterpret_cast<const unsigned*>(device_pointer(tris->material_indices().get()));
+                reinterpret_cast<const unsigned*>(device_pointer(tris->material_indices()));
         }
         g.material_offset = unsigned(materials.size() / std::max(1u, ray_types));
         g.material_count = unsigned(inst.materials.size());
@@ -135,6 +137,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
     std::vector<gpu::GpuBvhNode> bvh_nodes;
     std::vector<gpu::GpuBvh> bvhs;
     std::vector<gpu::GpuGeometryAccel> accels;
+    std::set<const core::GeometryAccel*> used_geometry;
     for (const core::CompiledNode& n : scene.nodes) {
         gpu::GpuNode g{};
         g.kind = unsigned(n.kind);
@@ -152,7 +155,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
         } else if (n.kind == NodeKind::kGeometryGroup) {
             const core::GeometryAccel& ga = *n.geometry;
             gpu::GpuGeometryAccel a{};
-            a.triangles_only = 0;  // the generic layout serves triangles too, for now
+            a.triangles_only = ga.triangles_only;
             a.brute_force = n.brute_force;
             for (unsigned r = 0; r < n.any_hit_for_ray_type.size(); ++r)
                 if (n.any_hit_for_ray_type[r]) a.any_hit_mask |= 1u << r;
@@ -164,33 +167,21 @@ void GpuScene::update(const core::CompiledScene& scene) {
             a.prim_total = 0;
             for (unsigned i : n.instances) a.prim_total += scene.instances[i].primitive_count;
             if (ga.triangles_only) {
-                // The CPU keeps a wide layout; the GPU gets a binary BVH over the same
-                // triangles, rebuilt only when they change.
+                // The CPU keeps its wide layout; the GPU gets its own over the same triangles,
+                // rebuilt only when they change.
                 GeometryMirror& mirror = m_geometry[&ga];
-                if (mirror.structure != ga.structure_signature || mirror.content != ga.content_signature ||
-                    mirror.nodes.empty()) {
-                    std::vector<Aabb> boxes(ga.indices.size());
-                    for (size_t t = 0; t < ga.indices.size(); ++t) {
-                        float3 p0 = ga.vertices[ga.indices[t].x], p1 = ga.vertices[ga.indices[t].y],
-                               p2 = ga.vertices[ga.indices[t].z];
-                        boxes[t] = {fminf(p0, fminf(p1, p2)), fmaxf(p0, fmaxf(p1, p2))};
-                    }
-                    accel::Bvh bvh;
-                    bvh.build(boxes);
-                    mirror.nodes.clear();
-                    mirror.order.clear();
-                    gpu::GpuBvh unused;
-                    append_bvh(bvh, mirror.nodes, mirror.order, unused);
+                used_geometry.insert(&ga);
+                if (mirror.structure != ga.structure_signature ||
+                    mirror.content != ga.content_signature) {
+                    GpuTriangleBvh bvh = build_gpu_triangle_bvh(ga.vertices, ga.indices);
+                    mirror.empty = ga.indices.empty();
+                    upload_gpu_triangle_bvh(bvh, mirror.bvh);
                     mirror.structure = ga.structure_signature;
                     mirror.content = ga.content_signature;
                 }
-                if (mirror.nodes.empty()) {
-                    a.bvh = {~0u, 0};
-                } else {
-                    a.bvh = {unsigned(bvh_nodes.size()), unsigned(order.size())};
-                    bvh_nodes.insert(bvh_nodes.end(), mirror.nodes.begin(), mirror.nodes.end());
-                    order.insert(order.end(), mirror.order.begin(), mirror.order.end());
-                }
+                a.triangles = mirror.bvh.view();
+                a.bvh = {~0u, 0};
+                if (mirror.empty) a.triangles_only = 0, a.prim_total = 0;  // nothing to hit
             } else {
                 append_bvh(ga.bvh, bvh_nodes, order, a.bvh);
             }
@@ -235,18 +226,35 @@ void GpuScene::update(const core::CompiledScene& scene) {
         else if (code >= kUserExceptionBase) m_params.exception_mask |= 1u << 31;
         else if (code > 0 && code < 31) m_params.exception_mask |= 1u << code;
     }
+    for (auto it = m_geometry.begin(); it != m_geometry.end();)
+        it = used_geometry.count(it->first) ? std::next(it) : m_geometry.erase(it);
+    // Buffers the new compile dropped: what the GPU wrote into them reaches the host now.
+    for (auto& [buffer, mirror] : m_previous_buffers)
+        if (mirror.device_newer) fetch_mirror(mirror);
     m_previous_buffers.clear();
 }
 
 void GpuScene::sync_buffers() {
-    for (auto& [buffer, mirror] : m_buffers) device_pointer(buffer);
+    for (auto& [buffer, mirror] : m_buffers) device_pointer(mirror.buffer);
 }
 
-void GpuScene::download_outputs() {
+void GpuScene::mark_outputs_device_newer() {
     for (auto& [buffer, mirror] : m_buffers)
-        if (buffer->type() != BufferType::kInput)
-            mirror.memory.download(const_cast<void*>(buffer->raw()),
-                                   buffer->count() * buffer->element().size);
+        if (buffer->type() != BufferType::kInput) {
+            mirror.device_newer = true;
+            buffer->mark_device_newer();
+        }
+}
+
+void GpuScene::fetch_mirror(BufferMirror& mirror) {
+    const Buffer& b = *mirror.buffer;
+    mirror.memory.download(const_cast<void*>(b.raw()), b.count() * b.element().size);
+    mirror.device_newer = false;
+}
+
+void GpuScene::fetch(const Buffer& buffer) {
+    auto found = m_buffers.find(&buffer);
+    if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);
 }
 
 }  // namespace lucent::cuda

@@ -8,6 +8,7 @@
 
 #include "core/compiled_scene.h"
 #include "cuda/device_buffer.h"
+#include "cuda/gpu_triangle_bvh.h"
 #include "cuda/megakernel_generator.h"
 #include "lucent_gpu/launch_params.cuh"
 
@@ -20,8 +21,11 @@ public:
     void update(const core::CompiledScene& scene);
     /// Uploads buffers changed by the host since the last launch (same compile).
     void sync_buffers();
-    /// Copies buffers that programs may write (output, input-output) back to the host.
-    void download_outputs();
+    /// After a launch: buffers programs may write (output, input-output) are newer on the
+    /// device; their host copies are fetched when the host reads them (fetch()).
+    void mark_outputs_device_newer();
+    /// Copies one buffer's device contents to its host copy (no-op if not mirrored).
+    void fetch(const Buffer& buffer);
 
     /// The scene part of the launch parameters (per-launch fields left for the caller).
     const gpu::LaunchParams& params() const { return m_params; }
@@ -33,16 +37,18 @@ private:
     struct BufferMirror {
         DeviceBuffer memory;
         uint64_t version = 0;
-        const Buffer* buffer = nullptr;
+        std::shared_ptr<const Buffer> buffer;  // alive while mirrored
+        bool device_newer = false;
     };
     struct GeometryMirror {
         uint64_t structure = 0, content = 0;
-        std::vector<gpu::GpuBvhNode> nodes;  // binary BVH over the triangles (generic layout)
-        std::vector<uint32_t> order;
+        GpuTriangleBvhDevice bvh;  // the triangles in the GPU layout (Aila and Laine 2009)
+        bool empty = true;
     };
 
-    CUdeviceptr device_pointer(const Buffer* buffer);
+    CUdeviceptr device_pointer(const std::shared_ptr<const Buffer>& buffer);
     gpu::ProgramRef add_program(const core::CompiledProgram& program);
+    void fetch_mirror(BufferMirror& mirror);
     void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
 
     ProgramTable m_programs;

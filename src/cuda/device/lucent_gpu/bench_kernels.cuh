@@ -12,6 +12,7 @@
 #pragma once
 
 #include "lucent/device/types.h"
+#include "lucent_gpu/ray_order.cuh"
 #include "lucent_gpu/triangle_bvh.cuh"
 
 #ifndef LUCENT_BENCH_PERSISTENT
@@ -47,6 +48,7 @@ __device__ inline void bench_trace(const GpuTriangleBvhView& bvh, const float4* 
     (void)0;
     const unsigned lane = threadIdx.x & 31u;
     const unsigned lanes_below = (1u << lane) - 1u;
+    GpuBvhStack stack;
     GpuBvhTraversal tr;
     tr.finish();
     unsigned ray = 0xffffffffu;  // the ray this lane traces, none yet
@@ -64,19 +66,20 @@ __device__ inline void bench_trace(const GpuTriangleBvhView& bvh, const float4* 
             if (ray >= count) break;
             const float4 o = __ldg(rays + 2 * ray);
             const float4 d = __ldg(rays + 2 * ray + 1);
-            tr.start(make_float3(o.x, o.y, o.z), make_float3(d.x, d.y, d.z), o.w, d.w);
+            tr.start(make_float3(o.x, o.y, o.z), make_float3(d.x, d.y, d.z), o.w, d.w, stack);
         }
-        tr.run<kQuery, true>(bvh, none);
+        tr.run<kQuery, true>(bvh, none, stack);
     }
 #else
     (void)counter;
     const unsigned ray = blockIdx.x * blockDim.x + threadIdx.x;
     if (ray >= count) return;
+    GpuBvhStack stack;
     GpuBvhTraversal tr;
     const float4 o = __ldg(rays + 2 * ray);
     const float4 d = __ldg(rays + 2 * ray + 1);
-    tr.start(make_float3(o.x, o.y, o.z), make_float3(d.x, d.y, d.z), o.w, d.w);
-    tr.run<kQuery, false>(bvh, none);
+    tr.start(make_float3(o.x, o.y, o.z), make_float3(d.x, d.y, d.z), o.w, d.w, stack);
+    tr.run<kQuery, false>(bvh, none, stack);
     store(ray, tr);
 #endif
 }
@@ -88,12 +91,11 @@ extern "C" __global__ void __launch_bounds__(LUCENT_BENCH_BLOCK, LUCENT_BENCH_MI
     lucent_bench_closest(lucent::gpu::GpuTriangleBvhView bvh, const float4* __restrict__ rays,
                          unsigned count, uint2* __restrict__ hits, unsigned* counter) {
     using namespace lucent::gpu;
-    bench_trace<kGpuClosest>(bvh, rays, count, counter,
-                             [&](unsigned i, const GpuBvhTraversal& tr) {
-                                 const bool h = tr.hit();
-                                 hits[i] = make_uint2(__float_as_uint(h ? tr.tmax : -1.0f),
-                                                      h ? bvh.triangle_ids[tr.hit_index] : 0u);
-                             });
+    bench_trace<kGpuClosest>(bvh, rays, count, counter, [&](unsigned i, const GpuBvhTraversal& tr) {
+        const bool h = tr.hit();
+        hits[i] = make_uint2(__float_as_uint(h ? tr.tmax : -1.0f),
+                             h ? bvh.triangle_ids[tr.hit_index] : 0u);
+    });
 }
 
 /// Any hit of every ray: occluded[i] = 1 when something lies in (tmin, tmax).
@@ -106,16 +108,19 @@ extern "C" __global__ void __launch_bounds__(LUCENT_BENCH_BLOCK, LUCENT_BENCH_MI
     });
 }
 
-/// Primary rays of BENCH.md, pixel i = y * width + x, y = 0 the top row. fwd, right, up2,
+/// Primary rays of BENCH.md, pixel y * width + x, y = 0 the top row. fwd, right, up2,
 /// t = tan(fov / 2) and a = W / H come from the host (computed once, as the CPU bench does).
+/// Ray i is pixel i, or with `tiled` the pixel gpu_tiled_pixel(i) (ray_order.cuh).
 extern "C" __global__ void lucent_bench_primary_rays(float ex, float ey, float ez, float fx,
                                                      float fy, float fz, float rx, float ry,
                                                      float rz, float ux, float uy, float uz,
                                                      float t, float a, unsigned width,
-                                                     unsigned height, float4* rays) {
+                                                     unsigned height, unsigned tiled,
+                                                     float4* rays) {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= width * height) return;
-    const unsigned x = i % width, y = i / width;
+    const unsigned pixel = tiled ? lucent::gpu::gpu_tiled_pixel(i, width, height) : i;
+    const unsigned x = pixel % width, y = pixel / width;
     const float w = (float)width, h = (float)height;
     const float u = (2 * (x + 0.5f) / w - 1) * t * a;
     const float v = (1 - 2 * (y + 0.5f) / h) * t;
@@ -127,18 +132,20 @@ extern "C" __global__ void lucent_bench_primary_rays(float ex, float ey, float e
 }
 
 /// Shadow and diffuse rays of BENCH.md from the primary hits. slot[i] is the index of
-/// pixel i's secondary rays among the hits (an exclusive prefix sum over hit pixels, so
-/// the rays stay in pixel order); tris_by_prim holds 3 float4 per triangle, input order.
+/// primary ray i's secondary rays among the hits (an exclusive prefix sum over the rays
+/// that hit, so they keep the primary order); tris_by_prim holds 3 float4 per triangle,
+/// input order. The diffuse hash takes the pixel index, as in BENCH.md.
 extern "C" __global__ void lucent_bench_secondary_rays(const float4* __restrict__ primary,
                                                        const uint2* __restrict__ hits,
                                                        const unsigned* __restrict__ slot,
                                                        const float4* __restrict__ tris_by_prim,
-                                                       unsigned count, float lx, float ly,
-                                                       float lz, float4* shadow,
-                                                       float4* diffuse) {
+                                                       unsigned width, unsigned height,
+                                                       unsigned tiled, float lx, float ly, float lz,
+                                                       float4* shadow, float4* diffuse) {
     using namespace lucent::gpu;
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= count) return;
+    if (i >= width * height) return;
+    const unsigned pixel = tiled ? gpu_tiled_pixel(i, width, height) : i;
     const uint2 hit = hits[i];
     const float t = __uint_as_float(hit.x);
     if (t < 0.0f) return;
@@ -158,14 +165,14 @@ extern "C" __global__ void lucent_bench_secondary_rays(const float4* __restrict_
     shadow[2 * s] = make_float4(o.x, o.y, o.z, 0.0f);
     shadow[2 * s + 1] = make_float4(ld.x, ld.y, ld.z, dist);
 
-    const unsigned h1 = bench_hash(2 * i + 1), h2 = bench_hash(h1);
+    const unsigned h1 = bench_hash(2 * pixel + 1), h2 = bench_hash(h1);
     const float u1 = (float)(h1 >> 8) / 16777216.0f, u2 = (float)(h2 >> 8) / 16777216.0f;
     const float r = sqrtf(u1), phi = 2 * kBenchPi * u2;
     const float3 tt =
         normalize(cross(n, fabsf(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
     const float3 bb = cross(n, tt);
-    const float3 dir = normalize(tt * (r * cosf(phi)) + bb * (r * sinf(phi)) +
-                                 n * sqrtf(fmaxf(0.0f, 1 - u1)));
+    const float3 dir =
+        normalize(tt * (r * cosf(phi)) + bb * (r * sinf(phi)) + n * sqrtf(fmaxf(0.0f, 1 - u1)));
     diffuse[2 * s] = make_float4(o.x, o.y, o.z, 0.0f);
     diffuse[2 * s + 1] = make_float4(dir.x, dir.y, dir.z, lucent::kInfinity);
 }

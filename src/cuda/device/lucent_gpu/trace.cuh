@@ -112,7 +112,7 @@ __device__ inline unsigned locate(const GpuGeometryAccel& ga, unsigned ref) {
     return lo;
 }
 
-__device__ void traverse_node(Frame& f, unsigned node, float3 origin, float3 direction);
+__device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origin, float3 direction);
 
 __device__ inline void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                       float3 direction) {
@@ -264,7 +264,7 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
     }
 }
 
-__device__ void trace_ray(Handle root, const Ray& ray, void* payload) {
+__device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload) {
     ThreadState& s = self();
     if (s.exception_code) return;  // an exception ends the launch index's work
     if (ray.ray_type >= params.ray_type_count) {

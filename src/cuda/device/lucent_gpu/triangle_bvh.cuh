@@ -45,9 +45,9 @@ constexpr int kGpuTriangleFloat4s = 3;
 constexpr int kGpuLeafCountShift = 28;
 constexpr unsigned kGpuLeafFirstMask = (1u << kGpuLeafCountShift) - 1u;
 constexpr int kGpuMaxLeafSize = 8;
-constexpr int kGpuStackSize = 64;              // entries; the CPU builder caps depth at 60
+constexpr int kGpuStackSize = 64;                   // entries; the CPU builder caps depth at 60
 constexpr int kGpuEntrypointSentinel = 0x76543210;  // bottom of the stack (Aila-Laine)
-constexpr float kGpuFarScale = 1.00000024f;    // 1 + 2 ulp, as TriangleAccel (Ize 2013)
+constexpr float kGpuFarScale = 1.00000024f;         // 1 + 2 ulp, as TriangleAccel (Ize 2013)
 
 /// Dynamic fetch (Kepler addendum): a persistent kernel leaves the traversal loop when
 /// fewer lanes than this are still traversing, to refill the finished ones.
@@ -58,7 +58,9 @@ constexpr float kGpuFarScale = 1.00000024f;    // 1 + 2 ulp, as TriangleAccel (I
 LUCENT_HD inline int gpu_make_leaf(unsigned first, unsigned count) {
     return (int)~(first | ((count - 1u) << kGpuLeafCountShift));
 }
-LUCENT_HD inline unsigned gpu_leaf_first(int leaf) { return ((unsigned)~leaf) & kGpuLeafFirstMask; }
+LUCENT_HD inline unsigned gpu_leaf_first(int leaf) {
+    return ((unsigned)~leaf) & kGpuLeafFirstMask;
+}
 LUCENT_HD inline unsigned gpu_leaf_count(int leaf) {
     return (((unsigned)~leaf) >> kGpuLeafCountShift) + 1u;
 }
@@ -123,22 +125,27 @@ struct GpuNoFilter {
 
 // ---- traversal ---------------------------------------------------------------------
 
-/// The state of one ray's traversal. It lives in registers, except the stack (local
-/// memory, cached in L1). run() may return before the ray is finished when kDynamicFetch
-/// is set; done() says whether it is.
-struct GpuBvhTraversal {
-    float ox, oy, oz;        // origin
-    float idx, idy, idz;     // 1 / direction (signed infinities for zero components)
-    float tmin, tmax;        // tmax shrinks to the closest accepted hit
-    WatertightRay wt;
-    int node;                // inner node offset, a leaf (< 0), or the sentinel when done
-    int leaf;                // a postponed leaf (< 0), or >= 0 for none
-    int sp;
-    int hit_index;           // leaf-order index of the closest accepted hit, -1 for none
-    float hit_u, hit_v;
-    int stack[kGpuStackSize];
+/// The traversal stack of one ray (local memory, cached in L1). It is kept apart from
+/// GpuBvhTraversal: an array indexed at run time inside the struct would drag the whole
+/// struct, ray included, into local memory.
+struct GpuBvhStack {
+    int entries[kGpuStackSize];
+};
 
-    LUCENT_HD void start(float3 origin, float3 dir, float t0, float t1) {
+/// The state of one ray's traversal, all scalars so that it stays in registers. run() may
+/// return before the ray is finished when kDynamicFetch is set; done() says whether it is.
+struct GpuBvhTraversal {
+    float ox, oy, oz;     // origin
+    float idx, idy, idz;  // 1 / direction (signed infinities for zero components)
+    float tmin, tmax;     // tmax shrinks to the closest accepted hit
+    WatertightRay wt;
+    int node;  // inner node offset, a leaf (< 0), or the sentinel when done
+    int leaf;  // a postponed leaf (< 0), or >= 0 for none
+    int sp;
+    int hit_index;  // leaf-order index of the closest accepted hit, -1 for none
+    float hit_u, hit_v;
+
+    LUCENT_HD void start(float3 origin, float3 dir, float t0, float t1, GpuBvhStack& stack) {
         ox = origin.x, oy = origin.y, oz = origin.z;
         idx = 1.0f / dir.x, idy = 1.0f / dir.y, idz = 1.0f / dir.z;
         tmin = t0;
@@ -147,7 +154,7 @@ struct GpuBvhTraversal {
         node = 0;
         leaf = 0;
         sp = 0;
-        stack[0] = kGpuEntrypointSentinel;
+        stack.entries[0] = kGpuEntrypointSentinel;
         hit_index = -1;
         hit_u = hit_v = 0.0f;
     }
@@ -176,7 +183,8 @@ struct GpuBvhTraversal {
 
     /// Traverses until done, or (kDynamicFetch) until too few lanes of the warp are busy.
     template <int kQuery, bool kDynamicFetch, class Filter>
-    LUCENT_HD void run(const GpuTriangleBvhView& bvh, Filter& filter) {
+    LUCENT_HD void run(const GpuTriangleBvhView& bvh, Filter& filter, GpuBvhStack& stack_memory) {
+        int* const stack = stack_memory.entries;
         const float4* __restrict__ nodes = bvh.nodes;
         const float4* __restrict__ tris = bvh.triangles;
         while (node != kGpuEntrypointSentinel) {
@@ -226,10 +234,9 @@ struct GpuBvhTraversal {
                     const float4 b = gpu_load(tris + 3 * i + 1);
                     const float4 c = gpu_load(tris + 3 * i + 2);
                     float t, u, v;
-                    if (!intersect_triangle_watertight(wt, make_float3(a.x, a.y, a.z),
-                                                       make_float3(b.x, b.y, b.z),
-                                                       make_float3(c.x, c.y, c.z), tmin, tmax,
-                                                       t, u, v))
+                    if (!intersect_triangle_watertight(
+                            wt, make_float3(a.x, a.y, a.z), make_float3(b.x, b.y, b.z),
+                            make_float3(c.x, c.y, c.z), tmin, tmax, t, u, v))
                         continue;
                     if constexpr (kQuery == kGpuFiltered) {
                         GpuHit candidate;
@@ -283,20 +290,22 @@ struct GpuBvhTraversal {
 /// Closest hit with t in (tmin, tmax).
 LUCENT_HD inline bool gpu_bvh_closest(const GpuTriangleBvhView& bvh, float3 origin, float3 dir,
                                       float tmin, float tmax, GpuHit& hit) {
+    GpuBvhStack stack;
     GpuBvhTraversal tr;
-    tr.start(origin, dir, tmin, tmax);
+    tr.start(origin, dir, tmin, tmax, stack);
     GpuNoFilter none;
-    tr.run<kGpuClosest, false>(bvh, none);
+    tr.run<kGpuClosest, false>(bvh, none, stack);
     return tr.result(bvh, hit);
 }
 
 /// True when any triangle is hit with t in (tmin, tmax); stops at the first.
 LUCENT_HD inline bool gpu_bvh_occluded(const GpuTriangleBvhView& bvh, float3 origin, float3 dir,
                                        float tmin, float tmax) {
+    GpuBvhStack stack;
     GpuBvhTraversal tr;
-    tr.start(origin, dir, tmin, tmax);
+    tr.start(origin, dir, tmin, tmax, stack);
     GpuNoFilter none;
-    tr.run<kGpuAny, false>(bvh, none);
+    tr.run<kGpuAny, false>(bvh, none, stack);
     return tr.hit();
 }
 
@@ -306,9 +315,10 @@ LUCENT_HD inline bool gpu_bvh_occluded(const GpuTriangleBvhView& bvh, float3 ori
 template <class Filter>
 LUCENT_HD inline bool gpu_bvh_filtered(const GpuTriangleBvhView& bvh, float3 origin, float3 dir,
                                        float tmin, float tmax, GpuHit& hit, Filter&& filter) {
+    GpuBvhStack stack;
     GpuBvhTraversal tr;
-    tr.start(origin, dir, tmin, tmax);
-    tr.run<kGpuFiltered, false>(bvh, filter);
+    tr.start(origin, dir, tmin, tmax, stack);
+    tr.run<kGpuFiltered, false>(bvh, filter, stack);
     return tr.result(bvh, hit);
 }
 

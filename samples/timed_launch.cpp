@@ -1,0 +1,38 @@
+// Launch timing shared by the samples: the first launch (which compiles the scene, and on
+// the GPU the megakernel) apart from the steady state, measured as a median of repeats.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+#include "samples/sample.h"
+
+namespace lucent::samples {
+
+void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
+                  RenderResult& result) {
+    ctx.launch(entry, settings.width, settings.height);
+    result.report = ctx.last_launch();
+    result.stages.push_back({"compile + accel", result.report.compile_ms + result.report.accel_ms, ""});
+    if (result.report.jit_ms > 0)
+        result.stages.push_back({"megakernel JIT", result.report.jit_ms,
+                                 result.report.jit_cached ? "loaded from the kernel cache"
+                                                          : "cold NVRTC compile"});
+    if (settings.repeat <= 1) {
+        result.stages.push_back({"launch", result.report.launch_ms, ""});
+        return;
+    }
+    std::vector<double> ms;
+    for (unsigned i = 1; i < settings.repeat; ++i) {
+        ctx.launch(entry, settings.width, settings.height);
+        ms.push_back(ctx.last_launch().launch_ms);
+    }
+    std::sort(ms.begin(), ms.end());
+    const double median = ms[ms.size() / 2];
+    char note[160];
+    std::snprintf(note, sizeof note, "median of %zu (min %.3f, max %.3f): %.1f frames/s",
+                  ms.size(), ms.front(), ms.back(), 1000.0 / median);
+    result.stages.push_back({"launch", median, note});
+}
+
+}  // namespace lucent::samples

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Builds a self-contained bundle in .gpu-bundle/ for a GPU machine that has the NVIDIA
+# driver but not Debian's packages: the binaries, the Debian runtime libraries they load
+# (run through the bundled loader, so the machine's own glibc does not matter) and the
+# benchmark scenes. On that machine: `.gpu-bundle/run .gpu-bundle/bin/lucent ...`.
+# Embree is left out (the GPU benchmark compares against Lucent's CPU backend).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=.gpu-bundle
+build=build-gpu-bundle
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLUCENT_NATIVE=OFF \
+      -DCMAKE_CXX_FLAGS="-mavx2 -mfma -mf16c -mbmi -mbmi2 -mlzcnt -mpopcnt" \
+      -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON > /dev/null
+cmake --build "$build" -j"$(nproc)"
+rm -rf "$out"
+mkdir -p "$out/bin" "$out/lib"
+cp "$build/lucent" "$build"/tests/*_test "$out/bin/"
+for lib in $(ldd "$out"/bin/* | awk '/=>/ {print $3}' | sort -u); do cp -L "$lib" "$out/lib/"; done
+cp -L /lib64/ld-linux-x86-64.so.2 "$out/lib/"
+scenes=../shared/scenes
+if [ -d "$scenes" ]; then
+  tar czf "$out/scenes.tgz" -C "$scenes" sponza.obj sibenik.obj bunny.obj dragon.obj cameras.txt
+fi
+cat > "$out/run" <<'RUN'
+#!/bin/sh
+# Runs a bundled program with the bundled loader and libraries.
+here=$(cd "$(dirname "$0")" && pwd)
+exec "$here/lib/ld-linux-x86-64.so.2" --library-path "$here/lib" "$@"
+RUN
+chmod +x "$out/run"
+du -sh "$out"

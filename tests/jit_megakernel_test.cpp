@@ -1,0 +1,30 @@
+// The GPU path must never silently stop compiling: for every sample, generate the CUDA
+// megakernel of its scene and compile it with NVRTC for sm_90 (no GPU needed).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "samples/sample.h"
+
+namespace {
+
+TEST(jit, EverySampleMegakernelCompilesForSm90) {
+#if !LUCENT_HAVE_CUDA
+    GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
+#else
+    ::setenv("LUCENT_CACHE_DIR", "off", 1);  // a real NVRTC compile, not a cache hit
+    for (const lucent::samples::SampleInfo& sample : lucent::samples::all_samples()) {
+        lucent::samples::RenderSettings settings;
+        settings.width = 8;
+        settings.height = 8;
+        settings.backend = lucent::BackendKind::kCpu;
+        settings.jit_check_sm = 90;
+        lucent::samples::RenderResult result;
+        ASSERT_NO_THROW(result = sample.render(settings)) << sample.name;
+        EXPECT_GT(result.report.jit_ms, 0.0) << sample.name << ": no megakernel was compiled";
+        EXPECT_FALSE(result.report.jit_cached) << sample.name;
+    }
+#endif
+}
+
+}  // namespace
