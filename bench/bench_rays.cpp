@@ -188,10 +188,14 @@ struct EngineResult {
     double primary_sum_t = 0, diffuse_sum_t = 0;
 };
 
-/// Traces the three ray sets with closest(o, d, tmax, t&, prim&) and any(o, d, tmax).
+/// Traces the three ray sets with closest(o, d, tmax, t&, prim&) and any(o, d, tmax). The
+/// shadow and diffuse rays start at the primary hits in `secondary_from` when given (so a
+/// peer traces exactly the rays Lucent traced), else at this engine's own; the primary hits
+/// are returned in `primary_hits` when asked.
 template <class Closest, class Any>
 EngineResult run_engine(const RaySet& primary, const scene::ObjMesh& mesh, float3 light,
-                        unsigned threads, int repeat, Closest&& closest, Any&& any) {
+                        unsigned threads, int repeat, Closest&& closest, Any&& any,
+                        Hits* primary_hits = nullptr, const Hits* secondary_from = nullptr) {
     EngineResult res;
     Hits hits{std::vector<float>(primary.size()), std::vector<uint32_t>(primary.size())};
     auto trace_closest = [&](const RaySet& rays, Hits& out) {
@@ -208,7 +212,8 @@ EngineResult run_engine(const RaySet& primary, const scene::ObjMesh& mesh, float
         if (t >= 0.0f) ++res.primary_hits, res.primary_sum_t += t;
 
     RaySet shadow, diffuse;
-    secondary_rays(primary, hits, mesh, light, shadow, diffuse);
+    secondary_rays(primary, secondary_from ? *secondary_from : hits, mesh, light, shadow, diffuse);
+    if (primary_hits) *primary_hits = hits;
     std::vector<unsigned char> blocked(shadow.size());
     res.shadow = timed(shadow.size(), threads, repeat, [&](size_t i) {
         blocked[i] = any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
@@ -313,6 +318,7 @@ int run_bench_rays(const RaysOptions& options) {
     accel.build(mesh.positions, mesh.indices, {}, &stats);
 
     const RaySet primary = primary_rays(cam, options.width, options.height);
+    Hits lucent_hits;
     const EngineResult lucent = run_engine(
         primary, mesh, cam.light, threads, options.repeat,
         [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
@@ -322,7 +328,8 @@ int run_bench_rays(const RaysOptions& options) {
             prim = hit.prim;
             return true;
         },
-        [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); });
+        [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); },
+        &lucent_hits);
 
     const bool peer = options.peer && EmbreePeer::available();
     EngineResult embree;
@@ -335,7 +342,8 @@ int run_bench_rays(const RaysOptions& options) {
             [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
                 return e.intersect(o, d, 0.0f, tmax, t, prim);
             },
-            [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); });
+            [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); },
+            nullptr, &lucent_hits);  // the same shadow and diffuse rays as Lucent's
     }
     const std::string differences = peer ? checksum_differences(lucent, embree) : "";
 

@@ -193,8 +193,9 @@ TEST_F(ExceptionsTest, UserExceptionInAClosestHitReportsTheLaunchIndex) {
             EXPECT_EQ(logged[i].code, kCodeA) << "index " << i;
             EXPECT_EQ(logged[i].detail, 99u);
             EXPECT_EQ(logged[i].launch_index.x, i);
-            // CPU backend: the exception unwinds the ray generation program too.
-            EXPECT_EQ(finished[i], -7) << "index " << i;
+            // CPU backend: the exception unwinds the ray generation program too. A GPU
+            // cannot unwind: later traces return at once and the program runs to its end.
+            if (test_backend() == BackendKind::kCpu) EXPECT_EQ(finished[i], -7) << "index " << i;
         }
     }
     ASSERT_EQ(ctx.last_launch().exceptions.count(kCodeA), 1u);

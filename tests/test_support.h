@@ -31,6 +31,8 @@ inline ContextOptions test_context_options() {
     ContextOptions options;
     options.backend = test_backend();
     options.threads = 2;
+    // LUCENT_TEST_JIT_CHECK=90: also compile each test scene's CUDA megakernel (slow).
+    if (const char* sm = std::getenv("LUCENT_TEST_JIT_CHECK")) options.jit_check_sm = std::atoi(sm);
     return options;
 }
 

@@ -94,10 +94,11 @@ TEST(Whitted, MatchesGoldenImage) {
 TEST(Whitted, LaunchRaisesNoExceptions) {
     const RenderResult& result = golden_render();
     EXPECT_EQ(result.report.exception_count(), 0u) << result.report.summary();
-    ASSERT_EQ(result.stages.size(), 3u);
-    EXPECT_EQ(result.stages[0].name, "scene setup");
+    // The GPU adds a "megakernel JIT" stage between compile and launch.
+    ASSERT_GE(result.stages.size(), 3u);
+    EXPECT_EQ(result.stages.front().name, "scene setup");
     EXPECT_EQ(result.stages[1].name, "compile + accel");
-    EXPECT_EQ(result.stages[2].name, "launch");
+    EXPECT_EQ(result.stages.back().name, "launch");
 }
 
 TEST(Whitted, SkyIsExactlyTheMissColour) {

@@ -49,6 +49,7 @@ struct LaunchReport {
     bool recompiled = false;
     double jit_ms = 0;       // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
     bool jit_cached = false; // CUDA: the megakernel came from the disk cache
+    double kernel_ms = 0;    // CUDA: the megakernel alone (CUDA events), within launch_ms
     uint64_t exception_count() const;
     /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
     std::string summary() const;

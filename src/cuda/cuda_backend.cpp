@@ -35,6 +35,8 @@ public:
     }
     ~CudaBackend() override {
         m_scene.reset();
+        if (m_start) m_driver.cuEventDestroy(m_start);
+        if (m_stop) m_driver.cuEventDestroy(m_stop);
         if (m_module) m_driver.cuModuleUnload(m_module);
         m_driver.cuDevicePrimaryCtxRelease(m_device);
     }
@@ -63,9 +65,8 @@ public:
         p.launch_count = uint64_t(size.x) * size.y * size.z;
         m_counter.alloc(sizeof(unsigned long long));
         m_counter.fill(0);
-        std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
-        for (auto& s : slots) s = {0, 0, 0, ~0ull};
-        m_exceptions.upload(slots.data(), slots.size() * sizeof slots[0]);
+        m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
+        m_exceptions.fill(0);
         p.work_counter = const_cast<unsigned long long*>(m_counter.as<unsigned long long>());
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
         const unsigned threads = unsigned(m_grid) * kBlock;
@@ -74,15 +75,25 @@ public:
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
         check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
 
+        if (!m_start) {
+            check(m_driver.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
+            check(m_driver.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
+        }
+        check(m_driver.cuEventRecord(m_start, nullptr), "cuEventRecord");
         check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_grid), 1, 1, kBlock, 1, 1, 0, nullptr,
                                       nullptr, nullptr),
               "launch the megakernel");
+        check(m_driver.cuEventRecord(m_stop, nullptr), "cuEventRecord");
         check(m_driver.cuCtxSynchronize(), "run the megakernel");
+        float kernel_ms = 0;
+        m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
+        report.kernel_ms = kernel_ms;
 
+        std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
         m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
         for (const auto& s : slots) {
             if (s.code == 0) continue;
-            uint64_t linear = s.first_linear;
+            uint64_t linear = ~s.first_linear_inverted;
             uint3 first{unsigned(linear % size.x), unsigned(linear / size.x % size.y),
                         unsigned(linear / (uint64_t(size.x) * size.y))};
             report.exceptions[s.code] = {s.count, first};
@@ -137,6 +148,7 @@ private:
     const core::CompiledScene* m_last_scene = nullptr;
     uint64_t m_last_generation = 0;
     DeviceBuffer m_counter, m_exceptions, m_scratch;
+    CUevent m_start = nullptr, m_stop = nullptr;
 };
 
 }  // namespace

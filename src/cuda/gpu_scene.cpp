@@ -39,9 +39,12 @@ CUdeviceptr GpuScene::device_pointer(const std::shared_ptr<const Buffer>& shared
     if (found == m_buffers.end()) {
         // Used by the new compile: reuse the previous compile's copy when there is one.
         auto previous = m_previous_buffers.find(buffer);
-        found = m_buffers.emplace(buffer, previous != m_previous_buffers.end()
-                                              ? std::move(previous->second)
-                                              : BufferMirror{}).first;
+        if (previous != m_previous_buffers.end()) {
+            found = m_buffers.emplace(buffer, std::move(previous->second)).first;
+            m_previous_buffers.erase(previous);  // what is left there was dropped
+        } else {
+            found = m_buffers.emplace(buffer, BufferMirror{}).first;
+        }
     }
     BufferMirror& m = found->second;
     m.buffer = shared;
@@ -203,6 +206,10 @@ void GpuScene::update(const core::CompiledScene& scene) {
     put(m_materials, materials);
     put(m_record_blob, m_records);
     put(m_miss, miss);
+    std::vector<unsigned> signatures;
+    for (const RayTypeDesc& r : scene.ray_types)
+        signatures.push_back(unsigned(r.payload->size << 8 | r.payload->align));
+    put(m_payload_signatures, signatures);
 
     m_params = gpu::LaunchParams{};
     m_params.nodes = m_nodes.as<gpu::GpuNode>();
@@ -218,6 +225,8 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_params.records = m_record_blob.as<unsigned char>();
     m_params.miss = m_miss.as<gpu::ProgramRef>();
     m_params.ray_type_count = ray_types;
+    m_params.payload_signatures = m_payload_signatures.as<unsigned>();
+    m_params.node_count = unsigned(scene.nodes.size());
     m_params.max_depth = scene.max_depth;
     m_params.print_enabled = scene.print_enabled;
     m_params.print_index = scene.print_index;

@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 
 #include "cuda/embedded_sources.h"
 
@@ -46,6 +47,11 @@ void compile_megakernel(Megakernel& k, int sm) {
     for (const EmbeddedSource& s : embedded_sources())
         request.headers.emplace_back(std::string(s.name), std::string(s.text));
     request.options = {"--std=c++20", "-default-device", "--use_fast_math"};
+    // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
+    if (const char* extra = std::getenv("LUCENT_NVRTC_OPTIONS")) {
+        std::istringstream words(extra);
+        for (std::string w; words >> w;) request.options.push_back(w);
+    }
     request.sm = sm;
     k.binary = compile_cubin(request);
 }

@@ -22,8 +22,10 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
     for (const core::CompiledNode& n : scene.nodes) {
         shape.transforms |= n.kind == NodeKind::kTransform;
         shape.selectors |= n.kind == NodeKind::kSelector;
-        if (n.kind == NodeKind::kGeometryGroup && n.geometry)
+        if (n.kind == NodeKind::kGeometryGroup && n.geometry) {
             shape.generic_geometry |= !n.geometry->triangles_only;
+            shape.triangle_groups |= n.geometry->triangles_only;
+        }
     }
     size_t attributes = 16;
     for (const core::CompiledInstance& inst : scene.instances)
@@ -62,9 +64,9 @@ const char* kind_call(ProgramKind kind) {
         default: return nullptr;
     }
 }
-std::string format_call(const char* pattern, std::string_view name) {
+std::string format_call(const char* pattern, const ProgramDesc& desc) {
     std::string s(pattern);
-    s.replace(s.find("%s"), 2, name);
+    s.replace(s.find("%s"), 2, std::string(desc.scope) + std::string(desc.name));
     return s;
 }
 }  // namespace
@@ -75,6 +77,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_TRANSFORMS " << shape.transforms << "\n"
         << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
         << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
+        << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
         << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
         << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
         << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
@@ -105,7 +108,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         out << fn << " {\n    switch (id) {\n";
         const auto& list = table.programs(kind);
         for (size_t i = 0; i < list.size(); ++i)
-            out << "        case " << i << ": " << format_call(kind_call(kind), list[i]->name)
+            out << "        case " << i << ": " << format_call(kind_call(kind), *list[i])
                 << "; break;\n";
         out << "        default: break;\n    }\n";
         if (kind == ProgramKind::kVisit) out << "    return ~0u;\n";

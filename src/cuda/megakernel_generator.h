@@ -32,6 +32,7 @@ struct KernelShape {
     bool transforms = false;
     bool selectors = false;
     bool generic_geometry = false;  // custom primitives, or a group not made only of triangles
+    bool triangle_groups = false;   // some group is made only of triangles (GPU triangle BVH)
     bool exceptions = false;        // any exception enabled (else bounds checks are compiled out)
     bool print = false;
     unsigned max_depth = 1;

@@ -45,8 +45,9 @@ LUCENT_HD unsigned primitive_index();
 template <class Payload>
 LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 #if LUCENT_GPU_CODE
-    // The megakernel is generated for known payload types: no run-time tag needed.
-    detail::trace_erased(root, ray, &payload, nullptr);
+    // No type identity without RTTI on the GPU: size and alignment catch most mismatches.
+    detail::trace_erased(root, ray, &payload,
+                         reinterpret_cast<const void*>(sizeof(Payload) << 8 | alignof(Payload)));
 #else
     detail::trace_erased(root, ray, &payload, &detail::TypeTag<Payload>::id);
 #endif

@@ -34,6 +34,7 @@ struct ProgramDesc {
     const TypeInfo* attributes;  // intersection, attribute, closest hit, any hit
     const TypeInfo* signature;   // callables: R(Args...)
     void (*entry)();             // the thunk; its real type follows from `kind`
+    std::string_view scope;      // enclosing namespaces, "" or "ns::inner::"
 };
 
 // Thunk signatures per kind (records, payloads and attributes type-erased).
@@ -48,6 +49,17 @@ using AttributeFn = void (*)(const void* rec, unsigned prim, float2 barycentrics
 
 namespace detail {
 bool register_program(const ProgramDesc& desc);
+
+/// Sets desc.scope from the __PRETTY_FUNCTION__ of the descriptor function the macro
+/// defines beside the program ("... ns::lucent_program_desc_name()"), so code generated for
+/// the GPU can name the program as ::ns::name.
+inline ProgramDesc with_scope(ProgramDesc desc, std::string_view pretty) {
+    size_t at = pretty.find("lucent_program_desc_");
+    size_t begin = pretty.rfind(' ', at);
+    begin = begin == std::string_view::npos ? 0 : begin + 1;
+    desc.scope = at == std::string_view::npos ? std::string_view() : pretty.substr(begin, at - begin);
+    return desc;
+}
 
 template <class F>
 void (*erase_fn(F f))() {
@@ -70,7 +82,8 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 
 #define LUCENT_DECLARE_PROGRAM_(name, make)                                     \
     inline const ::lucent::ProgramDesc& lucent_program_desc_##name() {         \
-        static const ::lucent::ProgramDesc desc = make;                        \
+        static const ::lucent::ProgramDesc desc =                              \
+            ::lucent::detail::with_scope(make, __PRETTY_FUNCTION__);           \
         return desc;                                                           \
     }                                                                          \
     inline const bool lucent_program_registered_##name =                       \

@@ -68,11 +68,13 @@ struct GpuMaterialSlot {
 };
 
 constexpr unsigned kGpuExceptionSlots = 32;
+/// Zero-initialised: code 0 is a free slot; the first launch index is kept inverted so
+/// that atomicMax finds the smallest and 0 means none.
 struct GpuExceptionSlot {
-    int code;  // 0: free
+    int code;
     unsigned pad;
     unsigned long long count;
-    unsigned long long first_linear;
+    unsigned long long first_linear_inverted;
 };
 
 struct LaunchParams {
@@ -88,7 +90,9 @@ struct LaunchParams {
     const GpuMaterialSlot* materials;
     const unsigned char* records;
     const ProgramRef* miss;
+    const unsigned* payload_signatures;  // per ray type: sizeof(payload) << 8 | alignof(payload)
     unsigned ray_type_count;
+    unsigned node_count;
     unsigned max_depth;
     ProgramRef ray_generation;
     ProgramRef exception;

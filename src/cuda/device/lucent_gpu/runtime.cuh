@@ -14,6 +14,12 @@
 #ifndef LUCENT_GPU_GENERIC_GEOMETRY
 #define LUCENT_GPU_GENERIC_GEOMETRY 1  // custom primitives, or groups mixing kinds
 #endif
+#ifndef LUCENT_GPU_TRIANGLE_GROUPS
+#define LUCENT_GPU_TRIANGLE_GROUPS 1  // groups made only of triangles (GPU triangle BVH)
+#endif
+#ifndef LUCENT_GPU_MIN_BLOCKS
+#define LUCENT_GPU_MIN_BLOCKS 1  // __launch_bounds__ hint: blocks per SM to fit in registers
+#endif
 #ifndef LUCENT_GPU_SELECTORS
 #define LUCENT_GPU_SELECTORS 1
 #endif

@@ -119,6 +119,7 @@ __device__ inline void geometry_group(Frame& f, const GpuGeometryAccel& ga, floa
     f.object_ray.origin = origin;
     f.object_ray.direction = direction;
     const float tmin = f.world_ray.tmin;
+#if LUCENT_GPU_TRIANGLE_GROUPS
     if (ga.triangles_only) {
         GpuHit hit;
         if (!((ga.any_hit_mask >> f.ray_type) & 1u)) {
@@ -142,6 +143,7 @@ __device__ inline void geometry_group(Frame& f, const GpuGeometryAccel& ga, floa
                          });
         return;
     }
+#endif
 #if LUCENT_GPU_GENERIC_GEOMETRY
     WatertightRay wray = make_watertight_ray(origin, direction);
     auto visit = [&](unsigned ref) {
@@ -264,11 +266,20 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
     }
 }
 
-__device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload) {
+__device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
+                                       unsigned payload_signature) {
     ThreadState& s = self();
     if (s.exception_code) return;  // an exception ends the launch index's work
     if (ray.ray_type >= params.ray_type_count) {
         detail::raise_exception(kExceptionInvalidRayType, ray.ray_type);
+        return;
+    }
+    if (payload_signature != params.payload_signatures[ray.ray_type]) {
+        detail::raise_exception(kExceptionPayloadTypeMismatch, ray.ray_type);
+        return;
+    }
+    if (root.index >= params.node_count) {
+        detail::raise_exception(kExceptionInvalidHandle, root.index);
         return;
     }
     if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
@@ -336,7 +347,7 @@ __device__ inline void count_exception(int code, unsigned long long linear) {
         int seen = atomicCAS(&slot.code, 0, code);
         if (seen == 0 || seen == code) {
             atomicAdd(&slot.count, 1ull);
-            atomicMin(&slot.first_linear, linear);
+            atomicMax(&slot.first_linear_inverted, ~linear);  // max of ~x = min of x
             return;
         }
     }
@@ -346,8 +357,8 @@ __device__ inline void count_exception(int code, unsigned long long linear) {
 
 namespace lucent {
 namespace detail {
-LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void*) {
-    gpu::trace_ray(root, ray, payload);
+LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* signature) {
+    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)));
 }
 }  // namespace detail
 
@@ -370,7 +381,8 @@ LUCENT_HD bool report_intersection(unsigned material) {
 
 /// The megakernel: persistent threads take launch indices from a global counter, a warp's
 /// worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
-extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK) lucent_megakernel() {
+extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
+lucent_megakernel() {
     using namespace lucent;
     using namespace lucent::gpu;
     ThreadState& s = self();

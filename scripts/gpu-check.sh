@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
+# root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
+# Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
+# with steps: render tests sanitizer bench profile (default: all but profile).
+set -uo pipefail
+out=${OUT:-gpu-out}
+mkdir -p "$out"
+B=.gpu-bundle
+R="$B/run"
+steps=${*:-render tests sanitizer bench}
+# The test binaries look for tests/ and the scenes where the build machine had them.
+mkdir -p /work/shared/scenes
+[ -e /work/main ] || ln -s "$PWD" /work/main
+[ -f /work/shared/scenes/sponza.obj ] || tar xzf "$B/scenes.tgz" -C /work/shared/scenes
+export LUCENT_CACHE_DIR=/tmp/lucent-kernel-cache
+nvidia-smi -L
+
+for step in $steps; do
+case $step in
+render)
+    rm -rf "$LUCENT_CACHE_DIR"
+    echo "== whitted 1024x1024: cold JIT, then cached, 1 spp, median of 500 launches"
+    $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose
+    $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose --repeat 500
+    $R $B/bin/lucent render --sample whitted --backend cpu --size 1024x1024 --out "$out/whitted_cpu.png"
+    python3 - "$out/whitted_cpu.png" "$out/whitted_cuda.png" <<'PY'
+import sys
+import numpy as np
+from PIL import Image
+a = np.asarray(Image.open(sys.argv[1]).convert("RGB")).astype(int)
+b = np.asarray(Image.open(sys.argv[2]).convert("RGB")).astype(int)
+d = np.abs(a - b).max(axis=2)
+print(f"CPU vs GPU whitted: {(d > 10).sum()} of {d.size} pixels differ by more than 10/255 "
+      f"({100.0 * (d > 10).sum() / d.size:.3f} %), max difference {d.max()}/255")
+PY
+    ;;
+tests)
+    # Each test alone, so a crash is pinned on one test and the others still run.
+    for t in programs nodes variables exceptions validation whitted; do
+        echo "== ${t}_test on the GPU"
+        pass=0; fail=0
+        for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
+            if LUCENT_TEST_BACKEND=cuda $R $B/bin/${t}_test --gtest_filter="$name" > /tmp/one.log 2>&1; then
+                pass=$((pass + 1))
+            else
+                fail=$((fail + 1)); echo "-- FAILED $name (exit $?)"; grep -vE "^\[|^Running|^Note:|invoke.cuh|__forceinline__|^ +\^$|note #" /tmp/one.log | head -12
+            fi
+        done
+        echo "${t}_test on the GPU: $pass passed, $fail failed"
+    done
+    ;;
+sweep)
+    echo "== whitted 1024x1024 frame rate against the register budget (blocks per SM hint)"
+    for mb in 1 5 6 8; do
+        echo "-- LUCENT_GPU_MIN_BLOCKS=$mb"
+        LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=$mb" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
+    done
+    ;;
+sanitizer)
+    echo "== compute-sanitizer memcheck: whitted, bench rays"
+    compute-sanitizer --tool memcheck --print-limit 20 $R $B/bin/lucent render --sample whitted --backend cuda --size 256x256 --out "$out/whitted_sanitized.png" 2>&1 | tail -8
+    compute-sanitizer --tool memcheck --print-limit 20 $R $B/bin/lucent bench rays --backend cuda --size 640x360 --repeat 1 --scene /work/shared/scenes/sponza.obj 2>&1 | tail -12
+    ;;
+profile)
+    echo "== ncu: the Whitted megakernel at 1024x1024"
+    ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
+        --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
+        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
+    ;;
+bench)
+    for s in sponza sibenik bunny dragon; do
+        echo "== bench rays --backend cuda $s"
+        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj
+    done
+    $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj
+    ;;
+esac
+done
