@@ -101,7 +101,8 @@ struct CompiledScene {
     std::vector<CompiledProgram> miss;  // per ray type
     std::vector<CompiledNode> nodes;
     std::vector<CompiledInstance> instances;
-    std::vector<std::shared_ptr<PackedRecord>> callable_records;  // Callable::record targets
+    std::vector<CompiledProgram> callables;  // bound through variables; their records are the
+                                             // targets of Callable::record
     unsigned max_depth = 8;
     bool print_enabled = false;
     int3 print_index{-1, -1, -1};

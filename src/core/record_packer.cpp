@@ -165,11 +165,14 @@ std::shared_ptr<PackedRecord> SceneCompiler::pack_callable(const std::shared_ptr
     auto record = std::make_shared<PackedRecord>();
     record->resize(program->desc().record->size);  // its address is final from here on
     m_callables[program.get()] = record;
-    m_scene->callable_records.push_back(record);  // the scene keeps the record alive
+    const size_t index = m_scene->callables.size();
+    m_scene->callables.emplace_back();  // the scene keeps the record alive
     ScopeChain chain;
     chain.then(m_state.context);
     CompiledProgram packed = pack(program, chain, "a variable (" + where + ")");
     std::memcpy(record->data(), packed.record->data(), record->size());
+    packed.record = record;
+    m_scene->callables[index] = std::move(packed);
     return record;
 }
 

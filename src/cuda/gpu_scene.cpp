@@ -80,22 +80,42 @@ void GpuScene::patch_record(unsigned char* bytes, const core::CompiledProgram& p
                 std::memcpy(at, &view, sizeof view);
                 break;
             }
-            case FieldKind::kCallable:
-                throw Error(program.label + ": callable programs are not supported by the CUDA "
-                            "backend yet; use --backend cpu for this scene");
+            case FieldKind::kCallable: {
+                struct Erased {
+                    void* fn;
+                    const void* record;
+                } c;
+                std::memcpy(&c, at, sizeof c);
+                auto found = m_callable_slots.find(c.record);
+                if (found == m_callable_slots.end())
+                    throw Error(program.label + ": a callable's record is missing from the scene");
+                // On the GPU: {dispatch id, record offset in the blob}.
+                c.fn = reinterpret_cast<void*>(uintptr_t(found->second.id));
+                c.record = reinterpret_cast<const void*>(uintptr_t(found->second.record));
+                std::memcpy(at, &c, sizeof c);
+                break;
+            }
             default: break;
         }
     }
 }
 
+unsigned GpuScene::reserve_record(const core::CompiledProgram& program) {
+    size_t offset = (m_records.size() + 15) / 16 * 16;
+    m_records.resize(offset + std::max<size_t>(program.desc->record->size, 16));
+    return unsigned(offset);
+}
+
+void GpuScene::write_record(unsigned offset, const core::CompiledProgram& program) {
+    std::memcpy(m_records.data() + offset, program.rec(), program.desc->record->size);
+    patch_record(m_records.data() + offset, program);
+}
+
 gpu::ProgramRef GpuScene::add_program(const core::CompiledProgram& program) {
     if (!program) return {-1, 0};
-    size_t offset = (m_records.size() + 15) / 16 * 16;
-    size_t size = program.desc->record->size;
-    m_records.resize(offset + std::max<size_t>(size, 16));
-    std::memcpy(m_records.data() + offset, program.rec(), size);
-    patch_record(m_records.data() + offset, program);
-    return {m_programs.id(program), unsigned(offset)};
+    unsigned offset = reserve_record(program);
+    write_record(offset, program);
+    return {m_programs.id(program), offset};
 }
 
 void GpuScene::update(const core::CompiledScene& scene) {
@@ -105,6 +125,13 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_programs = build_program_table(scene);
     m_records.clear();
     m_entries.clear();
+    // Callables first: records that call them need their ids and record offsets, and they
+    // may call each other, so every slot is reserved before any record is written.
+    m_callable_slots.clear();
+    for (const core::CompiledProgram& c : scene.callables)
+        m_callable_slots[c.rec()] = {m_programs.id(c), reserve_record(c)};
+    for (const core::CompiledProgram& c : scene.callables)
+        write_record(m_callable_slots[c.rec()].record, c);
     for (const core::CompiledEntry& e : scene.entries)
         m_entries.emplace_back(add_program(e.ray_generation), add_program(e.exception));
     std::vector<gpu::ProgramRef> miss;

@@ -48,11 +48,14 @@ private:
 
     CUdeviceptr device_pointer(const std::shared_ptr<const Buffer>& buffer);
     gpu::ProgramRef add_program(const core::CompiledProgram& program);
+    unsigned reserve_record(const core::CompiledProgram& program);
+    void write_record(unsigned offset, const core::CompiledProgram& program);
     void fetch_mirror(BufferMirror& mirror);
     void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
 
     ProgramTable m_programs;
     std::vector<unsigned char> m_records;
+    std::unordered_map<const void*, gpu::ProgramRef> m_callable_slots;  // by host record
     std::vector<std::pair<gpu::ProgramRef, gpu::ProgramRef>> m_entries;
     std::unordered_map<const Buffer*, BufferMirror> m_buffers, m_previous_buffers;
     std::unordered_map<const core::GeometryAccel*, GeometryMirror> m_geometry;

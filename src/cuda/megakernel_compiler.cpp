@@ -25,6 +25,7 @@ ProgramTable build_program_table(const core::CompiledScene& scene) {
             }
     }
     for (const core::CompiledNode& n : scene.nodes) table.id(n.visit);
+    for (const core::CompiledProgram& c : scene.callables) table.id(c);
     return table;
 }
 

@@ -69,6 +69,61 @@ std::string format_call(const char* pattern, const ProgramDesc& desc) {
     s.replace(s.find("%s"), 2, std::string(desc.scope) + std::string(desc.name));
     return s;
 }
+/// Splits a function type's name, "float3(const float3&, int)", into its result type and
+/// parameter types (commas inside <>, () or [] do not split).
+bool split_signature(std::string_view sig, std::string& result, std::vector<std::string>& params) {
+    size_t open = sig.find('(');
+    if (open == std::string_view::npos || sig.empty() || sig.back() != ')') return false;
+    result = std::string(sig.substr(0, open));
+    while (!result.empty() && result.back() == ' ') result.pop_back();
+    std::string_view inside = sig.substr(open + 1, sig.size() - open - 2);
+    int depth = 0;
+    std::string current;
+    for (char c : inside) {
+        if (c == '<' || c == '(' || c == '[') ++depth;
+        if (c == '>' || c == ')' || c == ']') --depth;
+        if (c == ',' && depth == 0) {
+            params.push_back(current);
+            current.clear();
+        } else if (!(current.empty() && c == ' ')) {
+            current += c;
+        }
+    }
+    if (!current.empty() && current != "void") params.push_back(current);
+    return true;
+}
+
+/// One function per callable signature, found by Callable::operator() through ADL on
+/// CallableTag<Signature>: a switch over the callables of that signature.
+void generate_callables(std::ostringstream& out, const std::vector<const ProgramDesc*>& list) {
+    std::map<std::string_view, std::vector<size_t>> by_signature;
+    for (size_t i = 0; i < list.size(); ++i) by_signature[list[i]->signature->name].push_back(i);
+    out << "namespace lucent::detail {\n";
+    for (const auto& [sig, ids] : by_signature) {
+        std::string result;
+        std::vector<std::string> params;
+        if (!split_signature(sig, result, params))
+            throw Error("callable program '" + std::string(list[ids[0]]->name) +
+                        "' has a signature the CUDA backend cannot spell: " + std::string(sig));
+        out << "__device__ " << result << " lucent_gpu_call(CallableTag<" << sig
+            << ">, unsigned id, unsigned record";
+        std::string args;
+        for (size_t a = 0; a < params.size(); ++a) {
+            out << ", " << params[a] << " a" << a;
+            args += ", a" + std::to_string(a);
+        }
+        out << ") {\n    const void* rec = ::lucent::gpu::params.records + record;\n"
+            << "    switch (id) {\n";
+        for (size_t i : ids)
+            out << "        case " << i << ": return ::lucent::gpu::invoke_callable(&::"
+                << list[i]->scope << list[i]->name << ", rec" << args << ");\n";
+        out << "        default: break;\n    }\n";
+        if (result != "void") out << "    return " << result << "{};\n";
+        out << "}\n";
+    }
+    out << "}  // namespace lucent::detail\n";
+}
+
 }  // namespace
 
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape) {
@@ -114,7 +169,9 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         if (kind == ProgramKind::kVisit) out << "    return ~0u;\n";
         out << "}\n";
     }
-    out << "}  // namespace lucent::gpu\n\n#include \"lucent_gpu/trace.cuh\"\n";
+    out << "}  // namespace lucent::gpu\n\n";
+    generate_callables(out, table.programs(ProgramKind::kCallable));
+    out << "\n#include \"lucent_gpu/trace.cuh\"\n";
     return out.str();
 }
 

@@ -126,11 +126,25 @@ struct TextureView {
 /// On the CPU it is a function pointer and the program's packed record.
 template <class Signature>
 struct Callable;
+namespace detail {
+template <class Signature>
+struct CallableTag {};  // selects the generated GPU dispatch of one signature (found by ADL)
+}  // namespace detail
 template <class R, class... Args>
 struct Callable<R(Args...)> {
+    // CPU: the program's thunk and its record. GPU: the program's dispatch id and its
+    // record's offset in the megakernel's record blob.
     R (*fn)(const void* record, Args...);
     const void* record;
-    LUCENT_HD R operator()(Args... args) const { return fn(record, args...); }
+    LUCENT_HD R operator()(Args... args) const {
+#if LUCENT_GPU_CODE
+        return lucent_gpu_call(detail::CallableTag<R(Args...)>{},
+                               unsigned(reinterpret_cast<unsigned long long>(fn)),
+                               unsigned(reinterpret_cast<unsigned long long>(record)), args...);
+#else
+        return fn(record, args...);
+#endif
+    }
 };
 
 }  // namespace lucent

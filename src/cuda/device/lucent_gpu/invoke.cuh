@@ -40,4 +40,9 @@ __device__ __forceinline__ void invoke(void (*f)(const R&, unsigned, float2, A&)
     f(*static_cast<const R*>(rec), prim, bary, *static_cast<A*>(attr));
 }
 
+template <class R, class Rec, class... P, class... A>
+__device__ __forceinline__ R invoke_callable(R (*f)(const Rec&, P...), const void* rec, A... a) {
+    return f(*static_cast<const Rec*>(rec), a...);
+}
+
 }  // namespace lucent::gpu
