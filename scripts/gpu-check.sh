@@ -37,7 +37,7 @@ PY
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs nodes variables exceptions validation whitted; do
+    for t in programs nodes variables exceptions validation whitted backend; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
