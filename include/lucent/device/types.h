@@ -129,6 +129,14 @@ struct Callable;
 namespace detail {
 template <class Signature>
 struct CallableTag {};  // selects the generated GPU dispatch of one signature (found by ADL)
+#if LUCENT_GPU_CODE
+/// Chosen only when the scene binds no callable of this signature (the megakernel then has
+/// no dispatch for it): a value-initialised result.
+template <class R, class... Args, class... A>
+__device__ R lucent_gpu_call(CallableTag<R(Args...)>, unsigned, unsigned, A...) {
+    return R();
+}
+#endif
 }  // namespace detail
 template <class R, class... Args>
 struct Callable<R(Args...)> {

@@ -119,6 +119,7 @@ __device__ inline void geometry_group(Frame& f, const GpuGeometryAccel& ga, floa
     f.object_ray.origin = origin;
     f.object_ray.direction = direction;
     const float tmin = f.world_ray.tmin;
+    (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
     if (ga.triangles_only) {
         GpuHit hit;
