@@ -69,27 +69,13 @@ profile)
         $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
     ;;
 hotspots)
-    echo "== ncu: source lines of the Whitted megakernel with the most stall samples"
+    echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"
     LUCENT_NVRTC_OPTIONS="-lineinfo" ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
-        --section SourceCounters --section WarpStateStats --page source --print-source cuda --csv \
-        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png > /tmp/source.csv 2>&1
-    python3 - /tmp/source.csv <<'PY'
-import csv, sys
-rows = [r for r in csv.reader(open(sys.argv[1], errors="replace")) if len(r) > 5]
-head = next((i for i, r in enumerate(rows) if any("Warp Stall Sampling (All" in c for c in r)), None)
-if head is None:
-    print("\n".join(",".join(r)[:200] for r in rows[:30])); sys.exit()
-cols = rows[head]
-k = next(i for i, c in enumerate(cols) if c.startswith("Warp Stall Sampling (All"))
-data = []
-for r in rows[head + 1:]:
-    try: data.append((float(r[k].replace(",", "")), r))
-    except (ValueError, IndexError): pass
-total = sum(v for v, _ in data) or 1
-print("columns:", cols[:4])
-for v, r in sorted(data, key=lambda x: -x[0])[:40]:
-    print(f"{100 * v / total:5.1f}%  " + " | ".join(c[:90] for c in r[:3]))
-PY
+        --section SourceCounters --section WarpStateStats -f -o /tmp/whitted \
+        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | tail -3
+    ncu -i /tmp/whitted.ncu-rep --page source --print-source cuda --csv > "$out/source.csv" 2> "$out/source.err"
+    ncu -i /tmp/whitted.ncu-rep --page source --print-source sass --csv > "$out/sass.csv" 2>> "$out/source.err"
+    ls -la "$out"; head -c 600 "$out/source.err"
     ;;
 bench)
     for s in sponza sibenik bunny dragon; do

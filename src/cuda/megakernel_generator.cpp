@@ -20,6 +20,7 @@ int ProgramTable::id(const core::CompiledProgram& program) {
 KernelShape kernel_shape(const core::CompiledScene& scene) {
     KernelShape shape;
     for (const core::CompiledNode& n : scene.nodes) {
+        shape.groups |= n.kind == NodeKind::kGroup;
         shape.transforms |= n.kind == NodeKind::kTransform;
         shape.selectors |= n.kind == NodeKind::kSelector;
         if (n.kind == NodeKind::kGeometryGroup && n.geometry) {
@@ -129,6 +130,7 @@ void generate_callables(std::ostringstream& out, const std::vector<const Program
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape) {
     std::ostringstream out;
     out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
+        << "#define LUCENT_GPU_GROUPS " << shape.groups << "\n"
         << "#define LUCENT_GPU_TRANSFORMS " << shape.transforms << "\n"
         << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
         << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"

@@ -29,6 +29,7 @@ private:
 
 /// What the generated kernel is specialised on.
 struct KernelShape {
+    bool groups = false;            // Group nodes (else every root is a GeometryGroup, or nested)
     bool transforms = false;
     bool selectors = false;
     bool generic_geometry = false;  // custom primitives, or a group not made only of triangles

@@ -8,6 +8,9 @@
 #include "lucent/device.h"
 #include "lucent_gpu/launch_params.cuh"
 
+#ifndef LUCENT_GPU_GROUPS
+#define LUCENT_GPU_GROUPS 1
+#endif
 #ifndef LUCENT_GPU_TRANSFORMS
 #define LUCENT_GPU_TRANSFORMS 1
 #endif
