@@ -28,9 +28,7 @@ bool report_candidate(ThreadState& ts, unsigned material);
 using cpu::ProgramContext;
 using cpu::TraceFrame;
 
-namespace {
-/// The transform in effect for the running program: the committed hit's in closest hit,
-/// the traversal position's in intersection, any-hit and visit programs, none elsewhere.
+namespace detail {
 bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) {
     TraceFrame* f = cpu::thread_state().current();
     if (!f) return false;
@@ -45,9 +43,7 @@ bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) 
     to_object = &f->to_object;
     return true;
 }
-}  // namespace
 
-namespace detail {
 void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag) {
     cpu::trace(cpu::thread_state(), root, ray, payload, payload_tag);
 }
@@ -115,31 +111,6 @@ void ignore_intersection() {
 void terminate_ray() {
     TraceFrame* f = cpu::thread_state().current();
     if (f && f->context == ProgramContext::kAnyHit) f->terminate_requested = true;
-}
-
-float3 object_to_world_point(float3 p) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_point(*w, p) : p;
-}
-float3 object_to_world_vector(float3 v) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_vector(*w, v) : v;
-}
-float3 object_to_world_normal(float3 n) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_normal_by_inverse(*o, n) : n;
-}
-float3 world_to_object_point(float3 p) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_point(*o, p) : p;
-}
-float3 world_to_object_vector(float3 v) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_vector(*o, v) : v;
-}
-float3 world_to_object_normal(float3 n) {
-    const Matrix4x3 *w, *o;
-    return current_transform(w, o) ? transform_normal_by_inverse(*w, n) : n;
 }
 
 }  // namespace lucent

@@ -64,13 +64,38 @@ LUCENT_HD void ignore_intersection();
 /// In an any-hit program: accept this intersection and stop traversal of this ray.
 LUCENT_HD void terminate_ray();
 
+namespace detail {
+/// The transform in effect for the running program (the committed hit's in closest hit,
+/// the traversal position's in intersection, any-hit, attribute and visit programs); false
+/// when there is none. Each backend implements it.
+LUCENT_HD bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object);
+}  // namespace detail
+
 /// Object/world transforms of the current hit or traversal position.
-LUCENT_HD float3 object_to_world_point(float3 p);
-LUCENT_HD float3 object_to_world_vector(float3 v);
-LUCENT_HD float3 object_to_world_normal(float3 n);
-LUCENT_HD float3 world_to_object_point(float3 p);
-LUCENT_HD float3 world_to_object_vector(float3 v);
-LUCENT_HD float3 world_to_object_normal(float3 n);
+LUCENT_HD inline float3 object_to_world_point(float3 p) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_point(*w, p) : p;
+}
+LUCENT_HD inline float3 object_to_world_vector(float3 v) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_vector(*w, v) : v;
+}
+LUCENT_HD inline float3 object_to_world_normal(float3 n) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_normal_by_inverse(*o, n) : n;
+}
+LUCENT_HD inline float3 world_to_object_point(float3 p) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_point(*o, p) : p;
+}
+LUCENT_HD inline float3 world_to_object_vector(float3 v) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_vector(*o, v) : v;
+}
+LUCENT_HD inline float3 world_to_object_normal(float3 n) {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? transform_normal_by_inverse(*w, n) : n;
+}
 
 /// Raise a user exception: code must be >= kUserExceptionBase. Ends this launch index
 /// and calls the entry point's exception program.

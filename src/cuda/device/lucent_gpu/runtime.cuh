@@ -173,50 +173,27 @@ LUCENT_HD bool potential_intersection(float t) {
 LUCENT_HD void ignore_intersection() { gpu::self().frame->ignore_requested = true; }
 LUCENT_HD void terminate_ray() { gpu::self().frame->terminate_requested = true; }
 
-namespace gpu {
-__device__ __forceinline__ bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) {
+namespace detail {
+LUCENT_HD bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) {
 #if LUCENT_GPU_TRANSFORMS
-    Frame* f = self().frame;
+    gpu::Frame* f = gpu::self().frame;
     if (!f) return false;
-    if (f->context == kCtxClosestHit) {
+    if (f->context == gpu::kCtxClosestHit) {
         if (!f->hit_transformed) return false;
         to_world = &f->hit_to_world;
         to_object = &f->hit_to_object;
         return true;
     }
-    if (f->context == kCtxMiss || !f->transformed) return false;
+    if (f->context == gpu::kCtxMiss || !f->transformed) return false;
     to_world = &f->to_world;
     to_object = &f->to_object;
     return true;
 #else
+    (void)to_world;
+    (void)to_object;
     return false;
 #endif
 }
-}  // namespace gpu
-
-LUCENT_HD float3 object_to_world_point(float3 p) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_point(*w, p) : p;
-}
-LUCENT_HD float3 object_to_world_vector(float3 v) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_vector(*w, v) : v;
-}
-LUCENT_HD float3 object_to_world_normal(float3 n) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_normal_by_inverse(*o, n) : n;
-}
-LUCENT_HD float3 world_to_object_point(float3 p) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_point(*o, p) : p;
-}
-LUCENT_HD float3 world_to_object_vector(float3 v) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_vector(*o, v) : v;
-}
-LUCENT_HD float3 world_to_object_normal(float3 n) {
-    const Matrix4x3 *w, *o;
-    return gpu::current_transform(w, o) ? transform_normal_by_inverse(*w, n) : n;
-}
+}  // namespace detail
 
 }  // namespace lucent

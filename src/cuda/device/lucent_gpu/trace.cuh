@@ -101,6 +101,16 @@ __device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, uns
     return true;
 }
 
+/// Slab test of a binary BVH node against the ray interval [tmin, tmax]; the far distance
+/// gets 2 ulp of slack so boxes of zero thickness are kept (as the CPU traversal does).
+__device__ __forceinline__ bool box_overlaps(const GpuBvhNode& n, float3 origin, float3 inv,
+                                             float tmin, float tmax) {
+    float3 t0 = (n.lo - origin) * inv, t1 = (n.hi - origin) * inv;
+    float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), tmin));
+    float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), tmax));
+    return tn <= tf * 1.00000024f;
+}
+
 /// The instance (position k in the accel) owning global primitive `ref`.
 __device__ inline unsigned locate(const GpuGeometryAccel& ga, unsigned ref) {
     unsigned lo = 0, hi = ga.instance_count;
@@ -187,10 +197,7 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     stack[top++] = 0;
     while (top > 0) {
         const GpuBvhNode n = nodes[stack[--top]];
-        float3 t0 = (n.lo - origin) * inv, t1 = (n.hi - origin) * inv;
-        float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), tmin));
-        float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), f.closest));
-        if (tn > tf * 1.00000024f) continue;
+        if (!box_overlaps(n, origin, inv, tmin, f.closest)) continue;
         if (n.count > 0) {
             for (unsigned i = 0; i < n.count; ++i)
                 if (visit(order[n.first + i])) return;
@@ -221,10 +228,7 @@ __device__ inline void group(Frame& f, const GpuNode& n, float3 origin, float3 d
     stack[top++] = 0;
     while (top > 0) {
         const GpuBvhNode b = nodes[stack[--top]];
-        float3 t0 = (b.lo - origin) * inv, t1 = (b.hi - origin) * inv;
-        float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), f.world_ray.tmin));
-        float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), f.closest));
-        if (tn > tf * 1.00000024f) continue;
+        if (!box_overlaps(b, origin, inv, f.world_ray.tmin, f.closest)) continue;
         if (b.count > 0) {
             for (unsigned i = 0; i < b.count; ++i) {
                 traverse_node(f, params.children[n.first + order[b.first + i]], origin, direction);
