@@ -45,7 +45,8 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     r->add_option("--fov", rays.fov, "Vertical field of view in degrees, (0, 180)")
         ->type_name("DEG");
     r->add_option("--light", rays.light, "Point light for shadow rays x,y,z")->type_name("X,Y,Z");
-    r->add_option("--size", rays.size, "Image size (default 1024x768; 3840x2160 with --backend cuda)")
+    r->add_option("--size", rays.size,
+                  "Image size (default 1024x768; 3840x2160 with --backend cuda)")
         ->type_name("WxH");
     r->add_option("--repeat", rays.repeat, "Timed repeats (median reported)")
         ->type_name("N")
@@ -98,8 +99,8 @@ int run_bench_rays_command(const BenchRaysArgs& args) {
     options.scene = args.scene;
     options.backend = bench_backend(args.backend);
     const Size size = parse_size(
-        "--size", !args.size.empty() ? args.size
-                                     : (options.backend == "cuda" ? "3840x2160" : "1024x768"));
+        "--size",
+        !args.size.empty() ? args.size : (options.backend == "cuda" ? "3840x2160" : "1024x768"));
     options.width = size.width;
     options.height = size.height;
     options.repeat = args.repeat;

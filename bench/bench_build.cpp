@@ -41,8 +41,9 @@ int run_bench_build(const BuildBenchOptions& options) {
         in.json = options.json;
         return cuda::run_bench_build_cuda(in);
 #else
-        throw Error("--backend cuda: this lucent was built without the CUDA backend (no CUDA "
-                    "toolkit at configure time); run with --backend cpu");
+        throw Error(
+            "--backend cuda: this lucent was built without the CUDA backend (no CUDA "
+            "toolkit at configure time); run with --backend cpu");
 #endif
     }
 

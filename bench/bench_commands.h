@@ -8,16 +8,17 @@
 namespace lucent::bench {
 
 struct RaysOptions {
-    std::string scene;          // an OBJ file
-    bool has_camera = false;    // eye/look/up/fov/light given; else read from cameras.txt beside the scene
+    std::string scene;  // an OBJ file
+    bool has_camera =
+        false;  // eye/look/up/fov/light given; else read from cameras.txt beside the scene
     float3 eye{0, 0, 0}, look{0, 0, -1}, up{0, 1, 0};
     float fov = 60;
     float3 light{0, 0, 0};
     unsigned width = 1024, height = 768;
-    int repeat = 5;             // timed repeats (median reported), after one warm-up
-    unsigned threads = 0;       // 0 = all cores
-    bool peer = true;           // run Embree on the same rays when built with it
-    bool json = false;          // machine-readable output
+    int repeat = 5;               // timed repeats (median reported), after one warm-up
+    unsigned threads = 0;         // 0 = all cores
+    bool peer = true;             // run Embree on the same rays when built with it
+    bool json = false;            // machine-readable output
     std::string backend = "cpu";  // "cpu", or "cuda" (src/cuda/bench_rays_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,

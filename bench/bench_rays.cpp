@@ -308,8 +308,9 @@ int run_bench_rays(const RaysOptions& options) {
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
         return cuda::run_bench_rays_cuda(in);
 #else
-        throw Error("--backend cuda: this lucent was built without the CUDA backend (no CUDA "
-                    "toolkit at configure time); run with --backend cpu");
+        throw Error(
+            "--backend cuda: this lucent was built without the CUDA backend (no CUDA "
+            "toolkit at configure time); run with --backend cpu");
 #endif
     }
 
@@ -342,8 +343,8 @@ int run_bench_rays(const RaysOptions& options) {
             [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
                 return e.intersect(o, d, 0.0f, tmax, t, prim);
             },
-            [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); },
-            nullptr, &lucent_hits);  // the same shadow and diffuse rays as Lucent's
+            [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); }, nullptr,
+            &lucent_hits);  // the same shadow and diffuse rays as Lucent's
     }
     const std::string differences = peer ? checksum_differences(lucent, embree) : "";
 

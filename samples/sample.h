@@ -25,11 +25,13 @@ struct RenderSettings {
     std::string scene;                        // built-in scene name or file; empty = default
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
     bool verbose = false;
-    int jit_check_sm = 0;                     // --jit-check: also compile the CUDA megakernel
-    unsigned repeat = 1;                      // --repeat: launches timed after the first
+    int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel
+    unsigned repeat = 1;   // --repeat: launches timed after the first
 
     /// The Context options these settings ask for.
-    ContextOptions context_options() const { return ContextOptions{backend, threads, jit_check_sm}; }
+    ContextOptions context_options() const {
+        return ContextOptions{backend, threads, jit_check_sm};
+    }
 };
 
 struct StageTiming {
@@ -68,8 +70,8 @@ const SampleInfo& find_sample(const std::string& name);
 /// the value and the accepted range when it does not parse or is out of [lo, hi].
 float get_float_option(const RenderSettings& s, const SampleInfo& info, const std::string& name,
                        float lo, float hi);
-int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name,
-                   int lo, int hi);
+int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name, int lo,
+                   int hi);
 /// Error naming any --set that the sample does not have, with the list it does have.
 void check_options(const RenderSettings& s, const SampleInfo& info);
 

@@ -13,11 +13,12 @@ void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
                   RenderResult& result) {
     ctx.launch(entry, settings.width, settings.height);
     result.report = ctx.last_launch();
-    result.stages.push_back({"compile + accel", result.report.compile_ms + result.report.accel_ms, ""});
+    result.stages.push_back(
+        {"compile + accel", result.report.compile_ms + result.report.accel_ms, ""});
     if (result.report.jit_ms > 0)
-        result.stages.push_back({"megakernel JIT", result.report.jit_ms,
-                                 result.report.jit_cached ? "loaded from the kernel cache"
-                                                          : "cold NVRTC compile"});
+        result.stages.push_back(
+            {"megakernel JIT", result.report.jit_ms,
+             result.report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
     if (settings.repeat <= 1) {
         result.stages.push_back({"launch", result.report.launch_ms, ""});
         return;
@@ -35,7 +36,8 @@ void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
     int n = std::snprintf(note, sizeof note, "median of %zu (min %.3f, max %.3f): %.1f frames/s",
                           ms.size(), ms.front(), ms.back(), 1000.0 / median);
     if (kernel.back() > 0)
-        std::snprintf(note + n, sizeof note - size_t(n), "; kernel alone %.3f ms", kernel[kernel.size() / 2]);
+        std::snprintf(note + n, sizeof note - size_t(n), "; kernel alone %.3f ms",
+                      kernel[kernel.size() / 2]);
     result.stages.push_back({"launch", median, note});
 }
 

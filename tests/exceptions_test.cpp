@@ -11,7 +11,7 @@ using testing::HasSubstr;
 constexpr unsigned kNotRaised = 0;  // ExceptionInfo::code of a slot no exception wrote
 
 class ExceptionsTest : public testing::Test {
-protected:
+  protected:
     ExceptionsTest() : ctx(test_context_options()) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<TestPayload>(0, "radiance");
@@ -31,7 +31,8 @@ protected:
     void recursion_scene(int wanted_depth) {
         auto material = ctx.create_material();
         material->set_closest_hit(0, program(ctx, LUCENT_PROGRAM(et_recurse)));
-        auto top = make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, square_at(1)), material)});
+        auto top = make_geometry_group(
+            ctx, {make_instance(ctx, make_triangles(ctx, square_at(1)), material)});
         ctx["top"] = top;
         ctx["wanted_depth"] = wanted_depth;
         ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_trace_depth)));
@@ -179,7 +180,8 @@ TEST_F(ExceptionsTest, UserExceptionInAClosestHitReportsTheLaunchIndex) {
     ctx.set_exception_enabled(kAllExceptions, true);
     auto material = ctx.create_material();
     material->set_closest_hit(0, program(ctx, LUCENT_PROGRAM(et_throw_in_hit)));
-    ctx["top"] = make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, square_at(1)), material)});
+    ctx["top"] =
+        make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, square_at(1)), material)});
     ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_trace_depth)));
     auto depths = depth_buffer(6);
     auto infos = exception_log(6);
@@ -205,13 +207,14 @@ TEST_F(ExceptionsTest, UserExceptionInAClosestHitReportsTheLaunchIndex) {
 }
 
 class BadTraceTest : public ExceptionsTest {
-protected:
+  protected:
     /// Runs et_bad_trace in `mode` over 3 indices; returns the report.
     const LaunchReport& run(int mode) {
         ctx.set_exception_enabled(kAllExceptions, true);
         ctx["top"] = make_geometry_group(
-            ctx, {make_instance(ctx, make_triangles(ctx, square_at(1)),
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
+            ctx, {make_instance(
+                     ctx, make_triangles(ctx, square_at(1)),
+                     make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
         ctx["mode"] = mode;
         ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_bad_trace)));
         infos = exception_log(3);
@@ -246,8 +249,9 @@ TEST_F(ExceptionsTest, ReportedMaterialIndexBeyondTheInstanceRaisesMaterialIndex
     auto geometry = make_spheres(ctx, {make_float4(0.3f, 0.1f, 5, 1)});
     geometry->set_intersection_program(program(ctx, LUCENT_PROGRAM(et_sphere_bad_material)));
     ctx["top"] = make_geometry_group(
-        ctx, {make_instance(ctx, geometry,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+        ctx,
+        {make_instance(ctx, geometry,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
     ctx["wanted_depth"] = 1;
     ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_trace_depth)));
     depth_buffer(2);
@@ -286,7 +290,8 @@ TEST_F(ExceptionsTest, ExceptionProgramDoesNotRunForADisabledCode) {
     ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_throw_pattern)));
     auto infos = exception_log(101);
     ctx.launch(0, 101);
-    for (const ExceptionInfo& e : read_buffer<ExceptionInfo>(*infos)) EXPECT_EQ(e.code, int(kNotRaised));
+    for (const ExceptionInfo& e : read_buffer<ExceptionInfo>(*infos))
+        EXPECT_EQ(e.code, int(kNotRaised));
 }
 
 TEST_F(ExceptionsTest, OutOfBoundsReadInABoundingBoxProgramIsAnErrorOrReported) {
@@ -298,8 +303,9 @@ TEST_F(ExceptionsTest, OutOfBoundsReadInABoundingBoxProgramIsAnErrorOrReported) 
     auto geometry = make_spheres(ctx, {make_float4(0, 0, 5, 1), make_float4(3, 0, 5, 1)});
     geometry->set_primitive_count(3);
     ctx["top"] = make_geometry_group(
-        ctx, {make_instance(ctx, geometry,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+        ctx,
+        {make_instance(ctx, geometry,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
     ctx["wanted_depth"] = 1;
     ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_trace_depth)));
     depth_buffer(1);
@@ -319,7 +325,7 @@ TEST_F(ExceptionsTest, OutOfBoundsReadInABoundingBoxProgramIsAnErrorOrReported) 
 // ---- user exceptions, the exception program, the report ------------------------------
 
 class UserExceptionTest : public ExceptionsTest {
-protected:
+  protected:
     UserExceptionTest() {
         ctx.set_exception_enabled(kAllExceptions, true);
         ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(et_throw_some)));

@@ -16,13 +16,14 @@ namespace {
 namespace fs = std::filesystem;
 
 class KernelCache : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         dir = fs::temp_directory_path() / ("lucent-cache-test-" + std::to_string(::getpid()));
         fs::remove_all(dir);
         ::setenv("LUCENT_CACHE_DIR", dir.c_str(), 1);
         request.name = "cache_test.cu";
-        request.source = "extern \"C\" __global__ void scale(float* x) { x[threadIdx.x] *= 2.0f; }\n";
+        request.source =
+            "extern \"C\" __global__ void scale(float* x) { x[threadIdx.x] *= 2.0f; }\n";
         request.sm = 90;
     }
     void TearDown() override {
@@ -91,7 +92,9 @@ TEST_F(KernelCache, CompileErrorNamesTheFileAndKeepsNothing) {
     EXPECT_TRUE(!fs::exists(dir) || fs::is_empty(dir));
 }
 #else
-TEST(KernelCache, NeedsTheCudaToolkit) { GTEST_SKIP() << "built without the CUDA toolkit"; }
+TEST(KernelCache, NeedsTheCudaToolkit) {
+    GTEST_SKIP() << "built without the CUDA toolkit";
+}
 #endif
 
 }  // namespace

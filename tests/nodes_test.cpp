@@ -10,22 +10,24 @@ namespace {
 
 constexpr float kEps = 1e-4f;
 
-#define EXPECT_FLOAT3_NEAR(a, b, eps)           \
-    do {                                        \
-        const float3 a_ = (a), b_ = (b);        \
-        EXPECT_NEAR(a_.x, b_.x, eps) << "x";    \
-        EXPECT_NEAR(a_.y, b_.y, eps) << "y";    \
-        EXPECT_NEAR(a_.z, b_.z, eps) << "z";    \
+#define EXPECT_FLOAT3_NEAR(a, b, eps)        \
+    do {                                     \
+        const float3 a_ = (a), b_ = (b);     \
+        EXPECT_NEAR(a_.x, b_.x, eps) << "x"; \
+        EXPECT_NEAR(a_.y, b_.y, eps) << "y"; \
+        EXPECT_NEAR(a_.z, b_.z, eps) << "z"; \
     } while (0)
 
 class NodesTest : public CasterFixture {
-protected:
-    std::shared_ptr<Program> sphere_hit() { return program(ctx, LUCENT_PROGRAM(common_sphere_hit)); }
+  protected:
+    std::shared_ptr<Program> sphere_hit() {
+        return program(ctx, LUCENT_PROGRAM(common_sphere_hit));
+    }
 
     /// A geometry group holding one sphere instance with material id `id`.
     std::shared_ptr<GeometryGroup> sphere_group(float4 sphere, unsigned id) {
-        return make_geometry_group(
-            ctx, {make_instance(ctx, make_spheres(ctx, {sphere}), make_material(ctx, sphere_hit(), id))});
+        return make_geometry_group(ctx, {make_instance(ctx, make_spheres(ctx, {sphere}),
+                                                       make_material(ctx, sphere_hit(), id))});
     }
 
     std::shared_ptr<Transform> transform(const Matrix4x3& m, std::shared_ptr<Node> child) {
@@ -106,13 +108,16 @@ TEST_F(NodesTest, ChangedMatrixTakesEffectAtTheNextLaunch) {
 }
 
 /// Rotation by 90 degrees about y: object +z becomes world +x, object +x becomes world -z.
-Matrix4x3 rotation_y90() { return Matrix4x3{{0, 0, 1, 0, 0, 1, 0, 0, -1, 0, 0, 0}}; }
+Matrix4x3 rotation_y90() {
+    return Matrix4x3{{0, 0, 1, 0, 0, 1, 0, 0, -1, 0, 0, 0}};
+}
 
 TEST_F(NodesTest, TrianglesUnderARotationHaveWorldSpaceNormalsAndHitPoints) {
     // The square at object z = 2 becomes the world plane x = 2.
     auto gg = make_geometry_group(
-        ctx, {make_instance(ctx, make_triangles(ctx, square_at(2)),
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
+        ctx,
+        {make_instance(ctx, make_triangles(ctx, square_at(2)),
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
     auto top = transform(rotation_y90(), gg);
     const auto hits = cast(top, {cast_ray(make_float3(-5, 0.1f, 0.3f), make_float3(1, 0, 0))});
     ASSERT_EQ(hits[0].hit, 1);
@@ -131,7 +136,8 @@ TEST_F(NodesTest, AttributeProgramBelowATransformSeesTheHitsTransformAndPrimitiv
     auto triangles = make_triangles(ctx, vertices);
     triangles->set_attribute_program(program(ctx, LUCENT_PROGRAM(nt_space_attributes)));
     auto gg = make_geometry_group(
-        ctx, {make_instance(ctx, triangles, make_material(ctx, program(ctx, LUCENT_PROGRAM(nt_space_hit)), 1))});
+        ctx, {make_instance(ctx, triangles,
+                            make_material(ctx, program(ctx, LUCENT_PROGRAM(nt_space_hit)), 1))});
     auto top = transform(rotation_y90(), gg);
     // Trace twice so the second trace starts from a used frame (no stale state).
     const auto hits = cast(top, {cast_ray(make_float3(-5, 0.1f, 0.3f), make_float3(1, 0, 0)),
@@ -140,13 +146,15 @@ TEST_F(NodesTest, AttributeProgramBelowATransformSeesTheHitsTransformAndPrimitiv
         ASSERT_EQ(hit.hit, 1);
         EXPECT_NEAR(hit.t, 7.0f, kEps);
         {
-            SCOPED_TRACE("object_to_world_normal in the attribute program uses the hit's transform");
+            SCOPED_TRACE(
+                "object_to_world_normal in the attribute program uses the hit's transform");
             EXPECT_FLOAT3_NEAR(hit.normal, make_float3(1, 0, 0), kEps);
         }
         EXPECT_EQ(hit.prim, hit.anyhit_count) << "primitive_index() equals the prim argument";
         EXPECT_GE(hit.anyhit_count, 2u) << "the hit is on the second square";
         {
-            SCOPED_TRACE("current_ray() in the attribute program is in object space, like intersection");
+            SCOPED_TRACE(
+                "current_ray() in the attribute program is in object space, like intersection");
             EXPECT_FLOAT3_NEAR(hit.object_point, make_float3(-0.3f, 0.1f, -5), kEps);
         }
     }
@@ -160,7 +168,8 @@ TEST_F(NodesTest, AnyHitBelowATransformSeesTheObjectRayAndWorldT) {
     material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(nt_anyhit_record)));
     auto gg = make_geometry_group(
         ctx, {make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 0, 1)}), material)});
-    const auto hits = cast(transform(m, gg), {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1))});
+    const auto hits =
+        cast(transform(m, gg), {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1))});
     ASSERT_EQ(hits[0].hit, 1);
     EXPECT_NEAR(hits[0].t, 8.0f, kEps);
     EXPECT_NEAR(hits[0].anyhit_t, 8.0f, kEps);
@@ -265,7 +274,7 @@ TEST_F(NodesTest, GeometryInstanceWithSeveralParentsIsHitUnderEach) {
 // ---- selectors ------------------------------------------------------------------
 
 class SelectorTest : public NodesTest {
-protected:
+  protected:
     /// Two children with the same sphere but different material ids (1 and 2).
     std::shared_ptr<Selector> selector(const ProgramDesc& visit) {
         auto s = ctx.create_selector();
@@ -367,7 +376,7 @@ TEST_F(NodesTest, ShadowRaysTraverseADifferentRootThanRadianceRays) {
 // ---- groups over many children ------------------------------------------------------
 
 class ManyChildrenTest : public NodesTest {
-protected:
+  protected:
     static constexpr int kGrid = 8;
     static float4 sphere_of(int i, int j) {
         return make_float4(2.0f * i, 2.0f * j, 10.0f + float((i + j) % 3), 0.8f);
@@ -405,7 +414,8 @@ protected:
                     child = make_geometry_group(ctx, {instance});
                 } else {
                     instance = make_instance(ctx, origin_sphere, material);
-                    child = transform(translation(s.x, s.y, s.z), make_geometry_group(ctx, {instance}));
+                    child =
+                        transform(translation(s.x, s.y, s.z), make_geometry_group(ctx, {instance}));
                 }
                 // The instance's id wins over the material's (closest-hit scope order).
                 (*instance)["id"] = id;
@@ -416,7 +426,8 @@ protected:
     std::vector<CastRay> grid_rays() {
         std::vector<CastRay> rays;
         for (int a = 0; a < 40; ++a)
-            for (int b = 0; b < 40; ++b) rays.push_back(along_z(-1.3f + 0.43f * a, -1.1f + 0.41f * b));
+            for (int b = 0; b < 40; ++b)
+                rays.push_back(along_z(-1.3f + 0.43f * a, -1.1f + 0.41f * b));
         return rays;
     }
 };
@@ -435,8 +446,8 @@ TEST_F(ManyChildrenTest, BvhOverChildrenMatchesBruteForce) {
         int id;
         float t;
         expected_hit(rays[r].origin.x, rays[r].origin.y, id, t);
-        const testing::Message where = testing::Message()
-                                       << "ray at (" << rays[r].origin.x << ", " << rays[r].origin.y << ")";
+        const testing::Message where = testing::Message() << "ray at (" << rays[r].origin.x << ", "
+                                                          << rays[r].origin.y << ")";
         if (id < 0) {
             EXPECT_EQ(bvh_hits[r].hit, 0) << where;
             EXPECT_EQ(flat_hits[r].hit, 0) << where;
@@ -456,7 +467,7 @@ TEST_F(ManyChildrenTest, BvhOverChildrenMatchesBruteForce) {
 // ---- refit ---------------------------------------------------------------------------
 
 class RefitTest : public NodesTest {
-protected:
+  protected:
     /// A 4x4 grid of quads over [0,4]^2 at z = 2 (32 triangles).
     static std::vector<float3> grid_vertices() {
         std::vector<float3> v;
@@ -474,7 +485,8 @@ protected:
     std::vector<CastRay> rays() {
         std::vector<CastRay> r;
         for (int a = 0; a < 16; ++a)
-            for (int b = 0; b < 8; ++b) r.push_back(along_z(0.23f + 0.45f * a, 0.21f + 0.45f * b, 0));
+            for (int b = 0; b < 8; ++b)
+                r.push_back(along_z(0.23f + 0.45f * a, 0.21f + 0.45f * b, 0));
         return r;
     }
 };
@@ -482,8 +494,9 @@ protected:
 TEST_F(RefitTest, RefitAfterMovingVerticesGivesTheSameHitsAsARebuild) {
     auto triangles = make_triangles(ctx, grid_vertices());
     auto gg = make_geometry_group(
-        ctx, {make_instance(ctx, triangles,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
+        ctx,
+        {make_instance(ctx, triangles,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
     auto top = ctx.create_group();
     top->add_child(gg);
     const auto ray_list = rays();
@@ -530,11 +543,13 @@ TEST_F(RefitTest, MixedTrianglesAndSpheresHitTheSameWithAndWithoutAHierarchy) {
     // that mixes built-in and custom primitives), traced with Builder::kBinnedSah and kNone.
     auto triangles = make_triangles(ctx, grid_vertices());
     std::vector<float4> balls;
-    for (int i = 0; i < 10; ++i) balls.push_back(make_float4(0.4f * i, 1.0f + 0.2f * i, 1.0f + 0.3f * i, 0.3f));
+    for (int i = 0; i < 10; ++i)
+        balls.push_back(make_float4(0.4f * i, 1.0f + 0.2f * i, 1.0f + 0.3f * i, 0.3f));
     auto gg = make_geometry_group(
-        ctx, {make_instance(ctx, triangles,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)),
-              make_instance(ctx, make_spheres(ctx, balls), make_material(ctx, sphere_hit(), 2))});
+        ctx,
+        {make_instance(ctx, triangles,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)),
+         make_instance(ctx, make_spheres(ctx, balls), make_material(ctx, sphere_hit(), 2))});
     const auto ray_list = rays();
     const auto with_bvh = cast(gg, ray_list);
     gg->acceleration()->set_builder(Builder::kNone);
@@ -552,11 +567,13 @@ TEST_F(RefitTest, MixedTrianglesAndSpheresHitTheSameWithAndWithoutAHierarchy) {
 
 TEST_F(RefitTest, RefitAfterMovingCustomPrimitivesFollowsTheirNewBounds) {
     auto spheres = make_spheres(ctx, {make_float4(0, 0, 5, 1), make_float4(3, 0, 5, 1)});
-    auto gg = make_geometry_group(ctx, {make_instance(ctx, spheres, make_material(ctx, sphere_hit(), 1))});
+    auto gg = make_geometry_group(
+        ctx, {make_instance(ctx, spheres, make_material(ctx, sphere_hit(), 1))});
     gg->acceleration()->set_refit(true);
     EXPECT_EQ(cast(gg, {along_z(10, 0, 0)})[0].hit, 0);
     // Move the second sphere far to the right: its box must move with it.
-    (*spheres)["spheres"] = input_buffer(ctx, std::vector<float4>{make_float4(0, 0, 5, 1), make_float4(10, 0, 7, 1)});
+    (*spheres)["spheres"] =
+        input_buffer(ctx, std::vector<float4>{make_float4(0, 0, 5, 1), make_float4(10, 0, 7, 1)});
     gg->acceleration()->mark_dirty();
     const auto hits = cast(gg, {along_z(10, 0, 0), along_z(3, 0, 0), along_z(0, 0, 0)});
     ASSERT_EQ(hits[0].hit, 1);

@@ -6,7 +6,9 @@
 #include "tests/test_support.h"
 
 // gtest compares and prints through ADL, which looks in uint3's (global) namespace.
-static bool operator==(uint3 a, uint3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+static bool operator==(uint3 a, uint3 b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
 static std::ostream& operator<<(std::ostream& os, uint3 v) {
     return os << "(" << v.x << "," << v.y << "," << v.z << ")";
 }
@@ -19,18 +21,18 @@ using testing::Not;
 
 constexpr float kEps = 1e-4f;
 
-#define EXPECT_FLOAT3_NEAR(a, b, eps)           \
-    do {                                        \
-        const float3 a_ = (a), b_ = (b);        \
-        EXPECT_NEAR(a_.x, b_.x, eps) << "x";    \
-        EXPECT_NEAR(a_.y, b_.y, eps) << "y";    \
-        EXPECT_NEAR(a_.z, b_.z, eps) << "z";    \
+#define EXPECT_FLOAT3_NEAR(a, b, eps)        \
+    do {                                     \
+        const float3 a_ = (a), b_ = (b);     \
+        EXPECT_NEAR(a_.x, b_.x, eps) << "x"; \
+        EXPECT_NEAR(a_.y, b_.y, eps) << "y"; \
+        EXPECT_NEAR(a_.z, b_.z, eps) << "z"; \
     } while (0)
 
 // ---- ray generation ------------------------------------------------------------
 
 class RayGenerationTest : public testing::Test {
-protected:
+  protected:
     RayGenerationTest() : ctx(test_context_options()) { ctx.set_entry_point_count(1); }
     Context ctx;
 };
@@ -102,8 +104,9 @@ TEST_F(ClosestHitTest, MissProgramRunsWhenNothingIsHitAndReadsItsRecord) {
     ctx["background_id"] = 77u;
     auto spheres = make_spheres(ctx, {make_float4(0, 0, 5, 1)});
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, spheres,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+        ctx,
+        {make_instance(ctx, spheres,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
     const auto hits = cast(top, {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, -1)),
                                  cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1))});
     EXPECT_EQ(hits[0].hit, 0);
@@ -117,8 +120,9 @@ TEST_F(ClosestHitTest, CustomSphereIntersectionFeedsAttributesToClosestHit) {
     // The far sphere is primitive 0, the near one primitive 1: closest hit must see the near.
     auto spheres = make_spheres(ctx, {make_float4(0, 0, 10, 1), make_float4(0, 0, 5, 1)});
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, spheres,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 3))});
+        ctx,
+        {make_instance(ctx, spheres,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 3))});
     const auto hits = cast(top, {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1)),
                                  cast_ray(make_float3(0, 0, 20), make_float3(0, 0, -1)),
                                  cast_ray(make_float3(3, 0, 0), make_float3(0, 0, 1))});
@@ -140,8 +144,9 @@ TEST_F(ClosestHitTest, CustomSphereIntersectionFeedsAttributesToClosestHit) {
 TEST_F(ClosestHitTest, OffAxisSphereHitHasAnalyticNormal) {
     auto spheres = make_spheres(ctx, {make_float4(1, 2, 6, 2)});
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, spheres,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 0))});
+        ctx,
+        {make_instance(ctx, spheres,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 0))});
     // Enters the sphere where (x - 1)^2 + (z - 6)^2 = 4 with x = 2: z = 6 - sqrt(3).
     const auto hits = cast(top, {cast_ray(make_float3(2, 2, 0), make_float3(0, 0, 1))});
     ASSERT_EQ(hits[0].hit, 1);
@@ -159,9 +164,9 @@ TEST_F(ClosestHitTest, ParallelogramIntersectionReportsItsCoordinates) {
     (*geometry)["v1"] = make_float3(2, 0, 0);
     (*geometry)["v2"] = make_float3(0, 4, 0);
     auto top = make_geometry_group(
-        ctx, {make_instance(
-                 ctx, geometry,
-                 make_material(ctx, program(ctx, LUCENT_PROGRAM(pk_parallelogram_hit)), 9))});
+        ctx,
+        {make_instance(ctx, geometry,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(pk_parallelogram_hit)), 9))});
     const auto hits = cast(top, {cast_ray(make_float3(0.5f, 1, 0), make_float3(0, 0, 1)),
                                  cast_ray(make_float3(2, 0, 0), make_float3(0, 0, 1))});
     ASSERT_EQ(hits[0].hit, 1);
@@ -174,10 +179,12 @@ TEST_F(ClosestHitTest, ParallelogramIntersectionReportsItsCoordinates) {
 
 TEST_F(ClosestHitTest, RayIntervalLimitsBothTrianglesAndCustomPrimitives) {
     // A square at z = 5 and a unit sphere centred at (3, 0, 5) (front at z = 4).
-    auto quad = make_instance(ctx, make_triangles(ctx, square_at(5, -1, 1, -1, 1)),
-                              make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
-    auto ball = make_instance(ctx, make_spheres(ctx, {make_float4(3, 0, 5, 1)}),
-                              make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 2));
+    auto quad =
+        make_instance(ctx, make_triangles(ctx, square_at(5, -1, 1, -1, 1)),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
+    auto ball =
+        make_instance(ctx, make_spheres(ctx, {make_float4(3, 0, 5, 1)}),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 2));
     auto top = make_geometry_group(ctx, {quad, ball});
     auto gen = program(ctx, LUCENT_PROGRAM(pk_cast_rays));
     ctx.set_ray_generation_program(0, gen);
@@ -211,12 +218,15 @@ TEST_F(ClosestHitTest, RayIntervalLimitsBothTrianglesAndCustomPrimitives) {
 TEST_F(ClosestHitTest, TrianglesAndCustomPrimitivesInOneGroupGiveTheNearestHit) {
     // Along x = 0: sphere front at z = 4, square at z = 6; along x = 0.5 the square is
     // moved in front (z = 3) for a second group. Order of instances must not matter.
-    auto ball = make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
-                              make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1));
-    auto far_quad = make_instance(ctx, make_triangles(ctx, square_at(6)),
-                                  make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 2));
-    auto near_quad = make_instance(ctx, make_triangles(ctx, square_at(3)),
-                                   make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 3));
+    auto ball =
+        make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1));
+    auto far_quad =
+        make_instance(ctx, make_triangles(ctx, square_at(6)),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 2));
+    auto near_quad =
+        make_instance(ctx, make_triangles(ctx, square_at(3)),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 3));
     const std::vector<CastRay> rays = {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1))};
     EXPECT_EQ(cast(make_geometry_group(ctx, {far_quad, ball}), rays)[0].id, 1u);
     EXPECT_EQ(cast(make_geometry_group(ctx, {ball, far_quad}), rays)[0].id, 1u);
@@ -230,12 +240,13 @@ using TriangleTest = CasterFixture;
 
 TEST_F(TriangleTest, BarycentricsAndNormalWithoutIndexBuffer) {
     // Triangle 0 at z = 2; triangle 1 elsewhere at z = 4.
-    auto triangles = make_triangles(
-        ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2),
-              make_float3(5, 0, 4), make_float3(6, 0, 4), make_float3(5, 1, 4)});
+    auto triangles =
+        make_triangles(ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2),
+                             make_float3(5, 0, 4), make_float3(6, 0, 4), make_float3(5, 1, 4)});
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, triangles,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 4))});
+        ctx,
+        {make_instance(ctx, triangles,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 4))});
     const auto hits = cast(top, {cast_ray(make_float3(0.2f, 0.3f, 0), make_float3(0, 0, 1)),
                                  cast_ray(make_float3(5.6f, 0.25f, 0), make_float3(0, 0, 1)),
                                  cast_ray(make_float3(0.8f, 0.8f, 0), make_float3(0, 0, 1))});
@@ -264,8 +275,9 @@ TEST_F(TriangleTest, IndexBufferSelectsTheVertices) {
         {make_float3(9, 9, 9), make_float3(0, 1, 2), make_float3(0, 0, 2), make_float3(1, 0, 2)},
         {make_uint3(2, 3, 1)});
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, triangles,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 4))});
+        ctx,
+        {make_instance(ctx, triangles,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 4))});
     const auto hits = cast(top, {cast_ray(make_float3(0.2f, 0.3f, 0), make_float3(0, 0, 1))});
     ASSERT_EQ(hits[0].hit, 1);
     EXPECT_NEAR(hits[0].t, 2.0f, kEps);
@@ -275,11 +287,11 @@ TEST_F(TriangleTest, IndexBufferSelectsTheVertices) {
 
 TEST_F(TriangleTest, AttributeProgramInterpolatesTexcoords) {
     const std::vector<uint3> indices = {make_uint3(0, 1, 2), make_uint3(3, 4, 5)};
-    auto triangles = make_triangles(
-        ctx,
-        {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2), make_float3(5, 0, 2),
-         make_float3(6, 0, 2), make_float3(5, 1, 2)},
-        indices);
+    auto triangles =
+        make_triangles(ctx,
+                       {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2),
+                        make_float3(5, 0, 2), make_float3(6, 0, 2), make_float3(5, 1, 2)},
+                       indices);
     triangles->set_attribute_program(program(ctx, LUCENT_PROGRAM(pk_texcoord_attributes)));
     // The attribute program's record resolves on the geometry (Program, GI, Geometry, Context).
     (*triangles)["indices"] = triangles->indices();
@@ -303,9 +315,9 @@ TEST_F(TriangleTest, AttributeProgramInterpolatesTexcoords) {
 }
 
 TEST_F(TriangleTest, PerTriangleMaterialIndexBufferSelectsTheMaterial) {
-    auto triangles = make_triangles(
-        ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2),
-              make_float3(5, 0, 2), make_float3(6, 0, 2), make_float3(5, 1, 2)});
+    auto triangles =
+        make_triangles(ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2),
+                             make_float3(5, 0, 2), make_float3(6, 0, 2), make_float3(5, 1, 2)});
     triangles->set_material_indices(input_buffer(ctx, std::vector<unsigned>{1, 0}));
     auto closest = program(ctx, LUCENT_PROGRAM(common_triangle_hit));
     auto instance = make_instance(ctx, triangles, make_material(ctx, closest, 100));
@@ -341,8 +353,9 @@ TEST_F(ClosestHitTest, ClosestHitSeesTHitAndTheWorldRay) {
     // A non-unit direction: t is in units of the direction, not of distance.
     auto quad = make_triangles(ctx, square_at(5));
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, quad,
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
+        ctx,
+        {make_instance(ctx, quad,
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
     const auto hits = cast(top, {cast_ray(make_float3(1, 2, -3), make_float3(0, 0, 2))});
     ASSERT_EQ(hits[0].hit, 1);
     EXPECT_NEAR(hits[0].t, 4.0f, kEps);
@@ -354,11 +367,11 @@ TEST_F(ClosestHitTest, ClosestHitSeesTHitAndTheWorldRay) {
 // ---- any hit --------------------------------------------------------------------
 
 class AnyHitTest : public CasterFixture {
-protected:
+  protected:
     /// A square at depth z with its own material (id = z) and optional any-hit program.
     std::shared_ptr<GeometryInstance> plane(float z, std::shared_ptr<Program> any_hit) {
-        auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)),
-                                      unsigned(z));
+        auto material =
+            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), unsigned(z));
         if (any_hit) material->set_any_hit(0, any_hit);
         return make_instance(ctx, make_triangles(ctx, square_at(z)), material);
     }
@@ -389,8 +402,8 @@ TEST_F(AnyHitTest, TerminateRayAcceptsTheHitAndStillRunsClosestHit) {
     // OptiX semantics: terminate_ray() accepts the candidate, stops traversal, and the
     // closest-hit program runs for the accepted (terminated) hit.
     auto terminate = program(ctx, LUCENT_PROGRAM(pk_anyhit_terminate));
-    auto top = make_geometry_group(ctx, {plane(2, terminate), plane(4, terminate),
-                                         plane(6, terminate)});
+    auto top =
+        make_geometry_group(ctx, {plane(2, terminate), plane(4, terminate), plane(6, terminate)});
     const auto hits = cast(top, rays);
     ASSERT_EQ(hits[0].hit, 1) << "closest hit must run after terminate_ray";
     EXPECT_EQ(hits[0].anyhit_count, 1u) << "traversal stops at the first accepted candidate";
@@ -411,7 +424,8 @@ TEST_F(AnyHitTest, TerminateRayStopsTraversalAcrossTheChildrenOfAGroup) {
     // Three planes, each in its own geometry group under one Group.
     auto terminate = program(ctx, LUCENT_PROGRAM(pk_anyhit_terminate));
     auto top = ctx.create_group();
-    for (float z : {6.0f, 2.0f, 4.0f}) top->add_child(make_geometry_group(ctx, {plane(z, terminate)}));
+    for (float z : {6.0f, 2.0f, 4.0f})
+        top->add_child(make_geometry_group(ctx, {plane(z, terminate)}));
     const auto hits = cast(top, rays);
     ASSERT_EQ(hits[0].hit, 1);
     EXPECT_EQ(hits[0].anyhit_count, 1u) << "no other group is entered after terminate_ray";
@@ -451,7 +465,8 @@ TEST_F(AnyHitTest, AnyHitSeesTheCandidatesBarycentricsForCutouts) {
     near_material->set_any_hit(0, cutout);
     // One triangle (0,0)-(1,0)-(0,1) at z = 2, so u = x and v = y.
     auto near = make_instance(
-        ctx, make_triangles(ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2)}),
+        ctx,
+        make_triangles(ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2)}),
         near_material);
     auto top = make_geometry_group(ctx, {near, plane(5, nullptr)});
     const auto hits = cast(top, {cast_ray(make_float3(0.2f, 0.1f, 0), make_float3(0, 0, 1)),
@@ -473,7 +488,8 @@ TEST_F(AnyHitTest, AnyHitSeesAttributeProgramAttributes) {
         ctx, std::vector<float2>{make_float2(0, 0), make_float2(10, 0), make_float2(0, 10)});
     auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(pk_texcoord_hit)), 2);
     material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(pk_anyhit_texcoord_cutout)));
-    auto top = make_geometry_group(ctx, {make_instance(ctx, triangles, material), plane(5, nullptr)});
+    auto top =
+        make_geometry_group(ctx, {make_instance(ctx, triangles, material), plane(5, nullptr)});
     const auto hits = cast(top, {cast_ray(make_float3(0.2f, 0.1f, 0), make_float3(0, 0, 1)),
                                  cast_ray(make_float3(0.7f, 0.1f, 0), make_float3(0, 0, 1))});
     EXPECT_EQ(hits[0].id, 2u) << "texcoord x = 2 is solid";
@@ -517,7 +533,8 @@ TEST_F(ClosestHitTest, ClosestHitTracesRecursivelyToTheRequestedDepth) {
     std::vector<float3> vertices = square_at(0);
     const std::vector<float3> far = square_at(2);
     vertices.insert(vertices.end(), far.begin(), far.end());
-    auto top = make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, vertices), material)});
+    auto top =
+        make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, vertices), material)});
     ctx["top"] = top;
     ctx.set_max_recursion_depth(8);
     const auto hits = cast(top, {cast_ray(make_float3(0.3f, 0.1f, 1), make_float3(0, 0, 1))});
@@ -538,7 +555,7 @@ std::string print_line(const char* format, unsigned i) {
 }
 
 class PrintTest : public RayGenerationTest {
-protected:
+  protected:
     PrintTest() { ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(pk_print_index))); }
     std::string launch_and_capture(unsigned width) {
         testing::internal::CaptureStdout();
@@ -616,10 +633,13 @@ TEST_F(ClosestHitTest, PrintInABoundingBoxProgramDoesNotCrash) {
         EXPECT_EXIT(
             {
                 auto spheres = make_spheres(ctx, {make_float4(0, 0, 5, 1)});
-                spheres->set_bounding_box_program(program(ctx, LUCENT_PROGRAM(pk_printing_sphere_bounds)));
+                spheres->set_bounding_box_program(
+                    program(ctx, LUCENT_PROGRAM(pk_printing_sphere_bounds)));
                 auto top = make_geometry_group(
-                    ctx, {make_instance(ctx, spheres,
-                                        make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+                    ctx,
+                    {make_instance(
+                        ctx, spheres,
+                        make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
                 ctx.set_print_enabled(enabled);
                 const auto hits = cast(top, {cast_ray(make_float3(0, 0, 0), make_float3(0, 0, 1))});
                 std::exit(hits[0].hit == 1 ? 0 : 3);
@@ -632,7 +652,7 @@ TEST_F(ClosestHitTest, PrintInABoundingBoxProgramDoesNotCrash) {
 // ---- textures ----------------------------------------------------------------------
 
 class TextureTest : public RayGenerationTest {
-protected:
+  protected:
     TextureTest() {
         ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(pk_sample_texture)));
         // A 4x1 texture whose texel i holds (i, 10 i, 0, 1).

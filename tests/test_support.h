@@ -45,8 +45,7 @@ inline std::string lowercase(std::string s) {
 /// Runs `fn`, expects a lucent::Error whose message contains every word of `words`
 /// (case-insensitive: we assert on meaning, not capitalisation). Returns the message.
 inline std::string expect_error(const std::function<void()>& fn,
-                                std::initializer_list<std::string> words,
-                                const char* what = "") {
+                                std::initializer_list<std::string> words, const char* what = "") {
     try {
         fn();
     } catch (const Error& e) {
@@ -147,12 +146,14 @@ inline Matrix4x3 scaling(float x, float y, float z) {
     return Matrix4x3{{x, 0, 0, 0, 0, y, 0, 0, 0, 0, z, 0}};
 }
 
-inline CastRay cast_ray(float3 origin, float3 direction) { return CastRay{origin, direction}; }
+inline CastRay cast_ray(float3 origin, float3 direction) {
+    return CastRay{origin, direction};
+}
 
 /// A CPU context with one entry point (the shared caster), ray type 0 carrying
 /// TestPayload, and the shared miss program: cast(top, rays) traces and returns payloads.
 class CasterFixture : public testing::Test {
-protected:
+  protected:
     CasterFixture() : ctx(test_context_options()) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<TestPayload>(0, "radiance");

@@ -14,19 +14,21 @@ using testing::HasSubstr;
 constexpr unsigned kRays = 4;
 
 class ValidationTest : public CasterFixture {
-protected:
+  protected:
     /// Binds the caster's variables so that only the defect under test is left.
     template <class N>
     void bind_caster(std::shared_ptr<N> top) {
         (*caster)["top"] = top;
         (*caster)["rays"] = input_buffer(
-            ctx, std::vector<CastRay>(kRays, cast_ray(make_float3(0.3f, 0.1f, 0), make_float3(0, 0, 1))));
+            ctx, std::vector<CastRay>(kRays,
+                                      cast_ray(make_float3(0.3f, 0.1f, 0), make_float3(0, 0, 1))));
         (*caster)["results"] = ctx.create_buffer<TestPayload>(BufferType::kOutput, kRays);
     }
 
     /// A geometry group: one square at z = 2 with `material`.
     std::shared_ptr<GeometryGroup> square_with(std::shared_ptr<Material> material) {
-        return make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, square_at(2)), material)});
+        return make_geometry_group(
+            ctx, {make_instance(ctx, make_triangles(ctx, square_at(2)), material)});
     }
 
     /// validate() and launch() must both throw an Error mentioning every word.
@@ -39,7 +41,8 @@ protected:
 // ---- a valid scene first: the negative tests below differ from it in one defect --------
 
 TEST_F(ValidationTest, ValidSceneValidatesAndLaunches) {
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
     EXPECT_NO_THROW(ctx.validate());
     EXPECT_NO_THROW(ctx.launch(0, kRays));
 }
@@ -49,7 +52,8 @@ TEST_F(ValidationTest, ValidSceneValidatesAndLaunches) {
 TEST(ValidationStandaloneTest, UnboundRayGenerationProgramIsRejected) {
     Context ctx(test_context_options());
     ctx.set_entry_point_count(1);
-    const std::string message = expect_error([&] { ctx.validate(); }, {"ray generation"}, "validate()");
+    const std::string message =
+        expect_error([&] { ctx.validate(); }, {"ray generation"}, "validate()");
     EXPECT_TRUE(mentions_any(message, {"entry", "set_ray_generation_program"})) << message;
     expect_error([&] { ctx.launch(0, 4); }, {"ray generation"}, "launch()");
 }
@@ -76,7 +80,8 @@ TEST_F(ValidationTest, RayTypeThatDoesNotExpectClosestHitAcceptsAnyHitOnlyMateri
 
 TEST_F(ValidationTest, MissProgramWithAnotherPayloadTypeIsRejected) {
     ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(vat_miss_other)));
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
     const std::string message = expect_rejected({"vat_miss_other", "payload"});
     EXPECT_TRUE(mentions_any(message, {"OtherPayload"})) << message;
     EXPECT_TRUE(mentions_any(message, {"TestPayload", "radiance"})) << message;
@@ -93,15 +98,18 @@ TEST_F(ValidationTest, ClosestHitWithAnotherPayloadTypeIsRejected) {
 TEST_F(ValidationTest, ClosestHitAttributesDifferentFromTheIntersectionsAreRejected) {
     // Sphere intersection writes SphereAttributes; this closest hit reads TriangleAttributes.
     bind_caster(make_geometry_group(
-        ctx, {make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))}));
+        ctx,
+        {make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))}));
     const std::string message = expect_rejected({"attribute"});
-    EXPECT_TRUE(mentions_any(message, {"common_triangle_hit", "common_sphere_intersect"})) << message;
+    EXPECT_TRUE(mentions_any(message, {"common_triangle_hit", "common_sphere_intersect"}))
+        << message;
 }
 
 TEST_F(ValidationTest, ClosestHitAttributesDifferentFromBuiltInTrianglesAreRejected) {
     // Triangles without an attribute program give TriangleAttributes.
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1)));
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1)));
     const std::string message = expect_rejected({"attribute", "common_sphere_hit"});
     EXPECT_TRUE(mentions_any(message, {"TriangleAttributes"})) << message;
 }
@@ -174,8 +182,9 @@ TEST_F(ValidationTest, IncompleteNodesAreRejectedWithWhatToSet) {
         geometry->set_name("no_programs");
         geometry->set_primitive_count(1);
         bind_caster(make_geometry_group(
-            ctx, {make_instance(ctx, geometry,
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))}));
+            ctx, {make_instance(
+                     ctx, geometry,
+                     make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))}));
         expect_rejected({"no_programs"});
     }
     {
@@ -200,7 +209,8 @@ TEST_F(ValidationTest, IncompleteNodesAreRejectedWithWhatToSet) {
     {
         auto instance = ctx.create_geometry_instance();
         instance->set_name("no_geometry");
-        instance->add_material(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
+        instance->add_material(
+            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
         bind_caster(make_geometry_group(ctx, {instance}));
         expect_rejected({"no_geometry", "geometry"});
     }
@@ -215,9 +225,9 @@ TEST_F(ValidationTest, MalformedTriangleBuffersAreRejected) {
         expect_rejected({"two_vertices"});
     }
     {
-        auto triangles = make_triangles(
-            ctx, {make_float3(0, 0, 0), make_float3(1, 0, 0), make_float3(0, 1, 0)},
-            {make_uint3(0, 1, 7)});
+        auto triangles =
+            make_triangles(ctx, {make_float3(0, 0, 0), make_float3(1, 0, 0), make_float3(0, 1, 0)},
+                           {make_uint3(0, 1, 7)});
         triangles->set_name("bad_index");
         bind_caster(make_geometry_group(ctx, {make_instance(ctx, triangles, material)}));
         expect_rejected({"bad_index", "7"});
@@ -240,10 +250,17 @@ TEST_F(ValidationTest, ProgramOfTheWrongKindIsRejectedAtTheCall) {
                  "miss as ray generation");
     expect_error([&] { ctx.set_miss_program(0, caster); }, {"miss"}, "ray generation as miss");
     auto geometry = ctx.create_geometry();
-    expect_error([&] { geometry->set_intersection_program(program(ctx, LUCENT_PROGRAM(common_sphere_bounds))); },
-                 {"intersection"}, "bounding box as intersection");
-    expect_error([&] { geometry->set_bounding_box_program(program(ctx, LUCENT_PROGRAM(common_sphere_intersect))); },
-                 {"bounding"}, "intersection as bounding box");
+    expect_error(
+        [&] {
+            geometry->set_intersection_program(program(ctx, LUCENT_PROGRAM(common_sphere_bounds)));
+        },
+        {"intersection"}, "bounding box as intersection");
+    expect_error(
+        [&] {
+            geometry->set_bounding_box_program(
+                program(ctx, LUCENT_PROGRAM(common_sphere_intersect)));
+        },
+        {"bounding"}, "intersection as bounding box");
 }
 
 TEST_F(ValidationTest, AfterAFailedLaunchFixingTheSceneLaunchesAgain) {
@@ -290,7 +307,8 @@ TEST_F(ValidationTest, CycleInTheGraphIsRejected) {
 TEST_F(ValidationTest, NonFiniteTransformIsRejected) {
     auto transform = ctx.create_transform();
     transform->set_name("broken_transform");
-    transform->set_child(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    transform->set_child(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
     Matrix4x3 m = translation(0, 0, 0);
     m.m[5] = std::numeric_limits<float>::quiet_NaN();
     try {
@@ -307,7 +325,8 @@ TEST_F(ValidationTest, NonFiniteTransformIsRejected) {
 // ---- launch sizes and buffers ---------------------------------------------------------
 
 TEST_F(ValidationTest, ZeroLaunchSizeIsRejected) {
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
     for (auto launch : std::vector<std::function<void()>>{
              [&] { ctx.launch(0, 0); }, [&] { ctx.launch(0, 4, 0); }, [&] { ctx.launch(0, 0, 4); },
              [&] { ctx.launch(0, 4, 4, 0); }}) {
@@ -330,11 +349,13 @@ TEST_F(ValidationTest, OutputBufferOfAnotherSizeThanTheLaunchIsRejected) {
 // ---- wrong API calls -----------------------------------------------------------------------
 
 TEST_F(ValidationTest, EntryPointIndexOutOfRangeIsRejected) {
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
     expect_error([&] { ctx.launch(1, kRays); }, {"entry"}, "launch(1)");
     expect_error([&] { ctx.set_ray_generation_program(3, caster); }, {"entry"},
                  "set_ray_generation_program(3)");
-    expect_error([&] { ctx.set_exception_program(3, caster); }, {"entry"}, "set_exception_program(3)");
+    expect_error([&] { ctx.set_exception_program(3, caster); }, {"entry"},
+                 "set_exception_program(3)");
 }
 
 TEST_F(ValidationTest, RayTypeIndexOutOfRangeIsRejected) {
@@ -349,8 +370,10 @@ TEST_F(ValidationTest, RayTypeIndexOutOfRangeIsRejected) {
         EXPECT_THAT(lowercase(e.what()), HasSubstr("ray type"));
         return;
     }
-    bind_caster(square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
-    expect_error([&] { ctx.validate(); }, {"ray type"}, "validate() with ray types 1..4 undeclared");
+    bind_caster(
+        square_with(make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1)));
+    expect_error([&] { ctx.validate(); }, {"ray type"},
+                 "validate() with ray types 1..4 undeclared");
 }
 
 TEST_F(ValidationTest, MapWithAnotherElementTypeIsRejected) {

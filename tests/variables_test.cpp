@@ -12,7 +12,7 @@ namespace lucent_tests {
 namespace {
 
 class VariablesTest : public testing::Test {
-protected:
+  protected:
     VariablesTest() : ctx(test_context_options()) {
         ctx.set_entry_point_count(2);
         ctx.set_ray_type<VtPayload>(0, "radiance");
@@ -116,7 +116,8 @@ TEST_F(VariablesTest, AttributeProgramResolvesProgramThenInstanceThenGeometryThe
     triangles->set_attribute_program(attributes);
     auto triangle_instance = make_instance(ctx, triangles, material);
     (*caster)["top"] = make_geometry_group(ctx, {triangle_instance});
-    check_scope_order("attr_value", {attributes.get(), triangle_instance.get(), triangles.get(), &ctx},
+    check_scope_order("attr_value",
+                      {attributes.get(), triangle_instance.get(), triangles.get(), &ctx},
                       [&] { return trace_once().attr; });
 }
 

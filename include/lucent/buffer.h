@@ -16,9 +16,9 @@ const char* buffer_type_name(BufferType type);
 
 /// A typed array. Element type is fixed at creation; map<T>() checks it.
 class Buffer : public ContextObject {
-public:
-    Buffer(detail::OwnerRef owner, std::string name, BufferType type,
-           const TypeInfo& element, unsigned dimensionality, uint3 size);
+  public:
+    Buffer(detail::OwnerRef owner, std::string name, BufferType type, const TypeInfo& element,
+           unsigned dimensionality, uint3 size);
 
     BufferType type() const { return m_type; }
     const TypeInfo& element() const { return *m_element; }
@@ -64,7 +64,7 @@ public:
     /// A GPU launch wrote the buffer: the host copy is refreshed on the next map or data.
     void mark_device_newer() const { m_device_newer = true; }
 
-private:
+  private:
     void check_element(const TypeInfo& requested) const;
     void sync_from_device() const;
     struct alignas(16) Block {
@@ -84,7 +84,7 @@ private:
 
 /// A 2D float4 texture with filtering and wrap modes, read by programs via TextureView.
 class TextureSampler : public ContextObject {
-public:
+  public:
     using ContextObject::ContextObject;
     std::string describe() const override;
 
@@ -98,7 +98,7 @@ public:
     WrapMode wrap_v() const { return m_wrap_v; }
     FilterMode filter() const { return m_filter; }
 
-private:
+  private:
     std::shared_ptr<Buffer> m_buffer;
     WrapMode m_wrap_u = WrapMode::kRepeat, m_wrap_v = WrapMode::kRepeat;
     FilterMode m_filter = FilterMode::kLinear;

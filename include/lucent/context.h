@@ -47,9 +47,9 @@ struct LaunchReport {
     double accel_ms = 0;    // acceleration builds and refits
     double launch_ms = 0;   // running the programs
     bool recompiled = false;
-    double jit_ms = 0;       // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
-    bool jit_cached = false; // CUDA: the megakernel came from the disk cache
-    double kernel_ms = 0;    // CUDA: the megakernel alone (CUDA events), within launch_ms
+    double jit_ms = 0;  // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
+    bool jit_cached = false;  // CUDA: the megakernel came from the disk cache
+    double kernel_ms = 0;     // CUDA: the megakernel alone (CUDA events), within launch_ms
     uint64_t exception_count() const;
     /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
     std::string summary() const;
@@ -59,7 +59,7 @@ struct LaunchReport {
 std::string exception_name(int code);
 
 class Context : public VariableScope {
-public:
+  public:
     explicit Context(ContextOptions options = {});
     ~Context() override;
     Context(const Context&) = delete;
@@ -82,8 +82,8 @@ public:
     /// Declares ray type `index` (ray types are 0, 1, ... with no gaps).
     template <class Payload>
     void set_ray_type(unsigned index, std::string name, bool expects_closest_hit = true) {
-        set_ray_type(index, RayTypeDesc{std::move(name), &type_info_of<Payload>(),
-                                        expects_closest_hit});
+        set_ray_type(index,
+                     RayTypeDesc{std::move(name), &type_info_of<Payload>(), expects_closest_hit});
     }
     void set_ray_type(unsigned index, RayTypeDesc desc);
     unsigned ray_type_count() const;
@@ -112,9 +112,8 @@ public:
         return create_buffer(type, type_info_of<T>(), width, height, depth);
     }
     /// Width only: 1D; width and height: 2D; all three: 3D.
-    std::shared_ptr<Buffer> create_buffer(BufferType type, const TypeInfo& element,
-                                          unsigned width, unsigned height = 0,
-                                          unsigned depth = 0);
+    std::shared_ptr<Buffer> create_buffer(BufferType type, const TypeInfo& element, unsigned width,
+                                          unsigned height = 0, unsigned depth = 0);
     std::shared_ptr<TextureSampler> create_texture_sampler();
     std::shared_ptr<Acceleration> create_acceleration(Builder builder = Builder::kBinnedSah);
     std::shared_ptr<Group> create_group();
@@ -137,10 +136,10 @@ public:
 
     struct Impl;
 
-protected:
+  protected:
     void variables_changed() override;
 
-private:
+  private:
     std::unique_ptr<Impl> m_impl;
 };
 

@@ -8,7 +8,7 @@ namespace lucent {
 
 /// Thrown by every host call that is wrong; the message names the object and the fix.
 class Error : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 

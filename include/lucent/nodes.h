@@ -25,7 +25,7 @@ enum class Builder {
 
 /// The acceleration structure of a Group or GeometryGroup.
 class Acceleration : public ContextObject {
-public:
+  public:
     using ContextObject::ContextObject;
     std::string describe() const override;
     void set_builder(Builder builder);
@@ -39,26 +39,26 @@ public:
     bool dirty() const { return m_dirty; }
     void clear_dirty() { m_dirty = false; }
 
-private:
+  private:
     Builder m_builder = Builder::kBinnedSah;
     bool m_refit = false;
     bool m_dirty = true;
 };
 
 class Node : public ContextObject {
-public:
+  public:
     Node(detail::OwnerRef owner, std::string name, NodeKind kind)
         : ContextObject(std::move(owner), std::move(name)), m_kind(kind) {}
     NodeKind kind() const { return m_kind; }
     std::string describe() const override;
 
-private:
+  private:
     NodeKind m_kind;
 };
 
 /// Child list shared by Group and Selector.
 class NodeWithChildren : public Node {
-public:
+  public:
     using Node::Node;
     /// Appends a child; returns its index.
     unsigned add_child(std::shared_ptr<Node> child);
@@ -68,41 +68,42 @@ public:
     const std::shared_ptr<Node>& child(unsigned index) const;
     const std::vector<std::shared_ptr<Node>>& children() const { return m_children; }
 
-protected:
+  protected:
     virtual void children_changed() { changed(); }
     std::vector<std::shared_ptr<Node>> m_children;
 };
 
 /// Children of any node kind, under an acceleration structure (top of a two-level scene).
 class Group : public NodeWithChildren {
-public:
+  public:
     Group(detail::OwnerRef owner, std::string name, std::shared_ptr<Acceleration> accel)
-        : NodeWithChildren(std::move(owner), std::move(name), NodeKind::kGroup), m_accel(std::move(accel)) {}
+        : NodeWithChildren(std::move(owner), std::move(name), NodeKind::kGroup),
+          m_accel(std::move(accel)) {}
     const std::shared_ptr<Acceleration>& acceleration() const { return m_accel; }
     void set_acceleration(std::shared_ptr<Acceleration> accel);
 
-protected:
+  protected:
     void children_changed() override;
 
-private:
+  private:
     std::shared_ptr<Acceleration> m_accel;
 };
 
 /// Children chosen per ray by a visit program.
 class Selector : public NodeWithChildren {
-public:
+  public:
     Selector(detail::OwnerRef owner, std::string name)
         : NodeWithChildren(std::move(owner), std::move(name), NodeKind::kSelector) {}
     void set_visit_program(std::shared_ptr<Program> visit);
     const std::shared_ptr<Program>& visit_program() const { return m_visit; }
 
-private:
+  private:
     std::shared_ptr<Program> m_visit;
 };
 
 /// One child moved by an affine 4x3 matrix (object to world).
 class Transform : public Node {
-public:
+  public:
     Transform(detail::OwnerRef owner, std::string name);
     void set_child(std::shared_ptr<Node> child);
     const std::shared_ptr<Node>& child() const { return m_child; }
@@ -111,7 +112,7 @@ public:
     void set_matrix(const Matrix4x3& m) { set_matrix(m.m); }
     const Matrix4x3& matrix() const { return m_matrix; }
 
-private:
+  private:
     std::shared_ptr<Node> m_child;
     Matrix4x3 m_matrix;
 };
@@ -120,19 +121,19 @@ class Material;
 
 /// Common base of Geometry (custom primitives) and GeometryTriangles (built in).
 class GeometryBase : public ContextObject, public VariableScope {
-public:
+  public:
     using ContextObject::ContextObject;
     virtual bool is_triangles() const = 0;
     virtual unsigned primitive_count() const = 0;
     std::string scope_name() const override { return describe(); }
 
-protected:
+  protected:
     void variables_changed() override { changed(); }
 };
 
 /// Custom primitives: a bounding-box and an intersection program shared by all of them.
 class Geometry : public GeometryBase {
-public:
+  public:
     using GeometryBase::GeometryBase;
     std::string describe() const override;
     bool is_triangles() const override { return false; }
@@ -143,7 +144,7 @@ public:
     const std::shared_ptr<Program>& bounding_box_program() const { return m_bounds; }
     const std::shared_ptr<Program>& intersection_program() const { return m_intersect; }
 
-private:
+  private:
     unsigned m_count = 0;
     std::shared_ptr<Program> m_bounds, m_intersect;
 };
@@ -151,7 +152,7 @@ private:
 /// Built-in triangles: a float3 vertex buffer, an optional uint3 index buffer, an optional
 /// unsigned per-triangle material index buffer, and an optional attribute program.
 class GeometryTriangles : public GeometryBase {
-public:
+  public:
     using GeometryBase::GeometryBase;
     std::string describe() const override;
     bool is_triangles() const override { return true; }
@@ -165,14 +166,14 @@ public:
     const std::shared_ptr<Program>& attribute_program() const { return m_attributes; }
     unsigned primitive_count() const override;
 
-private:
+  private:
     std::shared_ptr<Buffer> m_vertices, m_indices, m_material_indices;
     std::shared_ptr<Program> m_attributes;
 };
 
 /// Closest-hit and any-hit programs per ray type.
 class Material : public ContextObject, public VariableScope {
-public:
+  public:
     using ContextObject::ContextObject;
     std::string describe() const override;
     std::string scope_name() const override { return describe(); }
@@ -184,16 +185,16 @@ public:
     /// One more than the highest ray type that has a program here.
     unsigned ray_type_slots() const { return unsigned(std::max(m_closest.size(), m_any.size())); }
 
-protected:
+  protected:
     void variables_changed() override { changed(); }
 
-private:
+  private:
     std::vector<std::shared_ptr<Program>> m_closest, m_any;
 };
 
 /// Binds a geometry to its materials (material index reported by intersection selects).
 class GeometryInstance : public ContextObject, public VariableScope {
-public:
+  public:
     using ContextObject::ContextObject;
     std::string describe() const override;
     std::string scope_name() const override { return describe(); }
@@ -205,20 +206,20 @@ public:
     unsigned material_count() const { return unsigned(m_materials.size()); }
     const std::shared_ptr<Material>& material(unsigned index) const;
 
-protected:
+  protected:
     void variables_changed() override { changed(); }
 
-private:
+  private:
     std::shared_ptr<GeometryBase> m_geometry;
     std::vector<std::shared_ptr<Material>> m_materials;
 };
 
 /// Leaves of the graph: geometry instances under one acceleration structure.
 class GeometryGroup : public Node {
-public:
-    GeometryGroup(detail::OwnerRef owner, std::string name,
-                  std::shared_ptr<Acceleration> accel)
-        : Node(std::move(owner), std::move(name), NodeKind::kGeometryGroup), m_accel(std::move(accel)) {}
+  public:
+    GeometryGroup(detail::OwnerRef owner, std::string name, std::shared_ptr<Acceleration> accel)
+        : Node(std::move(owner), std::move(name), NodeKind::kGeometryGroup),
+          m_accel(std::move(accel)) {}
     unsigned add_child(std::shared_ptr<GeometryInstance> instance);
     void set_child(unsigned index, std::shared_ptr<GeometryInstance> instance);
     void remove_child(unsigned index);
@@ -228,7 +229,7 @@ public:
     const std::shared_ptr<Acceleration>& acceleration() const { return m_accel; }
     void set_acceleration(std::shared_ptr<Acceleration> accel);
 
-private:
+  private:
     std::vector<std::shared_ptr<GeometryInstance>> m_children;
     std::shared_ptr<Acceleration> m_accel;
 };

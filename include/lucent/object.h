@@ -23,7 +23,7 @@ using OwnerRef = std::shared_ptr<ContextShared>;
 }  // namespace detail
 
 class ContextObject {
-public:
+  public:
     ContextObject(detail::OwnerRef owner, std::string name)
         : m_owner(std::move(owner)), m_name(std::move(name)) {}
     virtual ~ContextObject() = default;
@@ -37,11 +37,11 @@ public:
     virtual std::string describe() const;
     const detail::OwnerRef owner() const { return m_owner; }
 
-protected:
+  protected:
     void changed() { ++m_owner->generation; }
     detail::OwnerRef m_owner;
 
-private:
+  private:
     std::string m_name;
 };
 

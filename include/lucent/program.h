@@ -14,17 +14,17 @@
 namespace lucent {
 
 class Program : public ContextObject, public VariableScope {
-public:
+  public:
     Program(detail::OwnerRef owner, const ProgramDesc& desc);
     const ProgramDesc& desc() const { return *m_desc; }
     ProgramKind kind() const { return m_desc->kind; }
     std::string describe() const override;
     std::string scope_name() const override { return describe(); }
 
-protected:
+  protected:
     void variables_changed() override { changed(); }
 
-private:
+  private:
     const ProgramDesc* m_desc;
 };
 

@@ -49,7 +49,7 @@ class VariableScope;
 
 /// `scope["name"] = value;` — assigns a variable by name.
 class VariableRef {
-public:
+  public:
     VariableRef(VariableScope& scope, std::string name) : m_scope(scope), m_name(std::move(name)) {}
     VariableRef& operator=(float v) { return set(make_plain_value(v)); }
     VariableRef& operator=(float2 v) { return set(make_plain_value(v)); }
@@ -79,7 +79,7 @@ public:
     }
     VariableRef& set(VariableValue value);
 
-private:
+  private:
     VariableRef& set_node(std::shared_ptr<Node> node);
     VariableScope& m_scope;
     std::string m_name;
@@ -87,7 +87,7 @@ private:
 
 /// Something that holds variables by name.
 class VariableScope {
-public:
+  public:
     virtual ~VariableScope() = default;
     VariableRef operator[](std::string name) { return VariableRef(*this, std::move(name)); }
     /// The value set here, or null.
@@ -97,10 +97,10 @@ public:
     /// How the scope names itself in messages ("Material 'glass'", "Context").
     virtual std::string scope_name() const = 0;
 
-protected:
+  protected:
     virtual void variables_changed() {}
 
-private:
+  private:
     friend class VariableRef;
     std::map<std::string, VariableValue> m_variables;
 };

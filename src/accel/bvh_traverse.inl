@@ -9,8 +9,10 @@ inline float slab_entry(const BvhNode& n, float3 org, float3 inv_dir, float tmin
     float tx0 = (n.lo.x - org.x) * inv_dir.x, tx1 = (n.hi.x - org.x) * inv_dir.x;
     float ty0 = (n.lo.y - org.y) * inv_dir.y, ty1 = (n.hi.y - org.y) * inv_dir.y;
     float tz0 = (n.lo.z - org.z) * inv_dir.z, tz1 = (n.hi.z - org.z) * inv_dir.z;
-    float t_near = lc_max(lc_max(lc_min(tx0, tx1), lc_min(ty0, ty1)), lc_max(lc_min(tz0, tz1), tmin));
-    float t_far = lc_min(lc_min(lc_max(tx0, tx1), lc_max(ty0, ty1)), lc_min(lc_max(tz0, tz1), tmax));
+    float t_near =
+        lc_max(lc_max(lc_min(tx0, tx1), lc_min(ty0, ty1)), lc_max(lc_min(tz0, tz1), tmin));
+    float t_far =
+        lc_min(lc_min(lc_max(tx0, tx1), lc_max(ty0, ty1)), lc_min(lc_max(tz0, tz1), tmax));
     // 1 + 2 ulp on the far side keeps boxes of zero thickness (Ize 2013, robust BVH traversal)
     return t_near <= t_far * 1.00000024f ? t_near : kInfinity * 2.0f;
 }

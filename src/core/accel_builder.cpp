@@ -25,7 +25,9 @@ struct Hasher {  // FNV-1a over the bytes of the values that define an accelerat
     }
 };
 
-Aabb empty_box() { return Aabb{make_float3(kInfinity), make_float3(-kInfinity)}; }
+Aabb empty_box() {
+    return Aabb{make_float3(kInfinity), make_float3(-kInfinity)};
+}
 void grow(Aabb& b, float3 p) {
     b.lo = fminf(b.lo, p);
     b.hi = fmaxf(b.hi, p);
@@ -34,7 +36,9 @@ void grow(Aabb& b, const Aabb& o) {
     b.lo = fminf(b.lo, o.lo);
     b.hi = fmaxf(b.hi, o.hi);
 }
-bool is_empty(const Aabb& b) { return b.lo.x > b.hi.x; }
+bool is_empty(const Aabb& b) {
+    return b.lo.x > b.hi.x;
+}
 
 uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
     return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
@@ -79,7 +83,8 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         const CompiledInstance& inst = m_scene->instances[i];
         structure.add(inst.source).add(inst.triangles).add(inst.primitive_count);
         if (const GeometryTriangles* tris = triangles_of(inst)) {
-            structure.add(tris->indices().get()).add(tris->indices() ? tris->indices()->version() : 0);
+            structure.add(tris->indices().get())
+                .add(tris->indices() ? tris->indices()->version() : 0);
             content.add(tris->vertices().get()).add(tris->vertices()->version());
         } else {
             triangles_only = false;
@@ -118,8 +123,10 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
                 ga.tri_instance.push_back(k);
             }
         }
-        if (refit) ga.triangles.refit(ga.vertices, ga.indices);
-        else ga.triangles.build(ga.vertices, ga.indices);
+        if (refit)
+            ga.triangles.refit(ga.vertices, ga.indices);
+        else
+            ga.triangles.build(ga.vertices, ga.indices);
         ga.bounds = ga.triangles.triangle_count() ? ga.triangles.bounds() : empty_box();
     } else {
         std::vector<Aabb> boxes;
@@ -132,8 +139,10 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
                 if (!is_empty(boxes.back())) grow(all, boxes.back());
             }
         }
-        if (refit) ga.bvh.refit(boxes);
-        else ga.bvh.build(boxes);
+        if (refit)
+            ga.bvh.refit(boxes);
+        else
+            ga.bvh.build(boxes);
         ga.bounds = all;
     }
     ga.structure_signature = structure.h;
@@ -192,7 +201,8 @@ void SceneCompiler::build_accelerations() {
     }
     for (auto it = m_cache.begin(); it != m_cache.end();)
         it = used.count(it->first) ? std::next(it) : m_cache.erase(it);
-    m_accel_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    m_accel_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace lucent::core

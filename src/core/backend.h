@@ -9,7 +9,7 @@
 namespace lucent::core {
 
 class Backend {
-public:
+  public:
     virtual ~Backend() = default;
     /// "cpu (2 threads)", for the user.
     virtual std::string name() const = 0;

@@ -5,17 +5,22 @@ namespace lucent {
 
 const char* buffer_type_name(BufferType type) {
     switch (type) {
-        case BufferType::kInput: return "input";
-        case BufferType::kOutput: return "output";
-        case BufferType::kInputOutput: return "input-output";
+        case BufferType::kInput:
+            return "input";
+        case BufferType::kOutput:
+            return "output";
+        case BufferType::kInputOutput:
+            return "input-output";
     }
     return "?";
 }
 
-std::string ContextObject::describe() const { return "object '" + m_name + "'"; }
+std::string ContextObject::describe() const {
+    return "object '" + m_name + "'";
+}
 
-Buffer::Buffer(detail::OwnerRef owner, std::string name, BufferType type,
-               const TypeInfo& element, unsigned dimensionality, uint3 size)
+Buffer::Buffer(detail::OwnerRef owner, std::string name, BufferType type, const TypeInfo& element,
+               unsigned dimensionality, uint3 size)
     : ContextObject(std::move(owner), std::move(name)),
       m_type(type),
       m_element(&element),
@@ -52,8 +57,8 @@ void Buffer::resize(unsigned width, unsigned height, unsigned depth) {
 void Buffer::check_element(const TypeInfo& requested) const {
     if (requested.tag != m_element->tag)
         throw Error(describe() + ": accessed as " + std::string(requested.name) +
-                    " but its elements are " + std::string(m_element->name) +
-                    "; map it with map<" + std::string(m_element->name) + ">()");
+                    " but its elements are " + std::string(m_element->name) + "; map it with map<" +
+                    std::string(m_element->name) + ">()");
 }
 
 void Buffer::sync_from_device() const {
@@ -68,10 +73,13 @@ void Buffer::unmap() {
     changed();
 }
 
-std::string TextureSampler::describe() const { return "TextureSampler '" + name() + "'"; }
+std::string TextureSampler::describe() const {
+    return "TextureSampler '" + name() + "'";
+}
 
 void TextureSampler::set_buffer(std::shared_ptr<Buffer> texels) {
-    if (texels && (texels->dimensionality() != 2 || texels->element().tag != type_info_of<float4>().tag))
+    if (texels &&
+        (texels->dimensionality() != 2 || texels->element().tag != type_info_of<float4>().tag))
         throw Error(describe() + ": texels must be a 2D buffer of float4, got " +
                     texels->describe());
     m_buffer = std::move(texels);

@@ -15,13 +15,13 @@ namespace lucent::core {
 
 /// A program's record, resolved and packed (16-byte aligned storage).
 class PackedRecord {
-public:
+  public:
     void resize(size_t bytes) { m_blocks.assign((bytes + 15) / 16, Block{}); }
     unsigned char* data() { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
     const unsigned char* data() const { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
     size_t size() const { return m_blocks.size() * 16; }
 
-private:
+  private:
     struct alignas(16) Block {
         unsigned char bytes[16];
     };
@@ -33,12 +33,15 @@ struct CompiledProgram {
     const ProgramDesc* desc = nullptr;
     std::shared_ptr<PackedRecord> record;  // shared: callables point into it
     std::string label;                     // "closest hit 'phong' of Material 'glass'"
-    std::vector<std::shared_ptr<const Buffer>> buffers;  // every buffer the record views (kept alive)
+    std::vector<std::shared_ptr<const Buffer>>
+        buffers;  // every buffer the record views (kept alive)
 
     explicit operator bool() const { return desc != nullptr; }
     const void* rec() const { return record ? record->data() : nullptr; }
     template <class Fn>
-    Fn entry() const { return reinterpret_cast<Fn>(desc->entry); }
+    Fn entry() const {
+        return reinterpret_cast<Fn>(desc->entry);
+    }
 };
 
 struct CompiledMaterial {
@@ -65,25 +68,25 @@ struct GeometryAccel {
     uint64_t structure_signature = 0;  // instances, primitive counts, index buffers
     uint64_t content_signature = 0;    // vertex buffer versions, bounding-box records
     bool triangles_only = false;
-    accel::TriangleAccel triangles;     // triangles_only: all instances' triangles together
-    std::vector<float3> vertices;       // the concatenated vertices
-    std::vector<uint3> indices;         // concatenated, rebased indices
-    std::vector<uint32_t> tri_instance; // triangle → position in CompiledNode::instances
-    accel::Bvh bvh;                     // otherwise: over every primitive of every instance
-    std::vector<uint32_t> prim_first;   // per instance: first global primitive (and triangle)
+    accel::TriangleAccel triangles;      // triangles_only: all instances' triangles together
+    std::vector<float3> vertices;        // the concatenated vertices
+    std::vector<uint3> indices;          // concatenated, rebased indices
+    std::vector<uint32_t> tri_instance;  // triangle → position in CompiledNode::instances
+    accel::Bvh bvh;                      // otherwise: over every primitive of every instance
+    std::vector<uint32_t> prim_first;    // per instance: first global primitive (and triangle)
     Aabb bounds{};
 };
 
 struct CompiledNode {
     NodeKind kind = NodeKind::kGroup;
     const Node* source = nullptr;
-    std::vector<unsigned> children;   // node indices (Transform: one)
-    std::vector<unsigned> instances;  // GeometryGroup: CompiledInstance indices
+    std::vector<unsigned> children;           // node indices (Transform: one)
+    std::vector<unsigned> instances;          // GeometryGroup: CompiledInstance indices
     std::shared_ptr<GeometryAccel> geometry;  // GeometryGroup
-    accel::Bvh child_bvh;             // Group: over children's boxes
-    bool brute_force = false;         // Builder::kNone
-    Matrix4x3 to_world{}, to_object{};  // Transform
-    CompiledProgram visit;            // Selector
+    accel::Bvh child_bvh;                     // Group: over children's boxes
+    bool brute_force = false;                 // Builder::kNone
+    Matrix4x3 to_world{}, to_object{};        // Transform
+    CompiledProgram visit;                    // Selector
     Aabb bounds{};
     std::vector<bool> any_hit_for_ray_type;  // GeometryGroup: some material has any-hit
 };

@@ -26,7 +26,9 @@ struct Context::Impl {
     int jit_check_sm = 0;
     unsigned next_id = 0;
 
-    std::string next_name(const char* kind) { return std::string(kind) + "#" + std::to_string(++next_id); }
+    std::string next_name(const char* kind) {
+        return std::string(kind) + "#" + std::to_string(++next_id);
+    }
 };
 
 namespace {
@@ -66,16 +68,22 @@ Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     }
 }
 
-const std::string& Context::backend_notice() const { return m_impl->notice; }
+const std::string& Context::backend_notice() const {
+    return m_impl->notice;
+}
 
 Context::~Context() {
     // Buffers may outlive the Context: they must not call into its backend any more.
     m_impl->shared->fetch_from_device = nullptr;
 }
 
-std::string Context::backend_name() const { return m_impl->backend->name(); }
+std::string Context::backend_name() const {
+    return m_impl->backend->name();
+}
 
-void Context::variables_changed() { ++m_impl->shared->generation; }
+void Context::variables_changed() {
+    ++m_impl->shared->generation;
+}
 
 // ---- entry points and ray types ------------------------------------------------------
 namespace {
@@ -98,7 +106,9 @@ void Context::set_entry_point_count(unsigned count) {
     m_impl->state.entries.resize(count);
     ++m_impl->shared->generation;
 }
-unsigned Context::entry_point_count() const { return unsigned(m_impl->state.entries.size()); }
+unsigned Context::entry_point_count() const {
+    return unsigned(m_impl->state.entries.size());
+}
 
 void Context::set_ray_generation_program(unsigned entry, std::shared_ptr<Program> program) {
     check_entry(m_impl->state, entry, "set_ray_generation_program");
@@ -126,7 +136,8 @@ void Context::set_ray_type(unsigned index, RayTypeDesc desc) {
     if (index >= 64)
         throw Error("Context::set_ray_type: ray type " + std::to_string(index) +
                     " is out of range (at most 64 ray types, numbered from 0)");
-    if (!desc.payload) throw Error("Context::set_ray_type: ray type '" + desc.name + "' needs a payload type");
+    if (!desc.payload)
+        throw Error("Context::set_ray_type: ray type '" + desc.name + "' needs a payload type");
     auto& s = m_impl->state;
     if (s.ray_types.size() <= index) {
         s.ray_types.resize(index + 1);
@@ -135,7 +146,9 @@ void Context::set_ray_type(unsigned index, RayTypeDesc desc) {
     s.ray_types[index] = std::move(desc);
     ++m_impl->shared->generation;
 }
-unsigned Context::ray_type_count() const { return unsigned(m_impl->state.ray_types.size()); }
+unsigned Context::ray_type_count() const {
+    return unsigned(m_impl->state.ray_types.size());
+}
 const RayTypeDesc& Context::ray_type(unsigned index) const {
     if (index >= m_impl->state.ray_types.size())
         throw Error("Context::ray_type: ray type " + std::to_string(index) +
@@ -165,7 +178,9 @@ void Context::set_max_recursion_depth(unsigned depth) {
     m_impl->state.max_depth = depth;
     ++m_impl->shared->generation;
 }
-unsigned Context::max_recursion_depth() const { return m_impl->state.max_depth; }
+unsigned Context::max_recursion_depth() const {
+    return m_impl->state.max_depth;
+}
 
 void Context::set_exception_enabled(int code, bool enabled) {
     auto& codes = m_impl->state.enabled_exceptions;
@@ -177,9 +192,12 @@ void Context::set_exception_enabled(int code, bool enabled) {
     } else {
         if (exception_enabled(kAllExceptions)) {
             // Expand "all" into the engine codes so one can be turned off.
-            codes = {kExceptionStackOverflow, kExceptionBufferIndexOutOfBounds,
-                     kExceptionPayloadTypeMismatch, kExceptionInvalidHandle,
-                     kExceptionInvalidRayType, kExceptionMaterialIndexOutOfRange,
+            codes = {kExceptionStackOverflow,
+                     kExceptionBufferIndexOutOfBounds,
+                     kExceptionPayloadTypeMismatch,
+                     kExceptionInvalidHandle,
+                     kExceptionInvalidRayType,
+                     kExceptionMaterialIndexOutOfRange,
                      kUserExceptionBase};
         }
         codes.erase(std::remove(codes.begin(), codes.end(), code), codes.end());
@@ -198,7 +216,9 @@ void Context::set_print_enabled(bool enabled) {
     m_impl->state.print_enabled = enabled;
     ++m_impl->shared->generation;
 }
-bool Context::print_enabled() const { return m_impl->state.print_enabled; }
+bool Context::print_enabled() const {
+    return m_impl->state.print_enabled;
+}
 void Context::set_print_launch_index(int x, int y, int z) {
     m_impl->state.print_index = int3{x, y, z};
     ++m_impl->shared->generation;
@@ -228,7 +248,8 @@ std::shared_ptr<Acceleration> Context::create_acceleration(Builder builder) {
     return a;
 }
 std::shared_ptr<Group> Context::create_group() {
-    return std::make_shared<Group>(m_impl->shared, m_impl->next_name("group"), create_acceleration());
+    return std::make_shared<Group>(m_impl->shared, m_impl->next_name("group"),
+                                   create_acceleration());
 }
 std::shared_ptr<GeometryGroup> Context::create_geometry_group() {
     return std::make_shared<GeometryGroup>(m_impl->shared, m_impl->next_name("geometry_group"),
@@ -241,7 +262,8 @@ std::shared_ptr<Selector> Context::create_selector() {
     return std::make_shared<Selector>(m_impl->shared, m_impl->next_name("selector"));
 }
 std::shared_ptr<GeometryInstance> Context::create_geometry_instance() {
-    return std::make_shared<GeometryInstance>(m_impl->shared, m_impl->next_name("geometry_instance"));
+    return std::make_shared<GeometryInstance>(m_impl->shared,
+                                              m_impl->next_name("geometry_instance"));
 }
 std::shared_ptr<Geometry> Context::create_geometry() {
     return std::make_shared<Geometry>(m_impl->shared, m_impl->next_name("geometry"));
@@ -259,7 +281,8 @@ void check_ray_generation(const core::CompiledScene& scene, unsigned entry) {
     if (!scene.entries[entry].ray_generation)
         throw Error("Context: entry point " + std::to_string(entry) +
                     " has no ray generation program; bind one with "
-                    "set_ray_generation_program(" + std::to_string(entry) + ", program)");
+                    "set_ray_generation_program(" +
+                    std::to_string(entry) + ", program)");
 }
 }  // namespace
 
@@ -270,11 +293,13 @@ void Context::validate() {
         if (!m_impl->state.entries[e].ray_generation)
             throw Error("Context: entry point " + std::to_string(e) +
                         " has no ray generation program; bind one with "
-                        "set_ray_generation_program(" + std::to_string(e) +
-                        ", program) or lower the entry point count");
+                        "set_ray_generation_program(" +
+                        std::to_string(e) + ", program) or lower the entry point count");
 }
 
-void Context::launch(unsigned entry, unsigned width) { launch(entry, width, 1, 1); }
+void Context::launch(unsigned entry, unsigned width) {
+    launch(entry, width, 1, 1);
+}
 void Context::launch(unsigned entry, unsigned width, unsigned height) {
     launch(entry, width, height, 1);
 }
@@ -310,9 +335,11 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     for (const Buffer* out : scene.entries[entry].output_buffers) {
         uint3 s = out->size();
         if (out->dimensionality() == dims && (s.x != width || s.y != height || s.z != depth))
-            throw Error("Context::launch: " + out->describe() + " is written by the ray generation program of entry " +
+            throw Error("Context::launch: " + out->describe() +
+                        " is written by the ray generation program of entry " +
                         std::to_string(entry) + " but the launch is " + std::to_string(width) +
-                        "x" + std::to_string(height) + (dims == 3 ? "x" + std::to_string(depth) : "") +
+                        "x" + std::to_string(height) +
+                        (dims == 3 ? "x" + std::to_string(depth) : "") +
                         "; resize the buffer to the launch size");
     }
     auto t1 = Clock::now();
@@ -321,7 +348,9 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     m_impl->last = std::move(report);
 }
 
-const LaunchReport& Context::last_launch() const { return m_impl->last; }
+const LaunchReport& Context::last_launch() const {
+    return m_impl->last;
+}
 
 // ---- reports ------------------------------------------------------------------------------
 uint64_t LaunchReport::exception_count() const {
@@ -332,16 +361,24 @@ uint64_t LaunchReport::exception_count() const {
 
 std::string exception_name(int code) {
     switch (code) {
-        case kExceptionStackOverflow: return "stack overflow";
-        case kExceptionBufferIndexOutOfBounds: return "buffer index out of bounds";
-        case kExceptionPayloadTypeMismatch: return "payload type mismatch";
-        case kExceptionInvalidHandle: return "invalid node handle";
-        case kExceptionInvalidRayType: return "invalid ray type";
-        case kExceptionMaterialIndexOutOfRange: return "material index out of range";
+        case kExceptionStackOverflow:
+            return "stack overflow";
+        case kExceptionBufferIndexOutOfBounds:
+            return "buffer index out of bounds";
+        case kExceptionPayloadTypeMismatch:
+            return "payload type mismatch";
+        case kExceptionInvalidHandle:
+            return "invalid node handle";
+        case kExceptionInvalidRayType:
+            return "invalid ray type";
+        case kExceptionMaterialIndexOutOfRange:
+            return "material index out of range";
     }
     std::ostringstream s;
-    if (code >= kUserExceptionBase) s << "user exception 0x" << std::hex << code;
-    else s << "exception " << code;
+    if (code >= kUserExceptionBase)
+        s << "user exception 0x" << std::hex << code;
+    else
+        s << "exception " << code;
     return s.str();
 }
 
@@ -355,7 +392,8 @@ std::string LaunchReport::summary() const {
 
 bool core::CompiledScene::exception_enabled(int code) const {
     for (int c : enabled_exceptions)
-        if (c == kAllExceptions || c == code || (code >= kUserExceptionBase && c == kUserExceptionBase))
+        if (c == kAllExceptions || c == code ||
+            (code >= kUserExceptionBase && c == kUserExceptionBase))
             return true;
     return false;
 }

@@ -7,10 +7,14 @@ namespace lucent {
 
 const char* node_kind_name(NodeKind kind) {
     switch (kind) {
-        case NodeKind::kGroup: return "Group";
-        case NodeKind::kGeometryGroup: return "GeometryGroup";
-        case NodeKind::kTransform: return "Transform";
-        case NodeKind::kSelector: return "Selector";
+        case NodeKind::kGroup:
+            return "Group";
+        case NodeKind::kGeometryGroup:
+            return "GeometryGroup";
+        case NodeKind::kTransform:
+            return "Transform";
+        case NodeKind::kSelector:
+            return "Selector";
     }
     return "?";
 }
@@ -18,7 +22,9 @@ const char* node_kind_name(NodeKind kind) {
 namespace {
 template <class T>
 void require(const std::shared_ptr<T>& p, const ContextObject& owner, const char* what) {
-    if (!p) throw Error(owner.describe() + ": " + what + " is null; pass an object created by the Context");
+    if (!p)
+        throw Error(owner.describe() + ": " + what +
+                    " is null; pass an object created by the Context");
 }
 template <class T>
 void require_same_context(const std::shared_ptr<T>& p, const ContextObject& owner) {
@@ -34,7 +40,9 @@ std::string index_error(const ContextObject& owner, const char* what, unsigned i
 }
 }  // namespace
 
-std::string Acceleration::describe() const { return "Acceleration '" + name() + "'"; }
+std::string Acceleration::describe() const {
+    return "Acceleration '" + name() + "'";
+}
 void Acceleration::set_builder(Builder builder) {
     m_builder = builder;
     mark_dirty();
@@ -62,17 +70,20 @@ unsigned NodeWithChildren::add_child(std::shared_ptr<Node> child) {
 void NodeWithChildren::set_child(unsigned index, std::shared_ptr<Node> child) {
     require(child, *this, "child");
     require_same_context(child, *this);
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     m_children[index] = std::move(child);
     children_changed();
 }
 void NodeWithChildren::remove_child(unsigned index) {
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     m_children.erase(m_children.begin() + index);
     children_changed();
 }
 const std::shared_ptr<Node>& NodeWithChildren::child(unsigned index) const {
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     return m_children[index];
 }
 
@@ -116,7 +127,9 @@ void Transform::set_matrix(const float m[12], bool transpose) {
     changed();
 }
 
-std::string Geometry::describe() const { return "Geometry '" + name() + "'"; }
+std::string Geometry::describe() const {
+    return "Geometry '" + name() + "'";
+}
 void Geometry::set_primitive_count(unsigned count) {
     m_count = count;
     changed();
@@ -138,7 +151,9 @@ void Geometry::set_intersection_program(std::shared_ptr<Program> program) {
     changed();
 }
 
-std::string GeometryTriangles::describe() const { return "GeometryTriangles '" + name() + "'"; }
+std::string GeometryTriangles::describe() const {
+    return "GeometryTriangles '" + name() + "'";
+}
 void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     require(vertices, *this, "vertex buffer");
     if (vertices->element().tag != type_info_of<float3>().tag || vertices->dimensionality() != 1)
@@ -148,9 +163,9 @@ void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     changed();
 }
 void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
-    if (indices && (indices->dimensionality() != 1 ||
-                    (indices->element().tag != type_info_of<uint3>().tag &&
-                     indices->element().tag != type_info_of<int3>().tag)))
+    if (indices &&
+        (indices->dimensionality() != 1 || (indices->element().tag != type_info_of<uint3>().tag &&
+                                            indices->element().tag != type_info_of<int3>().tag)))
         throw Error(describe() + ": indices must be a 1D buffer of uint3 or int3, got " +
                     indices->describe());
     m_indices = std::move(indices);
@@ -176,7 +191,9 @@ unsigned GeometryTriangles::primitive_count() const {
     return m_vertices ? unsigned(m_vertices->count() / 3) : 0;
 }
 
-std::string Material::describe() const { return "Material '" + name() + "'"; }
+std::string Material::describe() const {
+    return "Material '" + name() + "'";
+}
 void Material::set_closest_hit(unsigned ray_type, std::shared_ptr<Program> program) {
     if (program && program->kind() != ProgramKind::kClosestHit)
         throw Error(describe() + ": " + program->describe() +
@@ -206,7 +223,9 @@ std::shared_ptr<Program> Material::any_hit(unsigned ray_type) const {
     return ray_type < m_any.size() ? m_any[ray_type] : nullptr;
 }
 
-std::string GeometryInstance::describe() const { return "GeometryInstance '" + name() + "'"; }
+std::string GeometryInstance::describe() const {
+    return "GeometryInstance '" + name() + "'";
+}
 void GeometryInstance::set_geometry(std::shared_ptr<GeometryBase> geometry) {
     require(geometry, *this, "geometry");
     require_same_context(geometry, *this);
@@ -243,17 +262,20 @@ unsigned GeometryGroup::add_child(std::shared_ptr<GeometryInstance> instance) {
 void GeometryGroup::set_child(unsigned index, std::shared_ptr<GeometryInstance> instance) {
     require(instance, *this, "child");
     require_same_context(instance, *this);
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     m_children[index] = std::move(instance);
     m_accel->mark_dirty();
 }
 void GeometryGroup::remove_child(unsigned index) {
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     m_children.erase(m_children.begin() + index);
     m_accel->mark_dirty();
 }
 const std::shared_ptr<GeometryInstance>& GeometryGroup::child(unsigned index) const {
-    if (index >= m_children.size()) throw Error(index_error(*this, "child", index, m_children.size()));
+    if (index >= m_children.size())
+        throw Error(index_error(*this, "child", index, m_children.size()));
     return m_children[index];
 }
 void GeometryGroup::set_acceleration(std::shared_ptr<Acceleration> accel) {

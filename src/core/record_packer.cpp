@@ -17,15 +17,40 @@ std::string chain_names(const ScopeChain& chain) {
 
 bool is_integer_kind(FieldKind k, int& lanes, bool& is_signed) {
     switch (k) {
-        case FieldKind::kInt: lanes = 1; is_signed = true; return true;
-        case FieldKind::kInt2: lanes = 2; is_signed = true; return true;
-        case FieldKind::kInt3: lanes = 3; is_signed = true; return true;
-        case FieldKind::kInt4: lanes = 4; is_signed = true; return true;
-        case FieldKind::kUint: lanes = 1; is_signed = false; return true;
-        case FieldKind::kUint2: lanes = 2; is_signed = false; return true;
-        case FieldKind::kUint3: lanes = 3; is_signed = false; return true;
-        case FieldKind::kUint4: lanes = 4; is_signed = false; return true;
-        default: return false;
+        case FieldKind::kInt:
+            lanes = 1;
+            is_signed = true;
+            return true;
+        case FieldKind::kInt2:
+            lanes = 2;
+            is_signed = true;
+            return true;
+        case FieldKind::kInt3:
+            lanes = 3;
+            is_signed = true;
+            return true;
+        case FieldKind::kInt4:
+            lanes = 4;
+            is_signed = true;
+            return true;
+        case FieldKind::kUint:
+            lanes = 1;
+            is_signed = false;
+            return true;
+        case FieldKind::kUint2:
+            lanes = 2;
+            is_signed = false;
+            return true;
+        case FieldKind::kUint3:
+            lanes = 3;
+            is_signed = false;
+            return true;
+        case FieldKind::kUint4:
+            lanes = 4;
+            is_signed = false;
+            return true;
+        default:
+            return false;
     }
 }
 
@@ -93,29 +118,35 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
             const Buffer& b = *value.buffer;
             if (b.element().tag != field.element->tag)
                 throw Error(where + ": the program reads BufferView<" +
-                            std::string(field.element->name) + "> but " + b.describe() +
-                            " holds " + std::string(b.element().name) +
+                            std::string(field.element->name) + "> but " + b.describe() + " holds " +
+                            std::string(b.element().name) +
                             "; bind a buffer created with that element type");
-            BufferView<unsigned char> view{const_cast<unsigned char*>(
-                                               static_cast<const unsigned char*>(b.raw())),
-                                           b.size(), checked ? unsigned(kViewBoundsChecked) : 0u};
+            BufferView<unsigned char> view{
+                const_cast<unsigned char*>(static_cast<const unsigned char*>(b.raw())), b.size(),
+                checked ? unsigned(kViewBoundsChecked) : 0u};
             std::memcpy(dst, &view, sizeof view);
             if (output_buffers && b.type() != BufferType::kInput) output_buffers->push_back(&b);
             return;
         }
         case FieldKind::kTexture: {
-            if (value.kind != FieldKind::kTexture || !value.texture) throw mismatch("texture sampler");
+            if (value.kind != FieldKind::kTexture || !value.texture)
+                throw mismatch("texture sampler");
             const TextureSampler& t = *value.texture;
             if (!t.buffer())
                 throw Error(where + ": " + t.describe() +
                             " has no texels; give it a 2D float4 buffer with set_buffer");
-            TextureView view{t.buffer()->data<float4>(), t.buffer()->size().x,
-                             t.buffer()->size().y, t.wrap_u(), t.wrap_v(), t.filter()};
+            TextureView view{t.buffer()->data<float4>(),
+                             t.buffer()->size().x,
+                             t.buffer()->size().y,
+                             t.wrap_u(),
+                             t.wrap_v(),
+                             t.filter()};
             std::memcpy(dst, &view, sizeof view);
             return;
         }
         case FieldKind::kHandle: {
-            if (value.kind != FieldKind::kHandle || !value.node) throw mismatch("node (Group, GeometryGroup, Transform or Selector)");
+            if (value.kind != FieldKind::kHandle || !value.node)
+                throw mismatch("node (Group, GeometryGroup, Transform or Selector)");
             Handle h{node_index(value.node)};
             std::memcpy(dst, &h, sizeof h);
             return;

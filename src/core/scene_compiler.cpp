@@ -23,7 +23,7 @@ bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
     float id = 1.0f / det;
     float r[9] = {c00 * id, (m[2] * m[9] - m[1] * m[10]) * id, (m[1] * m[6] - m[2] * m[5]) * id,
                   c01 * id, (m[0] * m[10] - m[2] * m[8]) * id, (m[2] * m[4] - m[0] * m[6]) * id,
-                  c02 * id, (m[1] * m[8] - m[0] * m[9]) * id, (m[0] * m[5] - m[1] * m[4]) * id};
+                  c02 * id, (m[1] * m[8] - m[0] * m[9]) * id,  (m[0] * m[5] - m[1] * m[4]) * id};
     for (int row = 0; row < 3; ++row) {
         float t = -(r[row * 3] * m[3] + r[row * 3 + 1] * m[7] + r[row * 3 + 2] * m[11]);
         inv.m[row * 4 + 0] = r[row * 3 + 0];
@@ -41,7 +41,9 @@ std::unique_ptr<CompiledScene> SceneCompiler::compile() {
     return std::move(m_scene);
 }
 
-void SceneCompiler::validate_only() { compile_graph(); }
+void SceneCompiler::validate_only() {
+    compile_graph();
+}
 
 void SceneCompiler::compile_graph() {
     m_scene = std::make_unique<CompiledScene>();
@@ -116,7 +118,8 @@ void SceneCompiler::compile_node(unsigned index) {
             CompiledNode& c = m_scene->nodes[index];
             c.children = std::move(children);
             if (node.kind() == NodeKind::kGroup) {
-                c.brute_force = static_cast<const Group&>(node).acceleration()->builder() == Builder::kNone;
+                c.brute_force =
+                    static_cast<const Group&>(node).acceleration()->builder() == Builder::kNone;
             } else {
                 auto& visit = static_cast<const Selector&>(node).visit_program();
                 if (!visit)
@@ -166,8 +169,7 @@ void SceneCompiler::compile_node(unsigned index) {
 
 void SceneCompiler::compile_instance(unsigned index) {
     const GeometryInstance& gi = *m_scene->instances[index].source;
-    if (!gi.geometry())
-        throw Error(gi.describe() + " has no geometry; set one with set_geometry");
+    if (!gi.geometry()) throw Error(gi.describe() + " has no geometry; set one with set_geometry");
     if (gi.material_count() == 0)
         throw Error(gi.describe() + " has no material; add one with add_material");
     const GeometryBase& geometry = *gi.geometry();
@@ -195,14 +197,16 @@ void SceneCompiler::compile_instance(unsigned index) {
                                 " vertices; fix the index buffer");
             }
         } else if (vertex_count % 3 != 0) {
-            throw Error(tris.describe() + ": without an index buffer the vertex count must be a "
-                        "multiple of 3, got " + std::to_string(vertex_count));
+            throw Error(tris.describe() +
+                        ": without an index buffer the vertex count must be a "
+                        "multiple of 3, got " +
+                        std::to_string(vertex_count));
         }
         if (tris.material_indices()) {
             if (tris.material_indices()->count() != out.primitive_count)
                 throw Error(tris.describe() + ": the material index buffer has " +
-                            std::to_string(tris.material_indices()->count()) +
-                            " entries for " + std::to_string(out.primitive_count) +
+                            std::to_string(tris.material_indices()->count()) + " entries for " +
+                            std::to_string(out.primitive_count) +
                             " triangles; give one per triangle");
             out.material_indices = tris.material_indices()->data<unsigned>();
             for (unsigned i = 0; i < out.primitive_count; ++i)
@@ -210,11 +214,12 @@ void SceneCompiler::compile_instance(unsigned index) {
                     throw Error(tris.describe() + ": triangle " + std::to_string(i) +
                                 " selects material " + std::to_string(out.material_indices[i]) +
                                 " but " + gi.describe() + " has " +
-                                std::to_string(gi.material_count()) + "; add materials or fix the index");
+                                std::to_string(gi.material_count()) +
+                                "; add materials or fix the index");
         }
         out.attribute = pack(tris.attribute_program(), geometry_scope, gi.describe());
-        out.attributes = out.attribute ? out.attribute.desc->attributes
-                                       : &type_info_of<TriangleAttributes>();
+        out.attributes =
+            out.attribute ? out.attribute.desc->attributes : &type_info_of<TriangleAttributes>();
     } else {
         auto& custom = static_cast<const Geometry&>(geometry);
         if (!custom.intersection_program())
@@ -275,8 +280,7 @@ void SceneCompiler::check_cycles() const {
                     in = in || p == c;
                     if (in) cycle += nodes[p].source->describe() + " -> ";
                 }
-                throw Error("the scene graph has a cycle: " + cycle +
-                            nodes[c].source->describe() +
+                throw Error("the scene graph has a cycle: " + cycle + nodes[c].source->describe() +
                             "; a node may not be its own descendant (remove one of these edges)");
             }
             if (state[c] == 0) self(self, c);
@@ -313,12 +317,12 @@ void SceneCompiler::check_types() const {
                                     "attribute) program and the hit programs");
                 }
                 if (scene.ray_types[r].expects_closest_hit && !mat.closest_hit[r])
-                    throw Error(inst.source->material(m)->describe() + " in " +
-                                inst.source->describe() + " has no closest-hit program for " +
-                                ray_type_label(m_state, r) +
-                                ", which reaches it; bind one with set_closest_hit(" +
-                                std::to_string(r) + ", program), or declare the ray type with "
-                                "expects_closest_hit = false if it only needs any-hit");
+                    throw Error(
+                        inst.source->material(m)->describe() + " in " + inst.source->describe() +
+                        " has no closest-hit program for " + ray_type_label(m_state, r) +
+                        ", which reaches it; bind one with set_closest_hit(" + std::to_string(r) +
+                        ", program), or declare the ray type with "
+                        "expects_closest_hit = false if it only needs any-hit");
             }
         }
     }

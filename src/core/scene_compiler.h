@@ -25,9 +25,8 @@ struct ScopeChain {
 };
 
 class SceneCompiler {
-public:
-    SceneCompiler(const ContextState& state, AccelCache& cache)
-        : m_state(state), m_cache(cache) {}
+  public:
+    SceneCompiler(const ContextState& state, AccelCache& cache) : m_state(state), m_cache(cache) {}
 
     /// Full compile for a launch.
     std::unique_ptr<CompiledScene> compile();
@@ -36,7 +35,7 @@ public:
     /// Time spent building/refitting acceleration structures in compile().
     double accel_ms() const { return m_accel_ms; }
 
-private:
+  private:
     void compile_graph();
     unsigned node_index(const std::shared_ptr<Node>& node);
     unsigned instance_index(const GeometryInstance& instance);

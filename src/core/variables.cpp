@@ -9,13 +9,18 @@ namespace lucent {
 
 std::string VariableValue::describe() const {
     switch (kind) {
-        case FieldKind::kBuffer: return buffer ? buffer->describe() : "a null buffer";
-        case FieldKind::kTexture: return texture ? texture->describe() : "a null texture";
-        case FieldKind::kHandle: return node ? node->describe() : "a null node";
-        case FieldKind::kCallable: return program ? program->describe() : "a null program";
+        case FieldKind::kBuffer:
+            return buffer ? buffer->describe() : "a null buffer";
+        case FieldKind::kTexture:
+            return texture ? texture->describe() : "a null texture";
+        case FieldKind::kHandle:
+            return node ? node->describe() : "a null node";
+        case FieldKind::kCallable:
+            return program ? program->describe() : "a null program";
         case FieldKind::kUserData:
             return "user data " + std::string(user_type ? user_type->name : "?");
-        default: return field_kind_name(kind);
+        default:
+            return field_kind_name(kind);
     }
 }
 

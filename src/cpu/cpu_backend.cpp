@@ -35,19 +35,20 @@ struct WorkerExceptions {
 };
 
 class CpuBackend final : public core::Backend {
-public:
+  public:
     explicit CpuBackend(unsigned threads) : m_pool(threads) {}
 
     std::string name() const override {
-        return "cpu (" + std::to_string(m_pool.size()) + " thread" + (m_pool.size() == 1 ? "" : "s") + ")";
+        return "cpu (" + std::to_string(m_pool.size()) + " thread" +
+               (m_pool.size() == 1 ? "" : "s") + ")";
     }
 
     void launch(const core::CompiledScene& scene, unsigned entry, uint3 size,
                 LaunchReport& report) override {
         const core::CompiledEntry& e = scene.entries[entry];
         const bool one_d = size.y == 1 && size.z == 1;
-        const unsigned tiles_x = one_d ? (size.x + kTile1D - 1) / kTile1D
-                                       : (size.x + kTileWidth - 1) / kTileWidth;
+        const unsigned tiles_x =
+            one_d ? (size.x + kTile1D - 1) / kTile1D : (size.x + kTileWidth - 1) / kTileWidth;
         const unsigned tiles_y = one_d ? 1 : (size.y + kTileHeight - 1) / kTileHeight;
         const uint64_t tile_count = uint64_t(tiles_x) * tiles_y * size.z;
 
@@ -97,7 +98,7 @@ public:
         for (auto& [code, m] : merged) report.exceptions[code] = {m.count, m.first_index};
     }
 
-private:
+  private:
     static void run_index(ThreadState& ts, const core::CompiledScene& scene,
                           const core::CompiledEntry& e, uint3 index, WorkerExceptions& out) {
         ts.launch_index = index;
@@ -110,7 +111,8 @@ private:
         try {
             e.ray_generation.entry<RayGenerationFn>()(e.ray_generation.rec());
         } catch (const ProgramException& ex) {
-            uint64_t linear = (uint64_t(index.z) * ts.launch_size.y + index.y) * ts.launch_size.x + index.x;
+            uint64_t linear =
+                (uint64_t(index.z) * ts.launch_size.y + index.y) * ts.launch_size.x + index.x;
             out.add(ex.code, index, linear);
             if (e.exception && scene.exception_enabled(ex.code)) {
                 ts.depth = 0;

@@ -15,8 +15,15 @@ constexpr size_t kAttributeBytes = 256;
 using core::ProgramException;
 
 enum class ProgramContext {
-    kRayGeneration, kException, kMiss, kClosestHit, kAnyHit, kIntersection, kVisit,
-    kAttribute, kBoundingBox,
+    kRayGeneration,
+    kException,
+    kMiss,
+    kClosestHit,
+    kAnyHit,
+    kIntersection,
+    kVisit,
+    kAttribute,
+    kBoundingBox,
 };
 
 struct alignas(16) AttributeStorage {
@@ -37,8 +44,8 @@ struct HitState {
 };
 
 struct TraceFrame {
-    Ray world_ray;    // as passed to trace()
-    Ray object_ray;   // in the space of the node being traversed
+    Ray world_ray;   // as passed to trace()
+    Ray object_ray;  // in the space of the node being traversed
     void* payload = nullptr;
     unsigned ray_type = 0;
     float closest = 0;  // upper end of the ray interval: shrinks with each committed hit

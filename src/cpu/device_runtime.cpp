@@ -21,7 +21,9 @@ ThreadState& thread_state() {
     static thread_local ThreadState idle;
     return t_state ? *t_state : idle;
 }
-void set_thread_state(ThreadState* state) { t_state = state; }
+void set_thread_state(ThreadState* state) {
+    t_state = state;
+}
 bool report_candidate(ThreadState& ts, unsigned material);
 }  // namespace cpu
 
@@ -48,9 +50,13 @@ void trace_erased(Handle root, const Ray& ray, void* payload, const void* payloa
     cpu::trace(cpu::thread_state(), root, ray, payload, payload_tag);
 }
 
-void raise_exception(int code, unsigned detail) { throw cpu::ProgramException{code, detail}; }
+void raise_exception(int code, unsigned detail) {
+    throw cpu::ProgramException{code, detail};
+}
 
-bool print_enabled_here() { return cpu::thread_state().print_here; }
+bool print_enabled_here() {
+    return cpu::thread_state().print_here;
+}
 
 void print_text(const char* text) {
     std::lock_guard lock(cpu::g_print_mutex);
@@ -59,8 +65,12 @@ void print_text(const char* text) {
 }
 }  // namespace detail
 
-uint3 launch_index() { return cpu::thread_state().launch_index; }
-uint3 launch_size() { return cpu::thread_state().launch_size; }
+uint3 launch_index() {
+    return cpu::thread_state().launch_index;
+}
+uint3 launch_size() {
+    return cpu::thread_state().launch_size;
+}
 
 const Ray& current_ray() {
     TraceFrame* f = cpu::thread_state().current();
@@ -69,8 +79,10 @@ const Ray& current_ray() {
         case ProgramContext::kIntersection:
         case ProgramContext::kAnyHit:
         case ProgramContext::kVisit:
-        case ProgramContext::kAttribute: return f->object_ray;
-        default: return f->world_ray;
+        case ProgramContext::kAttribute:
+            return f->object_ray;
+        default:
+            return f->world_ray;
     }
 }
 
@@ -78,10 +90,14 @@ float t_hit() {
     TraceFrame* f = cpu::thread_state().current();
     if (!f) return 0.0f;
     switch (f->context) {
-        case ProgramContext::kAnyHit: return f->candidate_t;
-        case ProgramContext::kClosestHit: return f->hit.t;
-        case ProgramContext::kMiss: return f->world_ray.tmax;
-        default: return f->closest;
+        case ProgramContext::kAnyHit:
+            return f->candidate_t;
+        case ProgramContext::kClosestHit:
+            return f->hit.t;
+        case ProgramContext::kMiss:
+            return f->world_ray.tmax;
+        default:
+            return f->closest;
     }
 }
 

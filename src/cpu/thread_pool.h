@@ -10,7 +10,7 @@
 namespace lucent::cpu {
 
 class ThreadPool {
-public:
+  public:
     /// `threads` workers in all, counting the calling thread; 0 = one per core.
     explicit ThreadPool(unsigned threads);
     ~ThreadPool();
@@ -18,7 +18,7 @@ public:
     /// Runs job(worker) on every worker (0 .. size()-1) and returns when all are done.
     void run(const std::function<void(unsigned worker)>& job);
 
-private:
+  private:
     void worker_loop(unsigned worker);
     unsigned m_size;
     std::vector<std::thread> m_threads;

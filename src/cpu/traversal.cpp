@@ -36,20 +36,28 @@ uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
 }
 
 class Traverser {
-public:
+  public:
     Traverser(ThreadState& ts, TraceFrame& frame) : m_ts(ts), m_frame(frame), m_scene(*ts.scene) {}
 
     void node(unsigned index, float3 origin, float3 direction) {
         const CompiledNode& n = m_scene.nodes[index];
         switch (n.kind) {
-            case NodeKind::kGeometryGroup: geometry_group(n, origin, direction); break;
-            case NodeKind::kGroup: group(n, origin, direction); break;
-            case NodeKind::kTransform: transform(n, origin, direction); break;
-            case NodeKind::kSelector: selector(n, origin, direction); break;
+            case NodeKind::kGeometryGroup:
+                geometry_group(n, origin, direction);
+                break;
+            case NodeKind::kGroup:
+                group(n, origin, direction);
+                break;
+            case NodeKind::kTransform:
+                transform(n, origin, direction);
+                break;
+            case NodeKind::kSelector:
+                selector(n, origin, direction);
+                break;
         }
     }
 
-private:
+  private:
     void group(const CompiledNode& n, float3 origin, float3 direction) {
         auto visit = [&](uint32_t child) {
             node(n.children[child], origin, direction);
@@ -71,7 +79,8 @@ private:
         m_frame.to_world = was ? compose(to_world, n.to_world) : n.to_world;
         m_frame.to_object = was ? compose(n.to_object, to_object) : n.to_object;
         m_frame.transformed = true;
-        node(n.children[0], transform_point(n.to_object, origin), transform_vector(n.to_object, direction));
+        node(n.children[0], transform_point(n.to_object, origin),
+             transform_vector(n.to_object, direction));
         m_frame.transformed = was;
         m_frame.to_world = to_world;
         m_frame.to_object = to_object;
@@ -118,8 +127,8 @@ private:
                 uint3 tri = triangle_of(inst, local);
                 float t, u, v;
                 if (intersect_triangle_watertight(wray, inst.vertices[tri.x], inst.vertices[tri.y],
-                                                  inst.vertices[tri.z], tmin, m_frame.closest, t,
-                                                  u, v)) {
+                                                  inst.vertices[tri.z], tmin, m_frame.closest, t, u,
+                                                  v)) {
                     unsigned global_tri = ref;  // prim_first doubles as the triangle numbering
                     triangle_candidate(n, global_tri, k, local, t, make_float2(u, v));
                 }
@@ -129,10 +138,10 @@ private:
             return m_frame.terminated;
         };
         if (n.brute_force) {
-            uint32_t total = ga.prim_first.empty()
-                                 ? 0
-                                 : ga.prim_first.back() +
-                                       m_scene.instances[n.instances.back()].primitive_count;
+            uint32_t total =
+                ga.prim_first.empty()
+                    ? 0
+                    : ga.prim_first.back() + m_scene.instances[n.instances.back()].primitive_count;
             for (uint32_t ref = 0; ref < total; ++ref)
                 if (visit(ref)) return;
         } else {
@@ -144,9 +153,10 @@ private:
     /// Global triangle → (position in the group, local index).
     void locate_triangle(const CompiledNode& n, unsigned global, size_t& k, unsigned& local) const {
         const core::GeometryAccel& ga = *n.geometry;
-        k = ga.triangles_only ? ga.tri_instance[global]
-                              : size_t(std::upper_bound(ga.prim_first.begin(), ga.prim_first.end(),
-                                                        global) - ga.prim_first.begin() - 1);
+        k = ga.triangles_only
+                ? ga.tri_instance[global]
+                : size_t(std::upper_bound(ga.prim_first.begin(), ga.prim_first.end(), global) -
+                         ga.prim_first.begin() - 1);
         local = global - ga.prim_first[k];
     }
 
@@ -193,7 +203,7 @@ private:
         return true;
     }
 
-public:
+  public:
     /// Fills `out` with the attributes of a triangle hit: the attribute program's, or the
     /// built-in TriangleAttributes (barycentrics and object-space geometric normal).
     static void compute_triangle_attributes(ThreadState& ts, const CompiledInstance& inst,
@@ -214,7 +224,7 @@ public:
         std::memcpy(out.bytes, &a, sizeof a);
     }
 
-private:
+  private:
     // ---- custom primitives ---------------------------------------------------------------
     void custom_primitive(unsigned instance_index, const CompiledInstance& inst, unsigned prim) {
         m_frame.instance = &inst;
@@ -222,7 +232,8 @@ private:
         m_frame.prim = prim;
         ProgramContext saved = m_frame.context;
         m_frame.context = ProgramContext::kIntersection;
-        inst.intersection.entry<IntersectionFn>()(inst.intersection.rec(), prim, m_frame.scratch.bytes);
+        inst.intersection.entry<IntersectionFn>()(inst.intersection.rec(), prim,
+                                                  m_frame.scratch.bytes);
         m_frame.context = saved;
     }
 
@@ -232,7 +243,7 @@ private:
         m_frame.object_ray.direction = direction;
     }
 
-public:
+  public:
     /// Runs an any-hit program on the candidate in the frame; false when it was ignored.
     static bool run_any_hit(TraceFrame& frame, const core::CompiledProgram& any_hit) {
         ProgramContext saved = frame.context;
@@ -247,7 +258,8 @@ public:
     }
 
     /// Records a hit as the closest so far (attributes are filled by the caller).
-    static void commit(TraceFrame& frame, unsigned instance, unsigned prim, float t, unsigned material) {
+    static void commit(TraceFrame& frame, unsigned instance, unsigned prim, float t,
+                       unsigned material) {
         frame.has_hit = true;
         frame.closest = t;
         HitState& h = frame.hit;
@@ -263,7 +275,7 @@ public:
         }
     }
 
-private:
+  private:
     bool run_any_hit(const core::CompiledProgram& any_hit) { return run_any_hit(m_frame, any_hit); }
     void begin_commit(unsigned instance, unsigned prim, float t, unsigned material) {
         commit(m_frame, instance, prim, t, material);
@@ -297,7 +309,8 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
         throw ProgramException{kExceptionInvalidRayType, ray.ray_type};
     if (payload_tag != scene.ray_types[ray.ray_type].payload->tag)
         throw ProgramException{kExceptionPayloadTypeMismatch, ray.ray_type};
-    if (root.index >= scene.nodes.size()) throw ProgramException{kExceptionInvalidHandle, root.index};
+    if (root.index >= scene.nodes.size())
+        throw ProgramException{kExceptionInvalidHandle, root.index};
     if (ts.depth >= scene.max_depth) throw ProgramException{kExceptionStackOverflow, ts.depth + 1};
 
     TraceFrame& frame = ts.frames[ts.depth++];
@@ -331,10 +344,12 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
                 frame.object_ray.origin = transform_point(hit.to_object, ray.origin);
                 frame.object_ray.direction = transform_vector(hit.to_object, ray.direction);
             }
-            Traverser::compute_triangle_attributes(ts, inst, hit.prim, hit.barycentrics, hit.attributes);
+            Traverser::compute_triangle_attributes(ts, inst, hit.prim, hit.barycentrics,
+                                                   hit.attributes);
         }
         frame.object_ray = ray;
-        const core::CompiledProgram& closest = inst.materials[hit.material].closest_hit[ray.ray_type];
+        const core::CompiledProgram& closest =
+            inst.materials[hit.material].closest_hit[ray.ray_type];
         if (closest) {
             frame.context = ProgramContext::kClosestHit;
             closest.entry<HitFn>()(closest.rec(), payload, hit.attributes.bytes);

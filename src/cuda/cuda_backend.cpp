@@ -19,7 +19,7 @@ namespace {
 constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
 
 class CudaBackend final : public core::Backend {
-public:
+  public:
     explicit CudaBackend(const DriverApi& d) : m_driver(d) {
         check(d.cuDeviceGet(&m_device, 0), "cuDeviceGet");
         char name[256] = {};
@@ -126,7 +126,8 @@ public:
                                          "_ZN6lucent3gpu6paramsE"),
               "find the launch parameters");
         int blocks_per_sm = 0;
-        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks_per_sm, m_kernel, kBlock, 0),
+        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks_per_sm, m_kernel, kBlock,
+                                                                   0),
               "occupancy");
         m_grid = std::max(1, blocks_per_sm) * m_sm_count;
         // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
@@ -135,7 +136,7 @@ public:
         m_source = std::move(kernel.source);
     }
 
-private:
+  private:
     const DriverApi& m_driver;
     CUdevice m_device = 0;
     CUcontext m_context = nullptr;

@@ -61,7 +61,8 @@ Loaded load() {
     LUCENT_LOAD(cuEventElapsedTime, "cuEventElapsedTime")
     LUCENT_LOAD(cuGetErrorString, "cuGetErrorString")
     LUCENT_LOAD(cuFuncGetAttribute, "cuFuncGetAttribute")
-    LUCENT_LOAD(cuOccupancyMaxActiveBlocksPerMultiprocessor, "cuOccupancyMaxActiveBlocksPerMultiprocessor")
+    LUCENT_LOAD(cuOccupancyMaxActiveBlocksPerMultiprocessor,
+                "cuOccupancyMaxActiveBlocksPerMultiprocessor")
 #undef LUCENT_LOAD
     if (missing) return l;
     if (CUresult r = l.api.cuInit(0); r != CUDA_SUCCESS) {
@@ -90,7 +91,8 @@ void check(CUresult result, const char* what) {
     if (result == CUDA_SUCCESS) return;
     const char* s = nullptr;
     if (const DriverApi* d = driver()) d->cuGetErrorString(result, &s);
-    throw Error(std::string("CUDA: ") + what + ": " + (s ? s : "error " + std::to_string(int(result))));
+    throw Error(std::string("CUDA: ") + what + ": " +
+                (s ? s : "error " + std::to_string(int(result))));
 }
 
 }  // namespace lucent::cuda

@@ -11,8 +11,10 @@ namespace lucent::cuda {
 namespace {
 template <class T>
 void put(DeviceBuffer& memory, const std::vector<T>& values) {
-    if (values.empty()) memory.reset();
-    else memory.upload(values.data(), values.size() * sizeof(T));
+    if (values.empty())
+        memory.reset();
+    else
+        memory.upload(values.data(), values.size() * sizeof(T));
 }
 
 const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
@@ -95,7 +97,8 @@ void GpuScene::patch_record(unsigned char* bytes, const core::CompiledProgram& p
                 std::memcpy(at, &c, sizeof c);
                 break;
             }
-            default: break;
+            default:
+                break;
         }
     }
 }
@@ -193,7 +196,8 @@ void GpuScene::update(const core::CompiledScene& scene) {
             a.instance_count = unsigned(n.instances.size());
             accel_instances.insert(accel_instances.end(), n.instances.begin(), n.instances.end());
             a.prim_first_offset = unsigned(accel_prim_first.size());
-            accel_prim_first.insert(accel_prim_first.end(), ga.prim_first.begin(), ga.prim_first.end());
+            accel_prim_first.insert(accel_prim_first.end(), ga.prim_first.begin(),
+                                    ga.prim_first.end());
             a.prim_total = 0;
             for (unsigned i : n.instances) a.prim_total += scene.instances[i].primitive_count;
             if (ga.triangles_only) {
@@ -258,9 +262,12 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_params.print_enabled = scene.print_enabled;
     m_params.print_index = scene.print_index;
     for (int code : scene.enabled_exceptions) {
-        if (code == kAllExceptions) m_params.exception_mask = ~0u;
-        else if (code >= kUserExceptionBase) m_params.exception_mask |= 1u << 31;
-        else if (code > 0 && code < 31) m_params.exception_mask |= 1u << code;
+        if (code == kAllExceptions)
+            m_params.exception_mask = ~0u;
+        else if (code >= kUserExceptionBase)
+            m_params.exception_mask |= 1u << 31;
+        else if (code > 0 && code < 31)
+            m_params.exception_mask |= 1u << code;
     }
     for (auto it = m_geometry.begin(); it != m_geometry.end();)
         it = used_geometry.count(it->first) ? std::next(it) : m_geometry.erase(it);

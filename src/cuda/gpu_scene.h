@@ -15,7 +15,7 @@
 namespace lucent::cuda {
 
 class GpuScene {
-public:
+  public:
     /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
     /// buffers whose host contents changed.
     void update(const core::CompiledScene& scene);
@@ -33,7 +33,7 @@ public:
     gpu::ProgramRef ray_generation(unsigned entry) const { return m_entries[entry].first; }
     gpu::ProgramRef exception(unsigned entry) const { return m_entries[entry].second; }
 
-private:
+  private:
     struct BufferMirror {
         DeviceBuffer memory;
         uint64_t version = 0;
@@ -62,7 +62,8 @@ private:
     gpu::LaunchParams m_params{};
     // Device copies of the flat arrays.
     DeviceBuffer m_nodes, m_children, m_bvh_nodes, m_prim_order, m_bvhs, m_accels,
-        m_accel_instances, m_accel_prim_first, m_instances, m_materials, m_record_blob, m_miss, m_payload_signatures;
+        m_accel_instances, m_accel_prim_first, m_instances, m_materials, m_record_blob, m_miss,
+        m_payload_signatures;
 };
 
 }  // namespace lucent::cuda

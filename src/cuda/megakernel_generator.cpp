@@ -41,28 +41,50 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
 namespace {
 const char* kind_function(ProgramKind kind) {
     switch (kind) {
-        case ProgramKind::kRayGeneration: return "__device__ void dispatch_ray_generation(int id, const void* rec)";
-        case ProgramKind::kException: return "__device__ void dispatch_exception(int id, const void* rec, const ExceptionInfo& ex)";
-        case ProgramKind::kMiss: return "__device__ void dispatch_miss(int id, const void* rec, void* prd)";
-        case ProgramKind::kClosestHit: return "__device__ void dispatch_closest_hit(int id, const void* rec, void* prd, const void* attr)";
-        case ProgramKind::kAnyHit: return "__device__ void dispatch_any_hit(int id, const void* rec, void* prd, const void* attr)";
-        case ProgramKind::kIntersection: return "__device__ void dispatch_intersection(int id, const void* rec, unsigned prim, void* attr)";
-        case ProgramKind::kVisit: return "__device__ unsigned dispatch_visit(int id, const void* rec)";
-        case ProgramKind::kAttribute: return "__device__ void dispatch_attribute(int id, const void* rec, unsigned prim, float2 bary, void* attr)";
-        default: return nullptr;
+        case ProgramKind::kRayGeneration:
+            return "__device__ void dispatch_ray_generation(int id, const void* rec)";
+        case ProgramKind::kException:
+            return "__device__ void dispatch_exception(int id, const void* rec, const "
+                   "ExceptionInfo& ex)";
+        case ProgramKind::kMiss:
+            return "__device__ void dispatch_miss(int id, const void* rec, void* prd)";
+        case ProgramKind::kClosestHit:
+            return "__device__ void dispatch_closest_hit(int id, const void* rec, void* prd, const "
+                   "void* attr)";
+        case ProgramKind::kAnyHit:
+            return "__device__ void dispatch_any_hit(int id, const void* rec, void* prd, const "
+                   "void* attr)";
+        case ProgramKind::kIntersection:
+            return "__device__ void dispatch_intersection(int id, const void* rec, unsigned prim, "
+                   "void* attr)";
+        case ProgramKind::kVisit:
+            return "__device__ unsigned dispatch_visit(int id, const void* rec)";
+        case ProgramKind::kAttribute:
+            return "__device__ void dispatch_attribute(int id, const void* rec, unsigned prim, "
+                   "float2 bary, void* attr)";
+        default:
+            return nullptr;
     }
 }
 const char* kind_call(ProgramKind kind) {
     switch (kind) {
-        case ProgramKind::kRayGeneration: return "invoke(&::%s, rec)";
-        case ProgramKind::kException: return "invoke(&::%s, rec, ex)";
-        case ProgramKind::kMiss: return "invoke(&::%s, rec, prd)";
+        case ProgramKind::kRayGeneration:
+            return "invoke(&::%s, rec)";
+        case ProgramKind::kException:
+            return "invoke(&::%s, rec, ex)";
+        case ProgramKind::kMiss:
+            return "invoke(&::%s, rec, prd)";
         case ProgramKind::kClosestHit:
-        case ProgramKind::kAnyHit: return "invoke(&::%s, rec, prd, attr)";
-        case ProgramKind::kIntersection: return "invoke(&::%s, rec, prim, attr)";
-        case ProgramKind::kVisit: return "return invoke_visit(&::%s, rec)";
-        case ProgramKind::kAttribute: return "invoke(&::%s, rec, prim, bary, attr)";
-        default: return nullptr;
+        case ProgramKind::kAnyHit:
+            return "invoke(&::%s, rec, prd, attr)";
+        case ProgramKind::kIntersection:
+            return "invoke(&::%s, rec, prim, attr)";
+        case ProgramKind::kVisit:
+            return "return invoke_visit(&::%s, rec)";
+        case ProgramKind::kAttribute:
+            return "invoke(&::%s, rec, prim, bary, attr)";
+        default:
+            return nullptr;
     }
 }
 std::string format_call(const char* pattern, const ProgramDesc& desc) {
@@ -116,8 +138,9 @@ void generate_callables(std::ostringstream& out, const std::vector<const Program
         out << ") {\n    const void* rec = ::lucent::gpu::params.records + record;\n"
             << "    switch (id) {\n";
         for (size_t i : ids)
-            out << "        case " << i << ": return ::lucent::gpu::invoke_callable(&::"
-                << list[i]->scope << list[i]->name << ", rec" << args << ");\n";
+            out << "        case " << i
+                << ": return ::lucent::gpu::invoke_callable(&::" << list[i]->scope << list[i]->name
+                << ", rec" << args << ");\n";
         out << "        default: break;\n    }\n";
         if (result != "void") out << "    return " << result << "{};\n";
         out << "}\n";

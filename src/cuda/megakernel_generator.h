@@ -14,14 +14,14 @@ namespace lucent::cuda {
 
 /// Dispatch ids of the bound programs, one numbering per program kind.
 class ProgramTable {
-public:
+  public:
     /// The program's id in its kind's switch (assigned on first sight); -1 for none.
     int id(const core::CompiledProgram& program);
     const std::vector<const ProgramDesc*>& programs(ProgramKind kind) const {
         return m_lists[size_t(kind)];
     }
 
-private:
+  private:
     static constexpr size_t kKinds = size_t(ProgramKind::kCallable) + 1;
     std::array<std::map<const ProgramDesc*, int>, kKinds> m_ids;
     std::array<std::vector<const ProgramDesc*>, kKinds> m_lists;
@@ -29,7 +29,7 @@ private:
 
 /// What the generated kernel is specialised on.
 struct KernelShape {
-    bool groups = false;            // Group nodes (else every root is a GeometryGroup, or nested)
+    bool groups = false;  // Group nodes (else every root is a GeometryGroup, or nested)
     bool transforms = false;
     bool selectors = false;
     bool generic_geometry = false;  // custom primitives, or a group not made only of triangles

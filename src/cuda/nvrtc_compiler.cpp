@@ -36,9 +36,9 @@ const NvrtcApi& nvrtc() {
         NvrtcApi a;
         std::vector<std::string> candidates;
         if (const char* p = std::getenv("LUCENT_NVRTC")) candidates.push_back(p);
-        candidates.insert(candidates.end(), {"libnvrtc.so.13", "libnvrtc.so",
-                                             "/usr/local/cuda/lib64/libnvrtc.so.13",
-                                             "/usr/local/cuda/lib64/libnvrtc.so"});
+        candidates.insert(candidates.end(),
+                          {"libnvrtc.so.13", "libnvrtc.so", "/usr/local/cuda/lib64/libnvrtc.so.13",
+                           "/usr/local/cuda/lib64/libnvrtc.so"});
         void* lib = nullptr;
         for (auto& c : candidates)
             if ((lib = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL))) break;
@@ -109,7 +109,8 @@ bool read_entry(const std::filesystem::path& file, const std::string& key, std::
     return checksum(cubin) == sum;
 }
 
-void write_entry(const std::filesystem::path& file, const std::string& key, const std::string& cubin) {
+void write_entry(const std::filesystem::path& file, const std::string& key,
+                 const std::string& cubin) {
     std::error_code ec;
     std::filesystem::create_directories(file.parent_path(), ec);
     auto tmp = file;
@@ -174,7 +175,8 @@ CompileResult compile_cubin(const CompileRequest& request) {
 
     CompileResult result;
     const std::string dir = kernel_cache_dir();
-    const std::filesystem::path file = dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / (hex + ".cubin");
+    const std::filesystem::path file =
+        dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / (hex + ".cubin");
     if (!dir.empty() && read_entry(file, hex, result.cubin)) {
         result.from_cache = true;
         result.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -189,8 +191,9 @@ CompileResult compile_cubin(const CompileRequest& request) {
     }
     for (auto& o : options) option_ptrs.push_back(o.c_str());
     nvrtcProgram program;
-    if (nvrtcResult r = api.create(&program, request.source.c_str(), request.name.c_str(),
-                                   int(header_text.size()), header_text.data(), header_names.data());
+    if (nvrtcResult r =
+            api.create(&program, request.source.c_str(), request.name.c_str(),
+                       int(header_text.size()), header_text.data(), header_names.data());
         r != NVRTC_SUCCESS)
         throw Error(std::string("NVRTC: cannot create program: ") + api.error_string(r));
     nvrtcResult compiled = api.compile(program, int(option_ptrs.size()), option_ptrs.data());

@@ -9,18 +9,18 @@
 namespace lucent::cuda {
 
 struct CompileRequest {
-    std::string name;                                        // e.g. "megakernel.cu"
+    std::string name;  // e.g. "megakernel.cu"
     std::string source;
     std::vector<std::pair<std::string, std::string>> headers;  // include name → text
-    std::vector<std::string> options;                        // besides the architecture
-    int sm = 90;                                             // compute capability * 10
+    std::vector<std::string> options;                          // besides the architecture
+    int sm = 90;                                               // compute capability * 10
 };
 
 struct CompileResult {
     std::string cubin;
     bool from_cache = false;
-    double ms = 0;        // compile (cold) or cache load time
-    std::string log;      // NVRTC's log, even on success
+    double ms = 0;    // compile (cold) or cache load time
+    std::string log;  // NVRTC's log, even on success
 };
 
 /// Compiles (or loads from the cache) a CUBIN. Throws lucent::Error with NVRTC's log on

@@ -59,7 +59,9 @@ LUCENT_RAY_GENERATION(common_cast, CasterRecord) {
     rec.results[i] = p;
 }
 
-LUCENT_MISS(common_miss, NoRecord, TestPayload) { prd.hit = 0; }
+LUCENT_MISS(common_miss, NoRecord, TestPayload) {
+    prd.hit = 0;
+}
 
 // ---- spheres: float4 (centre, radius) per primitive ----------------------------
 struct SphereAttributes {

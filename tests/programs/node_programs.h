@@ -16,9 +16,13 @@ struct ChoiceRecord {
     unsigned choice;
 };
 LUCENT_RECORD(ChoiceRecord, choice)
-LUCENT_VISIT(nt_visit_by_choice, ChoiceRecord) { return rec.choice; }
+LUCENT_VISIT(nt_visit_by_choice, ChoiceRecord) {
+    return rec.choice;
+}
 
-LUCENT_VISIT(nt_visit_by_launch_index, NoRecord) { return launch_index().x % 2u; }
+LUCENT_VISIT(nt_visit_by_launch_index, NoRecord) {
+    return launch_index().x % 2u;
+}
 
 // ---- a second ray type with its own payload and root ---------------------------------
 struct ShadowPayload {
@@ -27,7 +31,9 @@ struct ShadowPayload {
     unsigned id;
 };
 
-LUCENT_MISS(nt_shadow_miss, NoRecord, ShadowPayload) { prd.hit = 0; }
+LUCENT_MISS(nt_shadow_miss, NoRecord, ShadowPayload) {
+    prd.hit = 0;
+}
 
 LUCENT_CLOSEST_HIT(nt_shadow_hit, IdRecord, ShadowPayload, SphereAttributes) {
     prd.hit = 1;
@@ -60,10 +66,10 @@ LUCENT_RAY_GENERATION(nt_two_roots, TwoRootsRecord) {
 /// What an attribute program sees below a Transform: the world-space normal it computes,
 /// primitive_index() and the ray it is given.
 struct SpaceAttributes {
-    float3 world_normal;    // object_to_world_normal of the object-space geometric normal
-    float3 ray_origin;      // current_ray().origin inside the attribute program
-    unsigned api_prim;      // primitive_index() inside the attribute program
-    unsigned prim;          // the prim argument
+    float3 world_normal;  // object_to_world_normal of the object-space geometric normal
+    float3 ray_origin;    // current_ray().origin inside the attribute program
+    unsigned api_prim;    // primitive_index() inside the attribute program
+    unsigned prim;        // the prim argument
 };
 LUCENT_ATTRIBUTE(nt_space_attributes, NoRecord, SpaceAttributes) {
     attr.world_normal = normalize(object_to_world_normal(make_float3(0, 0, 1)));

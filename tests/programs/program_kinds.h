@@ -114,8 +114,8 @@ LUCENT_RECORD(TexcoordRecord, indices, texcoords)
 LUCENT_ATTRIBUTE(pk_texcoord_attributes, TexcoordRecord, TexcoordAttributes) {
     const uint3 tri = rec.indices[prim];
     const float u = barycentrics.x, v = barycentrics.y;
-    attr.texcoord = rec.texcoords[tri.x] * (1.0f - u - v) + rec.texcoords[tri.y] * u +
-                    rec.texcoords[tri.z] * v;
+    attr.texcoord =
+        rec.texcoords[tri.x] * (1.0f - u - v) + rec.texcoords[tri.y] * u + rec.texcoords[tri.z] * v;
     attr.prim = prim;
 }
 LUCENT_CLOSEST_HIT(pk_texcoord_hit, IdRecord, TestPayload, TexcoordAttributes) {
@@ -144,13 +144,17 @@ struct ScaleRecord {
     float factor;
 };
 LUCENT_RECORD(ScaleRecord, factor)
-LUCENT_CALLABLE(pk_scale, ScaleRecord, float3, (float3 v)) { return v * rec.factor; }
+LUCENT_CALLABLE(pk_scale, ScaleRecord, float3, (float3 v)) {
+    return v * rec.factor;
+}
 
 struct OffsetRecord {
     float3 offset;
 };
 LUCENT_RECORD(OffsetRecord, offset)
-LUCENT_CALLABLE(pk_offset, OffsetRecord, float3, (float3 v)) { return v + rec.offset; }
+LUCENT_CALLABLE(pk_offset, OffsetRecord, float3, (float3 v)) {
+    return v + rec.offset;
+}
 
 struct CallerRecord {
     Callable<float3(float3)> shade;

@@ -11,7 +11,9 @@ struct OtherPayload {
     float value;
 };
 
-LUCENT_MISS(vat_miss_other, NoRecord, OtherPayload) { prd.value = 0; }
+LUCENT_MISS(vat_miss_other, NoRecord, OtherPayload) {
+    prd.value = 0;
+}
 LUCENT_CLOSEST_HIT(vat_closest_other, NoRecord, OtherPayload, TriangleAttributes) {
     prd.value = t_hit();
 }
@@ -45,9 +47,15 @@ struct CallFloatRecord {
     Callable<float(float)> fn;
 };
 LUCENT_RECORD(CallFloatRecord, fn)
-LUCENT_RAY_GENERATION(vat_call_float, CallFloatRecord) { (void)rec.fn(1.0f); }
+LUCENT_RAY_GENERATION(vat_call_float, CallFloatRecord) {
+    (void)rec.fn(1.0f);
+}
 
-LUCENT_CALLABLE(vat_callable_float3, NoRecord, float3, (float3 v)) { return v; }
-LUCENT_CALLABLE(vat_callable_float, NoRecord, float, (float v)) { return v; }
+LUCENT_CALLABLE(vat_callable_float3, NoRecord, float3, (float3 v)) {
+    return v;
+}
+LUCENT_CALLABLE(vat_callable_float, NoRecord, float, (float v)) {
+    return v;
+}
 
 }  // namespace lucent_tests

@@ -69,7 +69,9 @@ struct VtAnyRecord {
     float ah_value;
 };
 LUCENT_RECORD(VtAnyRecord, ah_value)
-LUCENT_ANY_HIT(vt_any, VtAnyRecord, VtPayload, VtAttributes) { prd.ah = rec.ah_value; }
+LUCENT_ANY_HIT(vt_any, VtAnyRecord, VtPayload, VtAttributes) {
+    prd.ah = rec.ah_value;
+}
 
 // ---- miss, ray generation, exception, visit --------------------------------------
 struct VtMissRecord {
@@ -95,20 +97,26 @@ LUCENT_RAY_GENERATION(vt_cast, VtCastRecord) {
     rec.out[0] = p;
 }
 
-LUCENT_RAY_GENERATION(vt_throw, NoRecord) { throw_exception(kUserExceptionBase + 1); }
+LUCENT_RAY_GENERATION(vt_throw, NoRecord) {
+    throw_exception(kUserExceptionBase + 1);
+}
 
 struct VtExceptionRecord {
     float ex_value;
     BufferView<float> ex_log;
 };
 LUCENT_RECORD(VtExceptionRecord, ex_value, ex_log)
-LUCENT_EXCEPTION(vt_exception, VtExceptionRecord) { rec.ex_log[0] = rec.ex_value; }
+LUCENT_EXCEPTION(vt_exception, VtExceptionRecord) {
+    rec.ex_log[0] = rec.ex_value;
+}
 
 struct VtVisitRecord {
     unsigned visit_value;
 };
 LUCENT_RECORD(VtVisitRecord, visit_value)
-LUCENT_VISIT(vt_visit, VtVisitRecord) { return rec.visit_value; }
+LUCENT_VISIT(vt_visit, VtVisitRecord) {
+    return rec.visit_value;
+}
 
 // ---- a record with a field of every kind ------------------------------------------
 struct Light {
@@ -163,13 +171,17 @@ struct AllKinds {
 LUCENT_RECORD(AllKinds, f, f2, f3, f4, i, i2, i3, i4, u, u2, u3, u4, m, values, tex, scene, fn,
               light, all_out)
 
-LUCENT_CALLABLE(vt_negate, NoRecord, float3, (float3 v)) { return -v; }
+LUCENT_CALLABLE(vt_negate, NoRecord, float3, (float3 v)) {
+    return -v;
+}
 
 struct VtScaleRecord {
     float scale;
 };
 LUCENT_RECORD(VtScaleRecord, scale)
-LUCENT_CALLABLE(vt_scale, VtScaleRecord, float3, (float3 v)) { return v * rec.scale; }
+LUCENT_CALLABLE(vt_scale, VtScaleRecord, float3, (float3 v)) {
+    return v * rec.scale;
+}
 
 LUCENT_RAY_GENERATION(vt_all_kinds, AllKinds) {
     AllKindsOut o;

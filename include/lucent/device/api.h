@@ -102,7 +102,8 @@ LUCENT_HD inline float3 world_to_object_normal(float3 n) {
 #if !LUCENT_GPU_CODE
 [[noreturn]]
 #endif
-LUCENT_HD inline void throw_exception(int code, unsigned detail = 0) {
+LUCENT_HD inline void
+throw_exception(int code, unsigned detail = 0) {
     detail::raise_exception(code < kUserExceptionBase ? kUserExceptionBase : code, detail);
 }
 
@@ -136,7 +137,7 @@ LUCENT_HD T& BufferView<T>::out_of_bounds(unsigned linear) const {
 #if LUCENT_GPU_CODE && defined(LUCENT_GPU_EXCEPTIONS) && !LUCENT_GPU_EXCEPTIONS
 #define LUCENT_BOUNDS_CHECKED(flags) false
 #else
-#define LUCENT_BOUNDS_CHECKED(flags) ((flags) & kViewBoundsChecked)
+#define LUCENT_BOUNDS_CHECKED(flags) ((flags)&kViewBoundsChecked)
 #endif
 template <class T>
 LUCENT_HD T& BufferView<T>::operator[](unsigned i) const {
@@ -160,7 +161,8 @@ LUCENT_HD T& BufferView<T>::operator[](uint3 i) const {
 namespace detail {
 LUCENT_HD inline int wrap_texel(int i, int n, WrapMode mode) {
     switch (mode) {
-        case WrapMode::kClampToEdge: return i < 0 ? 0 : (i >= n ? n - 1 : i);
+        case WrapMode::kClampToEdge:
+            return i < 0 ? 0 : (i >= n ? n - 1 : i);
         case WrapMode::kMirror: {
             int period = 2 * n;
             int m = i % period;

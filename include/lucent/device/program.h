@@ -19,8 +19,16 @@
 namespace lucent {
 
 enum class ProgramKind {
-    kRayGeneration, kException, kMiss, kIntersection, kBoundingBox,
-    kClosestHit, kAnyHit, kVisit, kAttribute, kCallable,
+    kRayGeneration,
+    kException,
+    kMiss,
+    kIntersection,
+    kBoundingBox,
+    kClosestHit,
+    kAnyHit,
+    kVisit,
+    kAttribute,
+    kCallable,
 };
 const char* program_kind_name(ProgramKind kind);
 
@@ -57,7 +65,8 @@ inline ProgramDesc with_scope(ProgramDesc desc, std::string_view pretty) {
     size_t at = pretty.find("lucent_program_desc_");
     size_t begin = pretty.rfind(' ', at);
     begin = begin == std::string_view::npos ? 0 : begin + 1;
-    desc.scope = at == std::string_view::npos ? std::string_view() : pretty.substr(begin, at - begin);
+    desc.scope =
+        at == std::string_view::npos ? std::string_view() : pretty.substr(begin, at - begin);
     return desc;
 }
 
@@ -69,10 +78,11 @@ template <class Record>
 ProgramDesc make_desc(std::string_view name, ProgramKind kind, const char* file,
                       const TypeInfo* payload, const TypeInfo* attributes, void (*entry)(),
                       const TypeInfo* signature = nullptr) {
-    return ProgramDesc{name, kind, file, &record_info_of<Record>(), payload, attributes,
-                       signature, entry};
+    return ProgramDesc{name,    kind,       file,      &record_info_of<Record>(),
+                       payload, attributes, signature, entry};
 }
-template <class F> struct CallableSignature;
+template <class F>
+struct CallableSignature;
 template <class R, class Rec, class... Args>
 struct CallableSignature<R (*)(const Rec&, Args...)> {
     using type = R(Args...);
@@ -80,50 +90,58 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 }  // namespace detail
 }  // namespace lucent
 
-#define LUCENT_DECLARE_PROGRAM_(name, make)                                     \
-    inline const ::lucent::ProgramDesc& lucent_program_desc_##name() {         \
-        static const ::lucent::ProgramDesc desc =                              \
-            ::lucent::detail::with_scope(make, __PRETTY_FUNCTION__);           \
-        return desc;                                                           \
-    }                                                                          \
-    inline const bool lucent_program_registered_##name =                       \
+#define LUCENT_DECLARE_PROGRAM_(name, make)                            \
+    inline const ::lucent::ProgramDesc& lucent_program_desc_##name() { \
+        static const ::lucent::ProgramDesc desc =                      \
+            ::lucent::detail::with_scope(make, __PRETTY_FUNCTION__);   \
+        return desc;                                                   \
+    }                                                                  \
+    inline const bool lucent_program_registered_##name =               \
         ::lucent::detail::register_program(lucent_program_desc_##name());
 
-#define LUCENT_RAY_GENERATION(name, Record)                                                  \
-    inline void name(const Record& rec);                                                     \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kRayGeneration, __FILE__, nullptr, nullptr,            \
-        ::lucent::detail::erase_fn(+[](const void* r) { name(*static_cast<const Record*>(r)); }))) \
+#define LUCENT_RAY_GENERATION(name, Record)                                                       \
+    inline void name(const Record& rec);                                                          \
+    LUCENT_DECLARE_PROGRAM_(                                                                      \
+        name, ::lucent::detail::make_desc<Record>(#name, ::lucent::ProgramKind::kRayGeneration,   \
+                                                  __FILE__, nullptr, nullptr,                     \
+                                                  ::lucent::detail::erase_fn(+[](const void* r) { \
+                                                      name(*static_cast<const Record*>(r));       \
+                                                  })))                                            \
     inline void name([[maybe_unused]] const Record& rec)
 
-#define LUCENT_EXCEPTION(name, Record)                                                       \
-    inline void name(const Record& rec, const ::lucent::ExceptionInfo& ex);                  \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kException, __FILE__, nullptr, nullptr,                \
-        ::lucent::detail::erase_fn(+[](const void* r, const ::lucent::ExceptionInfo& e) {    \
-            name(*static_cast<const Record*>(r), e);                                        \
-        })))                                                                                 \
-    inline void name([[maybe_unused]] const Record& rec,                                     \
+#define LUCENT_EXCEPTION(name, Record)                                                        \
+    inline void name(const Record& rec, const ::lucent::ExceptionInfo& ex);                   \
+    LUCENT_DECLARE_PROGRAM_(                                                                  \
+        name,                                                                                 \
+        ::lucent::detail::make_desc<Record>(                                                  \
+            #name, ::lucent::ProgramKind::kException, __FILE__, nullptr, nullptr,             \
+            ::lucent::detail::erase_fn(+[](const void* r, const ::lucent::ExceptionInfo& e) { \
+                name(*static_cast<const Record*>(r), e);                                      \
+            })))                                                                              \
+    inline void name([[maybe_unused]] const Record& rec,                                      \
                      [[maybe_unused]] const ::lucent::ExceptionInfo& ex)
 
-#define LUCENT_MISS(name, Record, Payload)                                                   \
-    inline void name(const Record& rec, Payload& prd);                                       \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kMiss, __FILE__, &::lucent::type_info_of<Payload>(),   \
-        nullptr, ::lucent::detail::erase_fn(+[](const void* r, void* p) {                    \
-            name(*static_cast<const Record*>(r), *static_cast<Payload*>(p));                 \
-        })))                                                                                 \
+#define LUCENT_MISS(name, Record, Payload)                                                     \
+    inline void name(const Record& rec, Payload& prd);                                         \
+    LUCENT_DECLARE_PROGRAM_(                                                                   \
+        name,                                                                                  \
+        ::lucent::detail::make_desc<Record>(                                                   \
+            #name, ::lucent::ProgramKind::kMiss, __FILE__, &::lucent::type_info_of<Payload>(), \
+            nullptr, ::lucent::detail::erase_fn(+[](const void* r, void* p) {                  \
+                name(*static_cast<const Record*>(r), *static_cast<Payload*>(p));               \
+            })))                                                                               \
     inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] Payload& prd)
 
 #define LUCENT_HIT_PROGRAM_(name, Kind, Record, Payload, Attributes)                         \
     inline void name(const Record& rec, Payload& prd, const Attributes& attr);               \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::Kind, __FILE__, &::lucent::type_info_of<Payload>(),    \
-        &::lucent::type_info_of<Attributes>(),                                               \
-        ::lucent::detail::erase_fn(+[](const void* r, void* p, const void* a) {              \
-            name(*static_cast<const Record*>(r), *static_cast<Payload*>(p),                  \
-                 *static_cast<const Attributes*>(a));                                        \
-        })))                                                                                 \
+    LUCENT_DECLARE_PROGRAM_(                                                                 \
+        name, ::lucent::detail::make_desc<Record>(                                           \
+                  #name, ::lucent::ProgramKind::Kind, __FILE__,                              \
+                  &::lucent::type_info_of<Payload>(), &::lucent::type_info_of<Attributes>(), \
+                  ::lucent::detail::erase_fn(+[](const void* r, void* p, const void* a) {    \
+                      name(*static_cast<const Record*>(r), *static_cast<Payload*>(p),        \
+                           *static_cast<const Attributes*>(a));                              \
+                  })))                                                                       \
     inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] Payload& prd,      \
                      [[maybe_unused]] const Attributes& attr)
 
@@ -134,58 +152,63 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 
 #define LUCENT_INTERSECTION(name, Record, Attributes)                                        \
     inline void name(const Record& rec, unsigned prim, Attributes& attr);                    \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kIntersection, __FILE__, nullptr,                      \
-        &::lucent::type_info_of<Attributes>(),                                               \
-        ::lucent::detail::erase_fn(+[](const void* r, unsigned i, void* a) {                 \
-            name(*static_cast<const Record*>(r), i, *static_cast<Attributes*>(a));           \
-        })))                                                                                 \
+    LUCENT_DECLARE_PROGRAM_(                                                                 \
+        name, ::lucent::detail::make_desc<Record>(                                           \
+                  #name, ::lucent::ProgramKind::kIntersection, __FILE__, nullptr,            \
+                  &::lucent::type_info_of<Attributes>(),                                     \
+                  ::lucent::detail::erase_fn(+[](const void* r, unsigned i, void* a) {       \
+                      name(*static_cast<const Record*>(r), i, *static_cast<Attributes*>(a)); \
+                  })))                                                                       \
     inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] unsigned prim,     \
                      [[maybe_unused]] Attributes& attr)
 
-#define LUCENT_BOUNDING_BOX(name, Record)                                                    \
-    inline void name(const Record& rec, unsigned prim, ::lucent::Aabb& box);                 \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kBoundingBox, __FILE__, nullptr, nullptr,              \
-        ::lucent::detail::erase_fn(+[](const void* r, unsigned i, ::lucent::Aabb& b) {       \
-            name(*static_cast<const Record*>(r), i, b);                                      \
-        })))                                                                                 \
-    inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] unsigned prim,     \
+#define LUCENT_BOUNDING_BOX(name, Record)                                                        \
+    inline void name(const Record& rec, unsigned prim, ::lucent::Aabb& box);                     \
+    LUCENT_DECLARE_PROGRAM_(                                                                     \
+        name, ::lucent::detail::make_desc<Record>(                                               \
+                  #name, ::lucent::ProgramKind::kBoundingBox, __FILE__, nullptr, nullptr,        \
+                  ::lucent::detail::erase_fn(+[](const void* r, unsigned i, ::lucent::Aabb& b) { \
+                      name(*static_cast<const Record*>(r), i, b);                                \
+                  })))                                                                           \
+    inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] unsigned prim,         \
                      ::lucent::Aabb& box)
 
 /// Selector visit program: returns the index of the child the current ray traverses
 /// (an index >= the child count means none).
-#define LUCENT_VISIT(name, Record)                                                           \
-    inline unsigned name(const Record& rec);                                                 \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kVisit, __FILE__, nullptr, nullptr,                    \
-        ::lucent::detail::erase_fn(+[](const void* r) -> unsigned {                          \
-            return name(*static_cast<const Record*>(r));                                     \
-        })))                                                                                 \
+#define LUCENT_VISIT(name, Record)                                                                \
+    inline unsigned name(const Record& rec);                                                      \
+    LUCENT_DECLARE_PROGRAM_(name,                                                                 \
+                            ::lucent::detail::make_desc<Record>(                                  \
+                                #name, ::lucent::ProgramKind::kVisit, __FILE__, nullptr, nullptr, \
+                                ::lucent::detail::erase_fn(+[](const void* r) -> unsigned {       \
+                                    return name(*static_cast<const Record*>(r));                  \
+                                })))                                                              \
     inline unsigned name([[maybe_unused]] const Record& rec)
 
 /// Attribute program of built-in triangles: turns barycentrics into user attributes,
 /// run once for the closest hit (and for each any-hit candidate).
-#define LUCENT_ATTRIBUTE(name, Record, Attributes)                                           \
-    inline void name(const Record& rec, unsigned prim, float2 barycentrics, Attributes& attr); \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kAttribute, __FILE__, nullptr,                         \
-        &::lucent::type_info_of<Attributes>(),                                               \
-        ::lucent::detail::erase_fn(+[](const void* r, unsigned i, float2 b, void* a) {       \
-            name(*static_cast<const Record*>(r), i, b, *static_cast<Attributes*>(a));        \
-        })))                                                                                 \
-    inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] unsigned prim,     \
+#define LUCENT_ATTRIBUTE(name, Record, Attributes)                                               \
+    inline void name(const Record& rec, unsigned prim, float2 barycentrics, Attributes& attr);   \
+    LUCENT_DECLARE_PROGRAM_(                                                                     \
+        name, ::lucent::detail::make_desc<Record>(                                               \
+                  #name, ::lucent::ProgramKind::kAttribute, __FILE__, nullptr,                   \
+                  &::lucent::type_info_of<Attributes>(),                                         \
+                  ::lucent::detail::erase_fn(+[](const void* r, unsigned i, float2 b, void* a) { \
+                      name(*static_cast<const Record*>(r), i, b, *static_cast<Attributes*>(a));  \
+                  })))                                                                           \
+    inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] unsigned prim,         \
                      [[maybe_unused]] float2 barycentrics, [[maybe_unused]] Attributes& attr)
 
 /// Callable program: LUCENT_CALLABLE(name, Record, float3, (float3 n, float t)) { ... }
 /// Bound to a record field of type Callable<float3(float3, float)> through a variable.
-#define LUCENT_CALLABLE(name, Record, Result, Params)                                        \
-    inline Result name(const Record& rec, LUCENT_UNPAREN_ Params);                           \
-    LUCENT_DECLARE_PROGRAM_(name, ::lucent::detail::make_desc<Record>(                      \
-        #name, ::lucent::ProgramKind::kCallable, __FILE__, nullptr, nullptr,                 \
-        ::lucent::detail::erase_fn(::lucent::detail::callable_thunk<&name>(&name)),         \
-        &::lucent::type_info_of<                                                             \
-            typename ::lucent::detail::CallableSignature<decltype(&name)>::type>()))         \
+#define LUCENT_CALLABLE(name, Record, Result, Params)                                          \
+    inline Result name(const Record& rec, LUCENT_UNPAREN_ Params);                             \
+    LUCENT_DECLARE_PROGRAM_(                                                                   \
+        name, ::lucent::detail::make_desc<Record>(                                             \
+                  #name, ::lucent::ProgramKind::kCallable, __FILE__, nullptr, nullptr,         \
+                  ::lucent::detail::erase_fn(::lucent::detail::callable_thunk<&name>(&name)),  \
+                  &::lucent::type_info_of<                                                     \
+                      typename ::lucent::detail::CallableSignature<decltype(&name)>::type>())) \
     inline Result name([[maybe_unused]] const Record& rec, LUCENT_UNPAREN_ Params)
 
 #define LUCENT_UNPAREN_(...) __VA_ARGS__

@@ -39,9 +39,18 @@ const TypeInfo& type_info_of() {
 
 /// What kind of value a record field holds; decides which variable values fit it.
 enum class FieldKind {
-    kFloat, kFloat2, kFloat3, kFloat4,
-    kInt, kInt2, kInt3, kInt4,
-    kUint, kUint2, kUint3, kUint4,
+    kFloat,
+    kFloat2,
+    kFloat3,
+    kFloat4,
+    kInt,
+    kInt2,
+    kInt3,
+    kInt4,
+    kUint,
+    kUint2,
+    kUint3,
+    kUint4,
     kMatrix4x3,
     kBuffer,    // BufferView<T>: element type in `element`
     kTexture,   // TextureView
@@ -52,9 +61,15 @@ enum class FieldKind {
 
 const char* field_kind_name(FieldKind kind);
 
-template <class T> struct FieldKindOf { static constexpr FieldKind value = FieldKind::kUserData; };
-#define LUCENT_FIELD_KIND(T, K) \
-    template <> struct FieldKindOf<T> { static constexpr FieldKind value = FieldKind::K; };
+template <class T>
+struct FieldKindOf {
+    static constexpr FieldKind value = FieldKind::kUserData;
+};
+#define LUCENT_FIELD_KIND(T, K)                          \
+    template <>                                          \
+    struct FieldKindOf<T> {                              \
+        static constexpr FieldKind value = FieldKind::K; \
+    };
 LUCENT_FIELD_KIND(float, kFloat)
 LUCENT_FIELD_KIND(float2, kFloat2)
 LUCENT_FIELD_KIND(float3, kFloat3)
@@ -71,12 +86,27 @@ LUCENT_FIELD_KIND(Matrix4x3, kMatrix4x3)
 LUCENT_FIELD_KIND(TextureView, kTexture)
 LUCENT_FIELD_KIND(Handle, kHandle)
 #undef LUCENT_FIELD_KIND
-template <class T> struct FieldKindOf<BufferView<T>> { static constexpr FieldKind value = FieldKind::kBuffer; };
-template <class S> struct FieldKindOf<Callable<S>> { static constexpr FieldKind value = FieldKind::kCallable; };
+template <class T>
+struct FieldKindOf<BufferView<T>> {
+    static constexpr FieldKind value = FieldKind::kBuffer;
+};
+template <class S>
+struct FieldKindOf<Callable<S>> {
+    static constexpr FieldKind value = FieldKind::kCallable;
+};
 
-template <class T> struct FieldElement { using type = T; };
-template <class T> struct FieldElement<BufferView<T>> { using type = T; };
-template <class S> struct FieldElement<Callable<S>> { using type = S; };
+template <class T>
+struct FieldElement {
+    using type = T;
+};
+template <class T>
+struct FieldElement<BufferView<T>> {
+    using type = T;
+};
+template <class S>
+struct FieldElement<Callable<S>> {
+    using type = S;
+};
 
 /// One named field of a record.
 struct FieldInfo {
@@ -120,8 +150,12 @@ const RecordInfo& record_info_of() {
 // ---- LUCENT_RECORD(Type, field, field, ...) ----------------------------------
 #define LUCENT_PP_CAT_(a, b) a##b
 #define LUCENT_PP_CAT(a, b) LUCENT_PP_CAT_(a, b)
-#define LUCENT_PP_NARG(...) LUCENT_PP_NARG_(__VA_ARGS__, 24, 23, 22, 21, 20, 19, 18, 17, 16, 15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0)
-#define LUCENT_PP_NARG_(_1, _2, _3, _4, _5, _6, _7, _8, _9, _10, _11, _12, _13, _14, _15, _16, _17, _18, _19, _20, _21, _22, _23, _24, N, ...) N
+#define LUCENT_PP_NARG(...)                                                                        \
+    LUCENT_PP_NARG_(__VA_ARGS__, 24, 23, 22, 21, 20, 19, 18, 17, 16, 15, 14, 13, 12, 11, 10, 9, 8, \
+                    7, 6, 5, 4, 3, 2, 1, 0)
+#define LUCENT_PP_NARG_(_1, _2, _3, _4, _5, _6, _7, _8, _9, _10, _11, _12, _13, _14, _15, _16, \
+                        _17, _18, _19, _20, _21, _22, _23, _24, N, ...)                        \
+    N
 #define LUCENT_FE_1(m, T, x) m(T, x)
 #define LUCENT_FE_2(m, T, x, ...) m(T, x) LUCENT_FE_1(m, T, __VA_ARGS__)
 #define LUCENT_FE_3(m, T, x, ...) m(T, x) LUCENT_FE_2(m, T, __VA_ARGS__)
@@ -148,16 +182,15 @@ const RecordInfo& record_info_of() {
 #define LUCENT_FE_24(m, T, x, ...) m(T, x) LUCENT_FE_23(m, T, __VA_ARGS__)
 #define LUCENT_FOR_EACH(m, T, ...) \
     LUCENT_PP_CAT(LUCENT_FE_, LUCENT_PP_NARG(__VA_ARGS__))(m, T, __VA_ARGS__)
-#define LUCENT_RECORD_FIELD_(T, f) \
-    ::lucent::make_field_info<T, decltype(T::f)>(#f, offsetof(T, f)),
+#define LUCENT_RECORD_FIELD_(T, f) ::lucent::make_field_info<T, decltype(T::f)>(#f, offsetof(T, f)),
 
 /// Declare the named fields of a record struct (its program variables), so the host can
 /// resolve each one through the variable scopes and pack the record.
-#define LUCENT_RECORD(T, ...)                                                        \
-    inline const ::lucent::RecordInfo& lucent_record_info(const T*) {                \
-        static const ::lucent::RecordInfo info{                                      \
+#define LUCENT_RECORD(T, ...)                                                                    \
+    inline const ::lucent::RecordInfo& lucent_record_info(const T*) {                            \
+        static const ::lucent::RecordInfo info{                                                  \
             #T, sizeof(T), alignof(T), {LUCENT_FOR_EACH(LUCENT_RECORD_FIELD_, T, __VA_ARGS__)}}; \
-        return info;                                                                 \
+        return info;                                                                             \
     }
 
 #else  // GPU code: reflection is a host concern

@@ -97,8 +97,8 @@ enum ViewFlags : unsigned { kViewBoundsChecked = 1u };
 template <class T>
 struct BufferView {
     T* data;
-    uint3 size;     // unused dimensions are 1
-    unsigned flags; // kViewBoundsChecked when out-of-bounds exceptions are on
+    uint3 size;      // unused dimensions are 1
+    unsigned flags;  // kViewBoundsChecked when out-of-bounds exceptions are on
 
     LUCENT_HD unsigned count() const { return size.x * size.y * size.z; }
     LUCENT_HD T& operator[](unsigned i) const;
@@ -107,7 +107,7 @@ struct BufferView {
     LUCENT_HD T* begin() const { return data; }
     LUCENT_HD T* end() const { return data + count(); }
 
-private:
+  private:
     LUCENT_HD T& out_of_bounds(unsigned linear) const;  // raises the exception
 };
 

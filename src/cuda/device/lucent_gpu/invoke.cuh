@@ -21,8 +21,8 @@ __device__ __forceinline__ void invoke(void (*f)(const R&, P&), const void* rec,
     f(*static_cast<const R*>(rec), *static_cast<P*>(prd));
 }
 template <class R, class P, class A>
-__device__ __forceinline__ void invoke(void (*f)(const R&, P&, const A&), const void* rec, void* prd,
-                                       const void* attr) {
+__device__ __forceinline__ void invoke(void (*f)(const R&, P&, const A&), const void* rec,
+                                       void* prd, const void* attr) {
     f(*static_cast<const R*>(rec), *static_cast<P*>(prd), *static_cast<const A*>(attr));
 }
 template <class R, class A>

@@ -14,13 +14,18 @@ struct ProgramRef {
     unsigned record;
 };
 
-enum GpuNodeKind : unsigned { kGpuGroup = 0, kGpuGeometryGroup = 1, kGpuTransform = 2, kGpuSelector = 3 };
+enum GpuNodeKind : unsigned {
+    kGpuGroup = 0,
+    kGpuGeometryGroup = 1,
+    kGpuTransform = 2,
+    kGpuSelector = 3
+};
 
 struct GpuNode {
     unsigned kind;
-    unsigned first;   // children[first .. first + count) for Group, Selector, Transform
+    unsigned first;  // children[first .. first + count) for Group, Selector, Transform
     unsigned count;
-    unsigned accel;   // Group: bvhs index (~0u: brute force); GeometryGroup: accels index
+    unsigned accel;  // Group: bvhs index (~0u: brute force); GeometryGroup: accels index
     ProgramRef visit;
     Matrix4x3 to_world, to_object;
 };
@@ -41,12 +46,12 @@ struct GpuBvh {
 struct GpuGeometryAccel {
     unsigned triangles_only;
     unsigned brute_force;
-    unsigned any_hit_mask;      // bit r: some material has an any-hit for ray type r
-    unsigned instance_offset;   // accel_instances[instance_offset + k]: CompiledInstance index
+    unsigned any_hit_mask;     // bit r: some material has an any-hit for ray type r
+    unsigned instance_offset;  // accel_instances[instance_offset + k]: CompiledInstance index
     unsigned instance_count;
-    unsigned prim_first_offset; // accel_prim_first[...]: first global primitive per instance
+    unsigned prim_first_offset;  // accel_prim_first[...]: first global primitive per instance
     unsigned prim_total;
-    GpuBvh bvh;                 // generic path
+    GpuBvh bvh;                    // generic path
     GpuTriangleBvhView triangles;  // triangles_only path (triangle ids are global primitives)
 };
 
@@ -97,7 +102,8 @@ struct LaunchParams {
     ProgramRef ray_generation;
     ProgramRef exception;
     uint3 launch_size;
-    unsigned exception_mask;  // bit c (1..6): engine code c runs the exception program; bit 31: user codes
+    unsigned exception_mask;  // bit c (1..6): engine code c runs the exception program; bit 31:
+                              // user codes
     unsigned long long launch_count;
     unsigned long long* work_counter;
     GpuExceptionSlot* exceptions;

@@ -54,8 +54,14 @@ __device__ unsigned dispatch_visit(int id, const void* rec);
 __device__ void dispatch_attribute(int id, const void* rec, unsigned prim, float2 bary, void* attr);
 
 enum Context : unsigned {
-    kCtxRayGeneration, kCtxException, kCtxMiss, kCtxClosestHit, kCtxAnyHit, kCtxIntersection,
-    kCtxVisit, kCtxAttribute,
+    kCtxRayGeneration,
+    kCtxException,
+    kCtxMiss,
+    kCtxClosestHit,
+    kCtxAnyHit,
+    kCtxIntersection,
+    kCtxVisit,
+    kCtxAttribute,
 };
 
 struct alignas(16) Attributes {
@@ -98,9 +104,13 @@ struct ThreadState {
 };
 
 __shared__ ThreadState g_threads[LUCENT_GPU_BLOCK];
-__device__ __forceinline__ ThreadState& self() { return g_threads[threadIdx.x]; }
+__device__ __forceinline__ ThreadState& self() {
+    return g_threads[threadIdx.x];
+}
 
-__device__ __forceinline__ const unsigned char* record(ProgramRef p) { return params.records + p.record; }
+__device__ __forceinline__ const unsigned char* record(ProgramRef p) {
+    return params.records + p.record;
+}
 
 }  // namespace lucent::gpu
 
@@ -125,11 +135,17 @@ LUCENT_HD bool print_enabled_here() {
     return false;
 #endif
 }
-LUCENT_HD void print_text(const char* text) { printf("%s", text); }
+LUCENT_HD void print_text(const char* text) {
+    printf("%s", text);
+}
 }  // namespace detail
 
-LUCENT_HD uint3 launch_index() { return gpu::self().launch_index; }
-LUCENT_HD uint3 launch_size() { return gpu::params.launch_size; }
+LUCENT_HD uint3 launch_index() {
+    return gpu::self().launch_index;
+}
+LUCENT_HD uint3 launch_size() {
+    return gpu::params.launch_size;
+}
 
 namespace gpu {
 __device__ const Ray g_no_ray = {};  // current_ray() outside any trace
@@ -141,8 +157,10 @@ LUCENT_HD const Ray& current_ray() {
         case gpu::kCtxIntersection:
         case gpu::kCtxAnyHit:
         case gpu::kCtxVisit:
-        case gpu::kCtxAttribute: return f->object_ray;
-        default: return f->world_ray;
+        case gpu::kCtxAttribute:
+            return f->object_ray;
+        default:
+            return f->world_ray;
     }
 }
 
@@ -150,10 +168,14 @@ LUCENT_HD float t_hit() {
     gpu::Frame* f = gpu::self().frame;
     if (!f) return 0.0f;
     switch (f->context) {
-        case gpu::kCtxAnyHit: return f->candidate_t;
-        case gpu::kCtxClosestHit: return f->hit_t;
-        case gpu::kCtxMiss: return f->world_ray.tmax;
-        default: return f->closest;
+        case gpu::kCtxAnyHit:
+            return f->candidate_t;
+        case gpu::kCtxClosestHit:
+            return f->hit_t;
+        case gpu::kCtxMiss:
+            return f->world_ray.tmax;
+        default:
+            return f->closest;
     }
 }
 
@@ -170,8 +192,12 @@ LUCENT_HD bool potential_intersection(float t) {
     return f->candidate_open;
 }
 
-LUCENT_HD void ignore_intersection() { gpu::self().frame->ignore_requested = true; }
-LUCENT_HD void terminate_ray() { gpu::self().frame->terminate_requested = true; }
+LUCENT_HD void ignore_intersection() {
+    gpu::self().frame->ignore_requested = true;
+}
+LUCENT_HD void terminate_ray() {
+    gpu::self().frame->terminate_requested = true;
+}
 
 namespace detail {
 LUCENT_HD bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) {

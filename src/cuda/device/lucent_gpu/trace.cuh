@@ -12,7 +12,8 @@ __device__ inline Matrix4x3 compose(const Matrix4x3& a, const Matrix4x3& b) {
     Matrix4x3 r;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 4; ++j) {
-            float v = a.m[i * 4 + 0] * b.m[j] + a.m[i * 4 + 1] * b.m[4 + j] + a.m[i * 4 + 2] * b.m[8 + j];
+            float v =
+                a.m[i * 4 + 0] * b.m[j] + a.m[i * 4 + 1] * b.m[4 + j] + a.m[i * 4 + 2] * b.m[8 + j];
             r.m[i * 4 + j] = j == 3 ? v + a.m[i * 4 + 3] : v;
         }
     return r;
@@ -43,7 +44,8 @@ __device__ inline void triangle_attributes(Frame& f, const GpuInstance& inst, un
     a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
 }
 
-__device__ inline void commit(Frame& f, unsigned instance, unsigned prim, float t, unsigned material) {
+__device__ inline void commit(Frame& f, unsigned instance, unsigned prim, float t,
+                              unsigned material) {
     f.has_hit = true;
     f.closest = t;
     f.hit_t = t;
@@ -116,8 +118,10 @@ __device__ inline unsigned locate(const GpuGeometryAccel& ga, unsigned ref) {
     unsigned lo = 0, hi = ga.instance_count;
     while (hi - lo > 1) {
         unsigned mid = (lo + hi) / 2;
-        if (params.accel_prim_first[ga.prim_first_offset + mid] <= ref) lo = mid;
-        else hi = mid;
+        if (params.accel_prim_first[ga.prim_first_offset + mid] <= ref)
+            lo = mid;
+        else
+            hi = mid;
     }
     return lo;
 }
@@ -126,7 +130,8 @@ __device__ inline unsigned locate(const GpuGeometryAccel& ga, unsigned ref) {
 // GeometryGroups get none of that code.
 #define LUCENT_GPU_NESTED (LUCENT_GPU_GROUPS || LUCENT_GPU_TRANSFORMS || LUCENT_GPU_SELECTORS)
 #if LUCENT_GPU_NESTED
-__device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origin, float3 direction);
+__device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origin,
+                                           float3 direction);
 #endif
 
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
@@ -147,16 +152,16 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
             }
             return;
         }
-        gpu_bvh_filtered(ga.triangles, origin, direction, tmin, f.closest, hit,
-                         [&](const GpuHit& c) -> int {
-                             if (!(c.t < f.closest)) return 0;
-                             unsigned k = locate(ga, c.prim);
-                             unsigned local = c.prim - params.accel_prim_first[ga.prim_first_offset + k];
-                             if (!triangle_candidate(f, params.accel_instances[ga.instance_offset + k],
-                                                     local, c.t, make_float2(c.u, c.v)))
-                                 return 0;
-                             return f.terminated ? 2 : 1;
-                         });
+        gpu_bvh_filtered(
+            ga.triangles, origin, direction, tmin, f.closest, hit, [&](const GpuHit& c) -> int {
+                if (!(c.t < f.closest)) return 0;
+                unsigned k = locate(ga, c.prim);
+                unsigned local = c.prim - params.accel_prim_first[ga.prim_first_offset + k];
+                if (!triangle_candidate(f, params.accel_instances[ga.instance_offset + k], local,
+                                        c.t, make_float2(c.u, c.v)))
+                    return 0;
+                return f.terminated ? 2 : 1;
+            });
         return;
     }
 #endif
@@ -178,7 +183,8 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
             f.prim = local;
             unsigned saved = f.context;
             f.context = kCtxIntersection;
-            dispatch_intersection(inst.intersection.id, record(inst.intersection), local, f.scratch.bytes);
+            dispatch_intersection(inst.intersection.id, record(inst.intersection), local,
+                                  f.scratch.bytes);
             f.context = saved;
         }
         return f.terminated || self().exception_code != 0;
@@ -244,8 +250,12 @@ __device__ inline void group(Frame& f, const GpuNode& n, float3 origin, float3 d
 __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 direction) {
     const GpuNode& n = params.nodes[index];
     switch (n.kind) {
-        case kGpuGeometryGroup: geometry_group(f, params.accels[n.accel], origin, direction); return;
-        case kGpuGroup: group(f, n, origin, direction); return;
+        case kGpuGeometryGroup:
+            geometry_group(f, params.accels[n.accel], origin, direction);
+            return;
+        case kGpuGroup:
+            group(f, n, origin, direction);
+            return;
 #if LUCENT_GPU_TRANSFORMS
         case kGpuTransform: {
             const bool was = f.transformed;
@@ -269,11 +279,13 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
             f.context = kCtxVisit;
             unsigned child = dispatch_visit(n.visit.id, record(n.visit));
             f.context = saved;
-            if (child < n.count) traverse_node(f, params.children[n.first + child], origin, direction);
+            if (child < n.count)
+                traverse_node(f, params.children[n.first + child], origin, direction);
             return;
         }
 #endif
-        default: return;
+        default:
+            return;
     }
 }
 #endif  // LUCENT_GPU_NESTED
@@ -402,7 +414,7 @@ LUCENT_HD bool report_intersection(unsigned material) {
 /// The megakernel: persistent threads take launch indices from a global counter, a warp's
 /// worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
 extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
-lucent_megakernel() {
+    lucent_megakernel() {
     using namespace lucent;
     using namespace lucent::gpu;
     ThreadState& s = self();
