@@ -97,6 +97,15 @@ struct CompiledEntry {
     std::vector<const Buffer*> output_buffers;  // Output buffers the ray-generation record views
 };
 
+/// Whether `code` is among the enabled ones (kAllExceptions enables every code, and
+/// kUserExceptionBase every user code).
+inline bool exception_code_enabled(const std::vector<int>& enabled, int code) {
+    for (int c : enabled)
+        if (c == kAllExceptions || c == code || (code >= kUserExceptionBase && c == kUserExceptionBase))
+            return true;
+    return false;
+}
+
 struct CompiledScene {
     uint64_t generation = 0;
     std::vector<CompiledEntry> entries;
@@ -110,7 +119,7 @@ struct CompiledScene {
     bool print_enabled = false;
     int3 print_index{-1, -1, -1};
     std::vector<int> enabled_exceptions;  // codes whose exception program runs
-    bool exception_enabled(int code) const;
+    bool exception_enabled(int code) const { return exception_code_enabled(enabled_exceptions, code); }
 };
 
 }  // namespace lucent::core

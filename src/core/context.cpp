@@ -205,12 +205,7 @@ void Context::set_exception_enabled(int code, bool enabled) {
     ++m_impl->shared->generation;
 }
 bool Context::exception_enabled(int code) const {
-    auto& codes = m_impl->state.enabled_exceptions;
-    if (std::find(codes.begin(), codes.end(), kAllExceptions) != codes.end()) return true;
-    if (code >= kUserExceptionBase)  // user codes are switched together
-        return std::find(codes.begin(), codes.end(), kUserExceptionBase) != codes.end() ||
-               std::find(codes.begin(), codes.end(), code) != codes.end();
-    return std::find(codes.begin(), codes.end(), code) != codes.end();
+    return core::exception_code_enabled(m_impl->state.enabled_exceptions, code);
 }
 void Context::set_print_enabled(bool enabled) {
     m_impl->state.print_enabled = enabled;
@@ -287,7 +282,6 @@ void check_ray_generation(const core::CompiledScene& scene, unsigned entry) {
 }  // namespace
 
 void Context::validate() {
-    LaunchReport scratch;
     core::SceneCompiler(m_impl->state, m_impl->accel_cache).validate_only();
     for (unsigned e = 0; e < m_impl->state.entries.size(); ++e)
         if (!m_impl->state.entries[e].ray_generation)
@@ -388,14 +382,6 @@ std::string LaunchReport::summary() const {
         s << exception_name(code) << ": " << e.count << " (first at " << e.first_index.x << ","
           << e.first_index.y << "," << e.first_index.z << ")\n";
     return s.str();
-}
-
-bool core::CompiledScene::exception_enabled(int code) const {
-    for (int c : enabled_exceptions)
-        if (c == kAllExceptions || c == code ||
-            (code >= kUserExceptionBase && c == kUserExceptionBase))
-            return true;
-    return false;
 }
 
 }  // namespace lucent
