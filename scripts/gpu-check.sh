@@ -51,10 +51,10 @@ tests)
     done
     ;;
 sweep)
-    echo "== whitted 1024x1024 frame rate against the register budget (blocks per SM hint)"
-    for mb in 1 5 6 8; do
-        echo "-- LUCENT_GPU_MIN_BLOCKS=$mb"
-        LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=$mb" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
+    echo "== whitted 1024x1024 frame rate against kernel variants (NVRTC defines)"
+    for v in "" "-DLUCENT_GPU_TILES=0" "-DLUCENT_GPU_MIN_BLOCKS=5"; do
+        echo "-- LUCENT_NVRTC_OPTIONS=$v"
+        LUCENT_NVRTC_OPTIONS="$v" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
     done
     ;;
 sanitizer)

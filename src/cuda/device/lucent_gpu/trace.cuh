@@ -420,17 +420,43 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
     ThreadState& s = self();
     const LaunchParams& p = params;
     const unsigned lane = threadIdx.x & 31u;
+#if LUCENT_GPU_TILES
+    // 2D and 3D launches: a warp takes an 8x4 tile of launch indices, so neighbouring rays,
+    // and their secondary rays, run together (less divergence than a row of 32).
+    const bool tiled = p.launch_size.y > 1;
+    const unsigned tiles_x = (p.launch_size.x + 7) / 8, tiles_y = (p.launch_size.y + 3) / 4;
+    const unsigned long long work =
+        tiled ? 32ull * tiles_x * tiles_y * p.launch_size.z : p.launch_count;
+#else
+    const bool tiled = false;
+    const unsigned tiles_x = 1, tiles_y = 1;
+    const unsigned long long work = p.launch_count;
+#endif
     for (;;) {
         unsigned long long base = 0;
         if (lane == 0) base = atomicAdd(p.work_counter, 32ull);
         base = __shfl_sync(0xffffffffu, base, 0);
-        if (base >= p.launch_count) return;
-        unsigned long long linear = base + lane;
-        if (linear >= p.launch_count) continue;
-        unsigned x = unsigned(linear % p.launch_size.x);
-        unsigned long long rest = linear / p.launch_size.x;
-        unsigned y = unsigned(rest % p.launch_size.y);
-        unsigned z = unsigned(rest / p.launch_size.y);
+        if (base >= work) return;
+        unsigned x, y, z;
+        if (tiled) {
+            unsigned long long tile = base / 32;
+            unsigned tx = unsigned(tile % tiles_x);
+            unsigned long long rest = tile / tiles_x;
+            x = tx * 8 + (lane & 7u);
+            y = unsigned(rest % tiles_y) * 4 + (lane >> 3);
+            z = unsigned(rest / tiles_y);
+            if (x >= p.launch_size.x || y >= p.launch_size.y) continue;
+        } else {
+            unsigned long long index = base + lane;
+            if (index >= p.launch_count) continue;
+            x = unsigned(index % p.launch_size.x);
+            unsigned long long rest = index / p.launch_size.x;
+            y = unsigned(rest % p.launch_size.y);
+            z = unsigned(rest / p.launch_size.y);
+        }
+        const unsigned long long linear =
+            (unsigned long long)(z * p.launch_size.y + y) * p.launch_size.x + x;
+        (void)tiles_y;
         s.launch_index = make_uint3(x, y, z);
         s.depth = 0;
         s.exception_code = 0;
