@@ -52,9 +52,13 @@ tests)
     ;;
 sweep)
     echo "== whitted 1024x1024 frame rate against kernel variants (NVRTC defines)"
-    for v in "" "-DLUCENT_GPU_TILES=0" "-DLUCENT_GPU_MIN_BLOCKS=5"; do
+    for v in "" "-DLUCENT_GPU_TILES=0"; do
         echo "-- LUCENT_NVRTC_OPTIONS=$v"
         LUCENT_NVRTC_OPTIONS="$v" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
+    done
+    for c in 100 50; do
+        echo "-- LUCENT_GPU_CARVEOUT=$c (shared memory share, default 0: L1 first)"
+        LUCENT_GPU_CARVEOUT=$c $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch"
     done
     ;;
 sanitizer)

@@ -61,6 +61,7 @@ Loaded load() {
     LUCENT_LOAD(cuEventElapsedTime, "cuEventElapsedTime")
     LUCENT_LOAD(cuGetErrorString, "cuGetErrorString")
     LUCENT_LOAD(cuFuncGetAttribute, "cuFuncGetAttribute")
+    LUCENT_LOAD(cuFuncSetAttribute, "cuFuncSetAttribute")
     LUCENT_LOAD(cuOccupancyMaxActiveBlocksPerMultiprocessor,
                 "cuOccupancyMaxActiveBlocksPerMultiprocessor")
 #undef LUCENT_LOAD

@@ -38,6 +38,7 @@ struct DriverApi {
     LUCENT_CU_FN(cuEventElapsedTime)
     LUCENT_CU_FN(cuGetErrorString)
     LUCENT_CU_FN(cuFuncGetAttribute)
+    LUCENT_CU_FN(cuFuncSetAttribute)
     LUCENT_CU_FN(cuOccupancyMaxActiveBlocksPerMultiprocessor)
 #undef LUCENT_CU_FN
 };
