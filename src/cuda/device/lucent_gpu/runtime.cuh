@@ -74,7 +74,9 @@ struct alignas(16) Attributes {
 /// One active trace (lives on the stack of trace_ray; recursion nests them).
 struct Frame {
     Ray world_ray;
-    Ray object_ray;
+#if LUCENT_GPU_TRANSFORMS
+    Ray object_ray;  // in the space of the node being traversed
+#endif
     void* payload;
     unsigned ray_type;
     float closest;
@@ -161,7 +163,11 @@ LUCENT_HD const Ray& current_ray() {
         case gpu::kCtxAnyHit:
         case gpu::kCtxVisit:
         case gpu::kCtxAttribute:
+#if LUCENT_GPU_TRANSFORMS
             return f->object_ray;
+#else
+            return f->world_ray;  // no transforms: object space is world space
+#endif
         default:
             return f->world_ray;
     }

@@ -136,8 +136,10 @@ __device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origi
 
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                                float3 direction) {
+#if LUCENT_GPU_TRANSFORMS  // else the object-space ray is the world ray
     f.object_ray.origin = origin;
     f.object_ray.direction = direction;
+#endif
     const float tmin = f.world_ray.tmin;
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
@@ -273,8 +275,10 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
 #endif
 #if LUCENT_GPU_SELECTORS
         case kGpuSelector: {
+#if LUCENT_GPU_TRANSFORMS
             f.object_ray.origin = origin;
             f.object_ray.direction = direction;
+#endif
             unsigned saved = f.context;
             f.context = kCtxVisit;
             unsigned child = dispatch_visit(n.visit.id, record(n.visit));
@@ -312,7 +316,9 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
     }
     Frame f;
     f.world_ray = ray;
+#if LUCENT_GPU_TRANSFORMS
     f.object_ray = ray;
+#endif
     f.payload = payload;
     f.ray_type = ray.ray_type;
     f.closest = ray.tmax;
@@ -340,10 +346,10 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
             const GpuInstance& inst = params.instances[f.hit_instance];
             if (f.hit_pending) {
                 // The attribute program runs as at the hit: its primitive, transform and ray.
-                f.object_ray = ray;
                 f.instance = f.hit_instance;
                 f.prim = f.hit_prim;
 #if LUCENT_GPU_TRANSFORMS
+                f.object_ray = ray;
                 f.transformed = f.hit_transformed;
                 if (f.hit_transformed) {
                     f.to_world = f.hit_to_world;
@@ -354,7 +360,9 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
 #endif
                 triangle_attributes(f, inst, f.hit_prim, f.hit_bary, f.hit_attr);
             }
+#if LUCENT_GPU_TRANSFORMS
             f.object_ray = ray;
+#endif
             ProgramRef closest = material_slot(inst, f.hit_material, f.ray_type).closest;
             if (closest.id >= 0) {
                 f.context = kCtxClosestHit;
