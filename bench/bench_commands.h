@@ -19,7 +19,7 @@ struct RaysOptions {
     unsigned threads = 0;         // 0 = all cores
     bool peer = true;             // run Embree on the same rays when built with it
     bool json = false;            // machine-readable output
-    std::string backend = "cpu";  // "cpu", or "cuda" (src/cuda/bench_rays_cuda.h)
+    std::string backend = "cpu";  // "cpu", or "cuda" (bench/bench_rays_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,
 /// and the peer's lines and ratios. Returns the process exit code; throws lucent::Error

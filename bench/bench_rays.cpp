@@ -18,7 +18,7 @@
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #ifdef LUCENT_HAVE_CUDA
-#include "cuda/bench_rays_cuda.h"
+#include "bench/bench_rays_cuda.h"
 #endif
 
 namespace lucent::bench {

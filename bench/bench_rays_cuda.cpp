@@ -1,4 +1,7 @@
-#include "cuda/bench_rays_cuda.h"
+// Compiled only with the CUDA backend (the build glob takes every bench/*.cpp).
+#include "bench/bench_rays_cuda.h"
+
+#if LUCENT_HAVE_CUDA
 
 #include <algorithm>
 #include <atomic>
@@ -547,3 +550,5 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
 }
 
 }  // namespace lucent::cuda
+
+#endif  // LUCENT_HAVE_CUDA
