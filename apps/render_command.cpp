@@ -104,7 +104,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
         ->check(CLI::Range(0u, 4096u).description(""))
         ->capture_default_str();
     cmd->add_flag("-v,--verbose", args.verbose,
-                  "Print the settings, and the megakernel's compile or cache-load time");
+                  "Print the settings and the sample's options before rendering");
     cmd->add_option("--repeat", args.repeat,
                     "Launch this many times and report the median launch time and frames/s")
         ->type_name("N")
@@ -119,7 +119,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"
                 "  lucent render --size 640x480 --threads 2 --out quick.png\n"
                 "  lucent render --out whitted.pfm      # linear float image\n"
-                "  lucent render --backend cuda         # fails with a message without CUDA\n");
+                "  lucent render --backend cuda         # on the GPU; a clear error without one\n"
+                "  lucent render --repeat 500           # median launch time and frames/s\n"
+                "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n");
     return cmd;
 }
 
