@@ -8,11 +8,10 @@
 #include <sstream>
 
 namespace lucent::cli {
-namespace {
 
-std::string quoted(const std::string& text) {
-    return "'" + text + "'";
-}
+std::string quoted(const std::string& text) { return "'" + text + "'"; }
+
+namespace {
 
 /// A whole-string number; false on trailing junk, overflow or a non-finite value.
 template <class T>

@@ -8,6 +8,7 @@
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "render_command.h"
+#include "tea_command.h"
 #include "samples/settings_error.h"
 
 namespace {
@@ -31,15 +32,18 @@ int main(int argc, char** argv) {
         "Examples:\n"
         "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"
         "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
+        "  lucent tea --block 0,0 --key 0,0,0,0 --rounds 32\n"
         "Run `lucent render --help` for the samples and their options.\n");
 
     RenderArgs render_args;
     BenchRaysArgs rays_args;
     BenchBuildArgs build_args;
+    TeaArgs tea_args;
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
         BenchCommands bench = add_bench_commands(app, rays_args, build_args);
+        CLI::App* tea = add_tea_command(app, tea_args);
         try {
             app.parse(argc, argv);
         } catch (const CLI::ParseError& e) {
@@ -57,6 +61,10 @@ int main(int argc, char** argv) {
         if (bench.build->parsed()) {
             where = "lucent bench build";
             return run_bench_build_command(build_args);
+        }
+        if (tea->parsed()) {
+            where = "lucent tea";
+            return run_tea(tea_args);
         }
         return report(where, "", "no command given; run `lucent --help`", kUsageExit);
     } catch (const UsageError& e) {

@@ -5,5 +5,6 @@
 #include "lucent/device/api.h"
 #include "lucent/device/program.h"
 #include "lucent/device/reflect.h"
+#include "lucent/device/tea.h"
 #include "lucent/device/types.h"
 #include "lucent/device/vector_math.h"
