@@ -8,6 +8,7 @@
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "render_command.h"
+#include "noise_command.h"
 #include "tea_command.h"
 #include "samples/settings_error.h"
 
@@ -39,11 +40,13 @@ int main(int argc, char** argv) {
     BenchRaysArgs rays_args;
     BenchBuildArgs build_args;
     TeaArgs tea_args;
+    NoiseArgs noise_args;
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
         BenchCommands bench = add_bench_commands(app, rays_args, build_args);
         CLI::App* tea = add_tea_command(app, tea_args);
+        CLI::App* noise = add_noise_command(app, noise_args);
         try {
             app.parse(argc, argv);
         } catch (const CLI::ParseError& e) {
@@ -65,6 +68,10 @@ int main(int argc, char** argv) {
         if (tea->parsed()) {
             where = "lucent tea";
             return run_tea(tea_args);
+        }
+        if (noise->parsed()) {
+            where = "lucent noise";
+            return run_noise(noise_args);
         }
         return report(where, "", "no command given; run `lucent --help`", kUsageExit);
     } catch (const UsageError& e) {
