@@ -5,6 +5,7 @@
 
 #include "bench/bench_commands.h"
 #include "cli_parse.h"
+#include "samples/tea/tea_bench.h"
 #include "lucent/context.h"
 #include "lucent/error.h"
 
@@ -27,7 +28,8 @@ std::string bench_backend(const std::string& text) {
 
 }  // namespace
 
-BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build) {
+BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build,
+                                 BenchTeaArgs& tea) {
     BenchCommands cmds;
     cmds.bench = app.add_subcommand("bench", "Benchmarks: ray throughput and BVH build time");
     cmds.bench->require_subcommand(1);
@@ -69,6 +71,24 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
         "  lucent bench rays --scene ../shared/scenes/bunny.obj --size 512x384 --repeat 9\n"
         "  lucent bench rays --scene my.obj --eye 0,1,5 --look 0,1,0 --up 0,1,0 --fov 45 "
         "--light 0,5,0\n");
+
+    CLI::App* t = cmds.bench->add_subcommand(
+        "tea", "TEA random numbers in 1 MB launches, fixed against generated key (Sebald Table 2)");
+    t->add_option("--backend", tea.backend, "cpu, cuda or auto")->type_name("KIND")->capture_default_str();
+    t->add_option("--threads", tea.threads, "CPU worker threads, 0 = one per core")->type_name("N");
+    t->add_option("--megabytes", tea.megabytes, "Output per key variant, 1..65536")
+        ->type_name("MB")
+        ->check(CLI::Range(1u, 65536u).description(""))
+        ->capture_default_str();
+    t->add_option("--rounds", tea.rounds, "TEA rounds, 1..64")
+        ->type_name("N")
+        ->check(CLI::Range(1u, 64u).description(""))
+        ->capture_default_str();
+    t->add_option("--device", tea.device, "Device identifier in the generated key")->type_name("D");
+    t->add_option("--seed", tea.seed, "Seed in the generated key")->type_name("S");
+    t->add_flag("--json", tea.json, "One JSON object instead of text");
+    t->footer("\nExamples:\n  lucent bench tea\n  lucent bench tea --megabytes 256 --rounds 4 --json\n");
+    cmds.tea = t;
 
     CLI::App* b = cmds.bench->add_subcommand("build", "Time the BVH build of a scene");
     b->add_option("--scene", build.scene, "OBJ file")->type_name("FILE")->required();
@@ -142,6 +162,18 @@ int run_bench_build_command(const BenchBuildArgs& args) {
     options.json = args.json;
     options.backend = bench_backend(args.backend);
     return bench::run_bench_build(options);
+}
+
+int run_bench_tea_command(const BenchTeaArgs& args) {
+    samples::TeaBenchOptions options;
+    options.backend = parse_backend("--backend", args.backend);
+    options.threads = args.threads;
+    options.megabytes = args.megabytes;
+    options.rounds = args.rounds;
+    options.device = args.device;
+    options.seed = args.seed;
+    options.json = args.json;
+    return samples::run_tea_bench(options);
 }
 
 }  // namespace lucent::cli

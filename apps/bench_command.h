@@ -28,14 +28,28 @@ struct BenchBuildArgs {
     std::string backend = "cpu";
 };
 
+/// `bench tea` options as typed.
+struct BenchTeaArgs {
+    std::string backend = "cpu";
+    unsigned threads = 0;
+    unsigned megabytes = 2048;
+    unsigned rounds = 2;
+    unsigned device = 0, seed = 0;
+    bool json = false;
+};
+
 struct BenchCommands {
     CLI::App* bench = nullptr;
     CLI::App* rays = nullptr;
     CLI::App* build = nullptr;
+    CLI::App* tea = nullptr;
 };
 
 /// Adds `bench` with its `rays` and `build` subcommands to `app`.
-BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build);
+BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildArgs& build,
+                                 BenchTeaArgs& tea);
+/// Runs a parsed `bench tea`; returns the exit code.
+int run_bench_tea_command(const BenchTeaArgs& args);
 /// Runs a parsed `bench rays`; returns the exit code. Throws UsageError, lucent::Error.
 int run_bench_rays_command(const BenchRaysArgs& args);
 /// Runs a parsed `bench build`; returns the exit code.

@@ -39,12 +39,13 @@ int main(int argc, char** argv) {
     RenderArgs render_args;
     BenchRaysArgs rays_args;
     BenchBuildArgs build_args;
+    BenchTeaArgs bench_tea_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
-        BenchCommands bench = add_bench_commands(app, rays_args, build_args);
+        BenchCommands bench = add_bench_commands(app, rays_args, build_args, bench_tea_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         try {
@@ -64,6 +65,10 @@ int main(int argc, char** argv) {
         if (bench.build->parsed()) {
             where = "lucent bench build";
             return run_bench_build_command(build_args);
+        }
+        if (bench.tea->parsed()) {
+            where = "lucent bench tea";
+            return run_bench_tea_command(bench_tea_args);
         }
         if (tea->parsed()) {
             where = "lucent tea";

@@ -7,6 +7,8 @@
 #include <string>
 
 #include "lucent/device/tea.h"
+#include "lucent/context.h"
+#include "samples/tea/tea_programs.h"
 #include "samples/tea/tea_statistics.h"
 
 namespace {
@@ -83,6 +85,35 @@ TEST(TeaStatistics, OneAndTwoRoundsFailThem) {
     for (unsigned rounds : {1u, 2u})
         EXPECT_FALSE(lucent::samples::measure_tea(rounds, lucent::zafar_tea_key(), 1u << 19).passes())
             << rounds << " rounds";
+}
+
+TEST(TeaPrograms, LaunchFillsTheBufferWithTheStreamOfEachKey) {
+    // The bench's programs through the engine: both variants give tea(first + i, 0) with
+    // their key; on the CUDA build the megakernel of the pair must also compile.
+    lucent::ContextOptions options{lucent::BackendKind::kCpu, 2};
+#if LUCENT_HAVE_CUDA
+    options.jit_check_sm = 90;
+#endif
+    lucent::Context ctx(options);
+    ctx.set_entry_point_count(2);
+    ctx.set_ray_generation_program(0, ctx.create_program(LUCENT_PROGRAM(tea_fixed_key)));
+    ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(tea_device_key)));
+    auto out = ctx.create_buffer<uint2>(lucent::BufferType::kOutput, 1000);
+    const uint4 device_key = lucent::generate_tea_key(lucent::zafar_tea_key(), make_uint2(3, 7));
+    ctx["out"] = out;
+    ctx["rounds"] = 4u;
+    ctx["first_block"] = 500u;
+    ctx["key"] = device_key;
+    for (unsigned entry : {0u, 1u}) {
+        ctx.launch(entry, 1000);
+        const uint4 key = entry == 0 ? lucent::zafar_tea_key() : device_key;
+        const uint2* words = out->data<uint2>();
+        for (unsigned i = 0; i < 1000; ++i) {
+            uint2 expected = tea(make_uint2(500 + i, 0), key, 4);
+            ASSERT_EQ(words[i].x, expected.x) << "entry " << entry << ", block " << i;
+            ASSERT_EQ(words[i].y, expected.y);
+        }
+    }
 }
 
 TEST(TeaCli, PrintsTheEncryptedPairAsHexWords) {
