@@ -1,6 +1,8 @@
 // Value parsers of the command line (see cli_parse.h).
 #include "cli_parse.h"
 
+#include "scene/exr_encoder.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -101,9 +103,13 @@ void check_image_path(const std::string& flag, const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".png" && ext != ".pfm")
+    if (ext != ".png" && ext != ".pfm" && ext != ".exr")
         throw UsageError(flag + " " + quoted(path) +
-                         ": the file name must end in .png (8-bit sRGB) or .pfm (32-bit float)");
+                         ": the file name must end in .png (8-bit sRGB), .exr (OpenEXR, float) "
+                         "or .pfm (32-bit float)");
+    if (ext == ".exr" && !scene::exr_supported())
+        throw UsageError(flag + " " + quoted(path) +
+                         ": this build has no OpenEXR (install libopenexr-dev); use .pfm");
     const fs::path dir = fs::path(path).parent_path();
     std::error_code ec;
     if (!dir.empty() && !fs::is_directory(dir, ec))

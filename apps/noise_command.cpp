@@ -22,7 +22,7 @@ CLI::App* add_noise_command(CLI::App& app, NoiseArgs& args) {
     cmd->add_option("--size", args.size, "Image side in pixels, 8..4096 (default: the kind's)")
         ->type_name("N")
         ->check(CLI::Range(8u, 4096u).description(""));
-    cmd->add_option("-o,--out", args.out, "Output image: .png or .pfm")->type_name("FILE")->capture_default_str();
+    cmd->add_option("-o,--out", args.out, "Output image: .png, .exr or .pfm")->type_name("FILE")->capture_default_str();
     cmd->add_option("--seed", args.seed,
                     "Draw with a per-device key made from (--device, seed) (Sebald Fig. 4); "
                     "without it, Zafar et al.'s fixed key")

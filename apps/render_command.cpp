@@ -89,7 +89,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--size", args.size, "Image size, each side 1..16384")
         ->type_name("WxH")
         ->capture_default_str();
-    cmd->add_option("-o,--out", args.out, "Output image: .png (8-bit sRGB) or .pfm (float)")
+    cmd->add_option("-o,--out", args.out, "Output image: .png (8-bit sRGB), .exr or .pfm (linear float)")
         ->type_name("FILE")
         ->capture_default_str();
     cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
@@ -118,7 +118,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "\nExamples:\n"
                 "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"
                 "  lucent render --size 640x480 --threads 2 --out quick.png\n"
-                "  lucent render --out whitted.pfm      # linear float image\n"
+                "  lucent render --out whitted.exr      # linear float image (or .pfm)\n"
                 "  lucent render --backend cuda         # on the GPU; a clear error without one\n"
                 "  lucent render --repeat 500           # median launch time and frames/s\n"
                 "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n");

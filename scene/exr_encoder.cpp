@@ -1,0 +1,99 @@
+#include "scene/exr_encoder.h"
+
+#include "lucent/error.h"
+
+#if LUCENT_HAVE_OPENEXR
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+
+#include <cstring>
+#endif
+
+namespace lucent::scene {
+
+#if LUCENT_HAVE_OPENEXR
+namespace {
+/// An Imf::OStream into a byte vector, so the file is written whole (and atomically) by
+/// write_image like every other format.
+class MemoryStream : public Imf::OStream {
+  public:
+    explicit MemoryStream(std::vector<unsigned char>& bytes) : Imf::OStream("memory"), m_bytes(bytes) {}
+    void write(const char c[], int n) override {
+        if (m_position + size_t(n) > m_bytes.size()) m_bytes.resize(m_position + size_t(n));
+        std::memcpy(m_bytes.data() + m_position, c, size_t(n));
+        m_position += size_t(n);
+    }
+    uint64_t tellp() override { return m_position; }
+    void seekp(uint64_t position) override { m_position = size_t(position); }
+
+  private:
+    std::vector<unsigned char>& m_bytes;
+    size_t m_position = 0;
+};
+}  // namespace
+
+bool exr_supported() { return true; }
+
+std::vector<unsigned char> encode_exr(const std::string& path, const Image& image) {
+    std::vector<unsigned char> bytes;
+    try {
+        Imf::Header header(int(image.width), int(image.height));
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+        // float3 pixels, row-major from the top: each channel is a strided view of them.
+        char* base = const_cast<char*>(reinterpret_cast<const char*>(image.pixels.data()));
+        const size_t xs = sizeof(float3), ys = sizeof(float3) * image.width;
+        Imf::FrameBuffer frame;
+        frame.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(float3, x), xs, ys));
+        frame.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(float3, y), xs, ys));
+        frame.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(float3, z), xs, ys));
+        MemoryStream stream(bytes);
+        Imf::OutputFile file(stream, header);
+        file.setFrameBuffer(frame);
+        file.writePixels(int(image.height));
+    } catch (const std::exception& e) {
+        throw Error("cannot write '" + path + "': OpenEXR encoding failed: " + e.what());
+    }
+    return bytes;
+}
+Image read_exr(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i window = file.header().dataWindow();
+        Image image;
+        image.width = unsigned(window.max.x - window.min.x + 1);
+        image.height = unsigned(window.max.y - window.min.y + 1);
+        image.pixels.resize(size_t(image.width) * image.height);
+        char* base = reinterpret_cast<char*>(image.pixels.data()) -
+                     (size_t(window.min.y) * image.width + size_t(window.min.x)) * sizeof(float3);
+        const size_t xs = sizeof(float3), ys = sizeof(float3) * image.width;
+        Imf::FrameBuffer frame;
+        frame.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(float3, x), xs, ys));
+        frame.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(float3, y), xs, ys));
+        frame.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(float3, z), xs, ys));
+        file.setFrameBuffer(frame);
+        file.readPixels(window.min.y, window.max.y);
+        return image;
+    } catch (const std::exception& e) {
+        throw Error("cannot read '" + path + "': " + e.what());
+    }
+}
+#else
+bool exr_supported() { return false; }
+
+Image read_exr(const std::string& path) {
+    throw Error("cannot read '" + path + "': this build has no OpenEXR");
+}
+
+std::vector<unsigned char> encode_exr(const std::string& path, const Image&) {
+    throw Error("cannot write '" + path +
+                "': this build has no OpenEXR (install libopenexr-dev and reconfigure); use "
+                ".pfm for a float image");
+}
+#endif
+
+}  // namespace lucent::scene
