@@ -5,9 +5,10 @@
 
 #include "bench/bench_commands.h"
 #include "cli_parse.h"
-#include "samples/tea/tea_bench.h"
 #include "lucent/context.h"
 #include "lucent/error.h"
+#include "progress_bar.h"
+#include "samples/tea/tea_bench.h"
 
 namespace lucent::cli {
 namespace {
@@ -74,7 +75,9 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
 
     CLI::App* t = cmds.bench->add_subcommand(
         "tea", "TEA random numbers in 1 MB launches, fixed against generated key (Sebald Table 2)");
-    t->add_option("--backend", tea.backend, "cpu, cuda or auto")->type_name("KIND")->capture_default_str();
+    t->add_option("--backend", tea.backend, "cpu, cuda or auto")
+        ->type_name("KIND")
+        ->capture_default_str();
     t->add_option("--threads", tea.threads, "CPU worker threads, 0 = one per core")->type_name("N");
     t->add_option("--megabytes", tea.megabytes, "Output per key variant, 1..65536")
         ->type_name("MB")
@@ -87,7 +90,8 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     t->add_option("--device", tea.device, "Device identifier in the generated key")->type_name("D");
     t->add_option("--seed", tea.seed, "Seed in the generated key")->type_name("S");
     t->add_flag("--json", tea.json, "One JSON object instead of text");
-    t->footer("\nExamples:\n  lucent bench tea\n  lucent bench tea --megabytes 256 --rounds 4 --json\n");
+    t->footer(
+        "\nExamples:\n  lucent bench tea\n  lucent bench tea --megabytes 256 --rounds 4 --json\n");
     cmds.tea = t;
 
     CLI::App* b = cmds.bench->add_subcommand("build", "Time the BVH build of a scene");
@@ -173,6 +177,9 @@ int run_bench_tea_command(const BenchTeaArgs& args) {
     options.device = args.device;
     options.seed = args.seed;
     options.json = args.json;
+    ProgressBar bar("bench tea", "MB");
+    if (!args.json)
+        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
     return samples::run_tea_bench(options);
 }
 

@@ -11,7 +11,9 @@
 
 namespace lucent::cli {
 
-std::string quoted(const std::string& text) { return "'" + text + "'"; }
+std::string quoted(const std::string& text) {
+    return "'" + text + "'";
+}
 
 namespace {
 

@@ -7,10 +7,10 @@
 #include "bench_command.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
-#include "render_command.h"
 #include "noise_command.h"
-#include "tea_command.h"
+#include "render_command.h"
 #include "samples/settings_error.h"
+#include "tea_command.h"
 
 namespace {
 

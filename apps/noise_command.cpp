@@ -10,8 +10,10 @@
 namespace lucent::cli {
 
 CLI::App* add_noise_command(CLI::App& app, NoiseArgs& args) {
-    CLI::App* cmd = app.add_subcommand("noise", "Write a TEA noise image (white, gradient, spectrum)");
-    cmd->add_option("--kind", args.kind, "white (64x64), gradient (256x256) or spectrum (1024x1024)")
+    CLI::App* cmd =
+        app.add_subcommand("noise", "Write a TEA noise image (white, gradient, spectrum)");
+    cmd->add_option("--kind", args.kind,
+                    "white (64x64), gradient (256x256) or spectrum (1024x1024)")
         ->type_name("KIND")
         ->check(CLI::IsMember({"white", "gradient", "spectrum"}))
         ->capture_default_str();
@@ -22,7 +24,9 @@ CLI::App* add_noise_command(CLI::App& app, NoiseArgs& args) {
     cmd->add_option("--size", args.size, "Image side in pixels, 8..4096 (default: the kind's)")
         ->type_name("N")
         ->check(CLI::Range(8u, 4096u).description(""));
-    cmd->add_option("-o,--out", args.out, "Output image: .png, .exr or .pfm")->type_name("FILE")->capture_default_str();
+    cmd->add_option("-o,--out", args.out, "Output image: .png, .exr or .pfm")
+        ->type_name("FILE")
+        ->capture_default_str();
     cmd->add_option("--seed", args.seed,
                     "Draw with a per-device key made from (--device, seed) (Sebald Fig. 4); "
                     "without it, Zafar et al.'s fixed key")
@@ -39,9 +43,10 @@ CLI::App* add_noise_command(CLI::App& app, NoiseArgs& args) {
 
 int run_noise(const NoiseArgs& args) {
     check_image_path("--out", args.out);
-    const uint4 key = args.seed >= 0
-                          ? generate_tea_key(zafar_tea_key(), make_uint2(args.device, unsigned(args.seed)))
-                          : zafar_tea_key();
+    const uint4 key =
+        args.seed >= 0
+            ? generate_tea_key(zafar_tea_key(), make_uint2(args.device, unsigned(args.seed)))
+            : zafar_tea_key();
     scene::Image image;
     if (args.kind == "white") {
         unsigned n = args.size ? args.size : 64;

@@ -9,9 +9,9 @@ namespace lucent::cli {
 struct NoiseArgs {
     std::string kind = "white";  // white (64x64), gradient (256x256), spectrum (1024x1024)
     unsigned rounds = 4;
-    unsigned size = 0;           // 0: the kind's size above
+    unsigned size = 0;  // 0: the kind's size above
     std::string out = "noise.png";
-    long long seed = -1;         // >= 0: a per-device key (Fig. 4) from (device, seed)
+    long long seed = -1;  // >= 0: a per-device key (Fig. 4) from (device, seed)
     unsigned device = 0;
 };
 

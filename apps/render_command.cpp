@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli_parse.h"
+#include "progress_bar.h"
 #include "samples/sample.h"
 
 namespace lucent::cli {
@@ -89,7 +90,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--size", args.size, "Image size, each side 1..16384")
         ->type_name("WxH")
         ->capture_default_str();
-    cmd->add_option("-o,--out", args.out, "Output image: .png (8-bit sRGB), .exr or .pfm (linear float)")
+    cmd->add_option("-o,--out", args.out,
+                    "Output image: .png (8-bit sRGB), .exr or .pfm (linear float)")
         ->type_name("FILE")
         ->capture_default_str();
     cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
@@ -138,8 +140,13 @@ int run_render(const RenderArgs& args) {
             std::printf("  --set %s=%s\n", name.c_str(), value.c_str());
     }
 
+    ProgressBar bar("render", "launches");
+    samples::RenderSettings run = settings;
+    if (settings.repeat > 1)
+        run.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
     const Clock::time_point start = Clock::now();
-    samples::RenderResult result = info.render(settings);
+    samples::RenderResult result = info.render(run);
+    bar.finish();
     const Clock::time_point written = Clock::now();
     scene::write_image(args.out, result.image);
     const double write_ms = ms_since(written);

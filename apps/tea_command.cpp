@@ -44,7 +44,8 @@ std::vector<unsigned> parse_words(const std::string& flag, const std::string& te
 }  // namespace
 
 CLI::App* add_tea_command(CLI::App& app, TeaArgs& args) {
-    CLI::App* cmd = app.add_subcommand("tea", "Encrypt a block with TEA (the fog sample's random numbers)");
+    CLI::App* cmd =
+        app.add_subcommand("tea", "Encrypt a block with TEA (the fog sample's random numbers)");
     cmd->add_option("--block", args.block, "The two 32-bit words to encrypt")
         ->type_name("V0,V1")
         ->capture_default_str();
@@ -73,8 +74,10 @@ CLI::App* add_tea_command(CLI::App& app, TeaArgs& args) {
 
 int run_tea(const TeaArgs& args) {
     if (args.statistics) {
-        std::printf("rounds  ones      bit z    byte chi2  p        serial corr  verdict   (%u blocks, %u bytes)\n",
-                    args.blocks, args.blocks * 8);
+        std::printf(
+            "rounds  ones      bit z    byte chi2  p        serial corr  verdict   (%u blocks, %u "
+            "bytes)\n",
+            args.blocks, args.blocks * 8);
         for (unsigned rounds : {1u, 2u, 3u, 4u, 5u, 6u, 8u, 16u, 32u}) {
             samples::TeaStatistics s = samples::measure_tea(rounds, zafar_tea_key(), args.blocks);
             std::printf("%6u  %.5f  %7.2f  %9.1f  %.4f  %+11.6f  %s\n", rounds, s.ones_fraction,

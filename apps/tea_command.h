@@ -7,11 +7,11 @@
 namespace lucent::cli {
 
 struct TeaArgs {
-    std::string block = "0,0";     // v0,v1
-    std::string key = "0,0,0,0";   // k0,k1,k2,k3
+    std::string block = "0,0";    // v0,v1
+    std::string key = "0,0,0,0";  // k0,k1,k2,k3
     unsigned rounds = 32;
-    bool statistics = false;       // the table of rounds against output statistics
-    unsigned blocks = 1u << 20;    // blocks measured per row of that table
+    bool statistics = false;     // the table of rounds against output statistics
+    unsigned blocks = 1u << 20;  // blocks measured per row of that table
 };
 
 /// Adds the `tea` subcommand to `app`; its options fill `args`.

@@ -2,6 +2,7 @@
 // (given as --set name=value) and a render function.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -27,6 +28,8 @@ struct RenderSettings {
     bool verbose = false;
     int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel
     unsigned repeat = 1;   // --repeat: launches timed after the first
+    /// Called as launches complete (done, total), e.g. for a progress bar; may be empty.
+    std::function<void(unsigned, unsigned)> progress;
 
     /// The Context options these settings ask for.
     ContextOptions context_options() const {

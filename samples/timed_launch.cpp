@@ -28,6 +28,7 @@ void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
         ctx.launch(entry, settings.width, settings.height);
         ms.push_back(ctx.last_launch().launch_ms);
         kernel.push_back(ctx.last_launch().kernel_ms);
+        if (settings.progress) settings.progress(i, settings.repeat - 1);
     }
     std::sort(ms.begin(), ms.end());
     std::sort(kernel.begin(), kernel.end());

@@ -21,7 +21,8 @@ namespace {
 /// write_image like every other format.
 class MemoryStream : public Imf::OStream {
   public:
-    explicit MemoryStream(std::vector<unsigned char>& bytes) : Imf::OStream("memory"), m_bytes(bytes) {}
+    explicit MemoryStream(std::vector<unsigned char>& bytes)
+        : Imf::OStream("memory"), m_bytes(bytes) {}
     void write(const char c[], int n) override {
         if (m_position + size_t(n) > m_bytes.size()) m_bytes.resize(m_position + size_t(n));
         std::memcpy(m_bytes.data() + m_position, c, size_t(n));
@@ -36,7 +37,9 @@ class MemoryStream : public Imf::OStream {
 };
 }  // namespace
 
-bool exr_supported() { return true; }
+bool exr_supported() {
+    return true;
+}
 
 std::vector<unsigned char> encode_exr(const std::string& path, const Image& image) {
     std::vector<unsigned char> bytes;
@@ -83,7 +86,9 @@ Image read_exr(const std::string& path) {
     }
 }
 #else
-bool exr_supported() { return false; }
+bool exr_supported() {
+    return false;
+}
 
 Image read_exr(const std::string& path) {
     throw Error("cannot read '" + path + "': this build has no OpenEXR");

@@ -153,10 +153,11 @@ std::vector<unsigned char> to_srgb8(const Image& image) {
 void write_image(const std::string& path, const Image& image) {
     const std::string ext = lower_extension(path);
     if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-        throw Error("cannot write '" + path + "': " +
-                    (ext.empty() ? std::string("no file extension")
-                                 : "unknown image extension '" + ext + "'") +
-                    "; use .png (8-bit sRGB), .exr (OpenEXR, float) or .pfm (32-bit float, linear)");
+        throw Error(
+            "cannot write '" + path + "': " +
+            (ext.empty() ? std::string("no file extension")
+                         : "unknown image extension '" + ext + "'") +
+            "; use .png (8-bit sRGB), .exr (OpenEXR, float) or .pfm (32-bit float, linear)");
     check_image(path, image);
     std::vector<unsigned char> bytes = ext == ".png"   ? encode_png(path, image)
                                        : ext == ".exr" ? encode_exr(path, image)

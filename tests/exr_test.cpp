@@ -16,7 +16,8 @@ TEST(Exr, WriteAndReadBackGivesTheSameFloats) {
     image.height = 3;
     for (unsigned i = 0; i < 21; ++i)
         image.pixels.push_back(make_float3(i * 0.1f, 1e-4f * i, 100.0f + i));  // beyond [0, 1]
-    const std::string path = (std::filesystem::temp_directory_path() / "lucent_exr_test.exr").string();
+    const std::string path =
+        (std::filesystem::temp_directory_path() / "lucent_exr_test.exr").string();
     lucent::scene::write_image(path, image);
     auto back = lucent::scene::read_exr(path);
     std::filesystem::remove(path);

@@ -24,7 +24,7 @@ TEST(TeaNoise, WhiteNoiseIsUniformOnTheUnitInterval) {
         squares += double(p.x) * p.x;
     }
     const double n = double(image.pixels.size()), mean = sum / n;
-    EXPECT_NEAR(mean, 0.5, 0.02);                       // 4.4 sigma for 4096 samples
+    EXPECT_NEAR(mean, 0.5, 0.02);  // 4.4 sigma for 4096 samples
     EXPECT_NEAR(squares / n - mean * mean, 1.0 / 12, 0.01);
 }
 
@@ -38,7 +38,9 @@ TEST(TeaNoise, GradientNoiseIsSmoothAndCentred) {
             ASSERT_GE(v, 0.0f);
             ASSERT_LE(v, 1.0f);
             sum += v;
-            if (x > 0) largest_step = std::max(largest_step, std::fabs(v - image.pixels[y * 256 + x - 1].x));
+            if (x > 0)
+                largest_step =
+                    std::max(largest_step, std::fabs(v - image.pixels[y * 256 + x - 1].x));
         }
     EXPECT_NEAR(sum / (256.0 * 256.0), 0.5, 0.05);
     EXPECT_LT(largest_step, 0.1f) << "one octave over 32-pixel cells changes slowly";

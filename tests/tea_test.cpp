@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
-#include "lucent/device/tea.h"
 #include "lucent/context.h"
+#include "lucent/device/tea.h"
 #include "samples/tea/tea_programs.h"
 #include "samples/tea/tea_statistics.h"
 
@@ -83,7 +83,8 @@ TEST(TeaStatistics, FourRoundsAndMorePassTheBitByteAndSerialTests) {
 TEST(TeaStatistics, OneAndTwoRoundsFailThem) {
     // The same tests reject too few rounds: they are not vacuous.
     for (unsigned rounds : {1u, 2u})
-        EXPECT_FALSE(lucent::samples::measure_tea(rounds, lucent::zafar_tea_key(), 1u << 19).passes())
+        EXPECT_FALSE(
+            lucent::samples::measure_tea(rounds, lucent::zafar_tea_key(), 1u << 19).passes())
             << rounds << " rounds";
 }
 

@@ -16,7 +16,7 @@ struct VariantResult {
 };
 
 VariantResult run_variant(Context& ctx, const std::shared_ptr<Buffer>& out, unsigned megabytes,
-                          unsigned entry) {
+                          unsigned entry, const std::function<void(unsigned)>& progress) {
     VariantResult r;
     ctx.launch(entry, kBlocksPerMegabyte);  // compile (and JIT) before timing
     auto start = std::chrono::steady_clock::now();
@@ -25,6 +25,7 @@ VariantResult run_variant(Context& ctx, const std::shared_ptr<Buffer>& out, unsi
         ctx.launch(entry, kBlocksPerMegabyte);
         const uint2* words = out->data<uint2>();  // the 1 MB reaches the host, as in the seed
         for (unsigned i = 0; i < kBlocksPerMegabyte; ++i) r.checksum ^= words[i].x ^ words[i].y;
+        if (progress) progress(mb + 1);
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return r;
@@ -42,15 +43,23 @@ int run_tea_bench(const TeaBenchOptions& options) {
     ctx["first_block"] = 0u;
     ctx["key"] = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
 
-    const VariantResult fixed = run_variant(ctx, out, options.megabytes, 0);
-    const VariantResult device = run_variant(ctx, out, options.megabytes, 1);
+    const unsigned total = 2 * options.megabytes;
+    auto report_from = [&](unsigned offset) {
+        return [&options, offset, total](unsigned done) {
+            if (options.progress) options.progress(offset + done, total);
+        };
+    };
+    const VariantResult fixed = run_variant(ctx, out, options.megabytes, 0, report_from(0));
+    const VariantResult device =
+        run_variant(ctx, out, options.megabytes, 1, report_from(options.megabytes));
     const double mb = options.megabytes;
     if (options.json) {
-        std::printf("{\"backend\": \"%s\", \"megabytes\": %u, \"rounds\": %u, "
-                    "\"fixed_key_mb_per_s\": %.1f, \"generated_key_mb_per_s\": %.1f, "
-                    "\"fixed_checksum\": \"%08x\", \"generated_checksum\": \"%08x\"}\n",
-                    ctx.backend_name().c_str(), options.megabytes, options.rounds,
-                    mb / fixed.seconds, mb / device.seconds, fixed.checksum, device.checksum);
+        std::printf(
+            "{\"backend\": \"%s\", \"megabytes\": %u, \"rounds\": %u, "
+            "\"fixed_key_mb_per_s\": %.1f, \"generated_key_mb_per_s\": %.1f, "
+            "\"fixed_checksum\": \"%08x\", \"generated_checksum\": \"%08x\"}\n",
+            ctx.backend_name().c_str(), options.megabytes, options.rounds, mb / fixed.seconds,
+            mb / device.seconds, fixed.checksum, device.checksum);
         return 0;
     }
     if (!ctx.backend_notice().empty()) std::printf("note: %s\n", ctx.backend_notice().c_str());

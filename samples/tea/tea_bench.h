@@ -2,6 +2,7 @@
 // with the fixed key against the generated per-device key, in MB/s, on any backend.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "lucent/context.h"
@@ -15,6 +16,8 @@ struct TeaBenchOptions {
     unsigned rounds = 2;        // the seed's fog uses 2
     unsigned device = 0, seed = 0;
     bool json = false;
+    /// Called as megabytes complete (done, total, over both variants); may be empty.
+    std::function<void(unsigned, unsigned)> progress;
 };
 
 /// Runs both variants and prints MB/s (and an XOR checksum of all output) per variant.

@@ -22,7 +22,9 @@ scene::Image gray_image(unsigned width, unsigned height) {
     return image;
 }
 
-float quintic(float t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+float quintic(float t) {
+    return t * t * t * (t * (t * 6 - 15) + 10);
+}
 }  // namespace
 
 scene::Image white_noise(unsigned width, unsigned height, unsigned rounds, uint4 key) {
@@ -36,7 +38,8 @@ scene::Image gradient_noise(unsigned width, unsigned height, unsigned cell, unsi
                             uint4 key) {
     scene::Image image = gray_image(width, height);
     auto gradient = [&](int ix, int iy) {
-        float angle = 6.2831853f * tea_unit_float(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds).x);
+        float angle =
+            6.2831853f * tea_unit_float(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds).x);
         return make_float2(std::cos(angle), std::sin(angle));
     };
     for (unsigned y = 0; y < height; ++y)
@@ -78,7 +81,8 @@ scene::Image noise_spectrum(unsigned size, unsigned rounds, uint4 key) {
     fftwf_destroy_plan(plan);
     fftwf_free(out);
     float top = *std::max_element(power.begin(), power.end());
-    for (size_t i = 0; i < power.size(); ++i) image.pixels[i] = make_float3(top > 0 ? power[i] / top : 0);
+    for (size_t i = 0; i < power.size(); ++i)
+        image.pixels[i] = make_float3(top > 0 ? power[i] / top : 0);
     return image;
 #else
     (void)size, (void)rounds, (void)key;

@@ -38,8 +38,10 @@ TeaStatistics measure_tea(unsigned rounds, uint4 key, uint64_t blocks, unsigned 
                 ++histogram[byte];
                 sum += byte;
                 sum_squares += double(byte) * byte;
-                if (have_previous) sum_products += double(previous) * byte;
-                else first = byte;
+                if (have_previous)
+                    sum_products += double(previous) * byte;
+                else
+                    first = byte;
                 previous = byte;
                 have_previous = true;
             }
@@ -54,7 +56,8 @@ TeaStatistics measure_tea(unsigned rounds, uint4 key, uint64_t blocks, unsigned 
     s.ones_fraction = double(ones) / bits;
     s.bit_balance_z = (double(ones) - bits / 2) / std::sqrt(bits / 4);
     const double expected = n / 256;
-    for (uint64_t count : histogram) s.byte_chi_square += (count - expected) * (count - expected) / expected;
+    for (uint64_t count : histogram)
+        s.byte_chi_square += (count - expected) * (count - expected) / expected;
     s.chi_square_p = chi_square_upper_tail(s.byte_chi_square, 255);
     const double denominator = n * sum_squares - sum * sum;
     s.serial_correlation = denominator == 0 ? 1.0 : (n * sum_products - sum * sum) / denominator;

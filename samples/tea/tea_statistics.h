@@ -12,10 +12,10 @@ namespace lucent::samples {
 struct TeaStatistics {
     unsigned rounds = 0;
     uint64_t bytes = 0;
-    double ones_fraction = 0;     // of all output bits; 0.5 expected
-    double bit_balance_z = 0;     // (ones - n/2) / sqrt(n/4): |z| < 5 expected
-    double byte_chi_square = 0;   // 256 bins, 255 degrees of freedom: about 255 expected
-    double chi_square_p = 0;      // upper-tail probability of that chi-square
+    double ones_fraction = 0;       // of all output bits; 0.5 expected
+    double bit_balance_z = 0;       // (ones - n/2) / sqrt(n/4): |z| < 5 expected
+    double byte_chi_square = 0;     // 256 bins, 255 degrees of freedom: about 255 expected
+    double chi_square_p = 0;        // upper-tail probability of that chi-square
     double serial_correlation = 0;  // of successive bytes: |r| < 5 / sqrt(bytes) expected
 
     /// Whether every statistic is inside the bounds above (chi-square p in [1e-4, 1 - 1e-4]).

@@ -63,6 +63,8 @@ LUCENT_HD inline uint4 zafar_tea_key() {
 }
 
 /// A uniform float in [0, 1) from the top 24 bits of a TEA output word.
-LUCENT_HD inline float tea_unit_float(unsigned word) { return float(word >> 8) * (1.0f / 16777216.0f); }
+LUCENT_HD inline float tea_unit_float(unsigned word) {
+    return float(word >> 8) * (1.0f / 16777216.0f);
+}
 
 }  // namespace lucent

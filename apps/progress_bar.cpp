@@ -1,0 +1,44 @@
+#include "progress_bar.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace lucent::cli {
+
+ProgressBar::ProgressBar(std::string label, std::string unit)
+    : m_label(std::move(label)),
+      m_unit(std::move(unit)),
+      m_enabled(::isatty(STDERR_FILENO) != 0),
+      m_start(std::chrono::steady_clock::now()),
+      m_last(m_start) {}
+
+ProgressBar::~ProgressBar() {
+    finish();
+}
+
+void ProgressBar::update(unsigned long long done, unsigned long long total) {
+    if (!m_enabled || total == 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (m_drawn && done < total && now - m_last < std::chrono::milliseconds(100)) return;
+    m_last = now;
+    const double elapsed = std::chrono::duration<double>(now - m_start).count();
+    const double rate = elapsed > 0 ? done / elapsed : 0;
+    const double left = rate > 0 ? (total - done) / rate : 0;
+    constexpr int kWidth = 30;
+    const int filled = int(kWidth * double(done) / double(total));
+    std::fprintf(stderr, "\r%s [%.*s%*s] %llu/%llu %s, %.1f %s/s, %.0f s left  ", m_label.c_str(),
+                 filled, "##############################", kWidth - filled, "", done, total,
+                 m_unit.c_str(), rate, m_unit.c_str(), left);
+    std::fflush(stderr);
+    m_drawn = true;
+}
+
+void ProgressBar::finish() {
+    if (!m_drawn) return;
+    std::fprintf(stderr, "\r%*s\r", 100, "");
+    std::fflush(stderr);
+    m_drawn = false;
+}
+
+}  // namespace lucent::cli
