@@ -15,6 +15,7 @@
 #include "accel/triangle_accel.h"
 #include "bench/bench_commands.h"
 #include "bench/embree_peer.h"
+#include "bench/ray_checksums.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #ifdef LUCENT_HAVE_CUDA
@@ -182,10 +183,8 @@ Rate timed(size_t count, unsigned threads, int repeat, Body&& body) {
 }
 
 /// One engine's figures and checksums for the three ray kinds.
-struct EngineResult {
+struct EngineResult : RayChecksums {
     Rate primary, shadow, diffuse;
-    size_t primary_hits = 0, shadow_rays = 0, occluded = 0, diffuse_rays = 0, diffuse_hits = 0;
-    double primary_sum_t = 0, diffuse_sum_t = 0;
 };
 
 /// Traces the three ray sets with closest(o, d, tmax, t&, prim&) and any(o, d, tmax). The
@@ -242,28 +241,6 @@ void print_engine(const char* prefix, const EngineResult& r) {
                 r.shadow_rays, r.occluded);
     std::printf("%sdiffuse %s rays=%zu hits=%zu sum_t=%.6e\n", prefix, rate_text(r.diffuse).c_str(),
                 r.diffuse_rays, r.diffuse_hits, r.diffuse_sum_t);
-}
-
-bool close(double a, double b) {
-    return std::fabs(a - b) <= 1e-6 * std::max(std::fabs(a), std::fabs(b));
-}
-
-/// Lists the checksums that differ between two engines (empty: they agree).
-std::string checksum_differences(const EngineResult& a, const EngineResult& b) {
-    std::string out;
-    auto add = [&](const std::string& what, double x, double y, bool ok) {
-        if (ok) return;
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "%s%s %.9g vs %.9g", out.empty() ? "" : ", ", what.c_str(),
-                      x, y);
-        out += buf;
-    };
-    add("primary hits", a.primary_hits, b.primary_hits, a.primary_hits == b.primary_hits);
-    add("primary sum_t", a.primary_sum_t, b.primary_sum_t, close(a.primary_sum_t, b.primary_sum_t));
-    add("shadow occluded", a.occluded, b.occluded, a.occluded == b.occluded);
-    add("diffuse hits", a.diffuse_hits, b.diffuse_hits, a.diffuse_hits == b.diffuse_hits);
-    add("diffuse sum_t", a.diffuse_sum_t, b.diffuse_sum_t, close(a.diffuse_sum_t, b.diffuse_sum_t));
-    return out;
 }
 
 std::string json_engine(const EngineResult& r) {
@@ -346,7 +323,8 @@ int run_bench_rays(const RaysOptions& options) {
             [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); }, nullptr,
             &lucent_hits);  // the same shadow and diffuse rays as Lucent's
     }
-    const std::string differences = peer ? checksum_differences(lucent, embree) : "";
+    const std::string differences =
+        peer ? checksum_differences(lucent, embree, "lucent", "embree") : "";
 
     if (options.json) {
         std::printf(

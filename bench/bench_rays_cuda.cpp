@@ -1,5 +1,6 @@
 // Compiled only with the CUDA backend (the build glob takes every bench/*.cpp).
 #include "bench/bench_rays_cuda.h"
+#include "bench/ray_checksums.h"
 
 #if LUCENT_HAVE_CUDA
 
@@ -148,31 +149,7 @@ Rate rate_of(const std::vector<double>& mrays) {
 }
 
 /// Checksums of one engine on the three ray sets (as the CPU bench computes them).
-struct Checksums {
-    size_t primary_hits = 0, shadow_rays = 0, occluded = 0, diffuse_rays = 0, diffuse_hits = 0;
-    double primary_sum_t = 0, diffuse_sum_t = 0;
-};
-
-bool close(double a, double b) {
-    return std::fabs(a - b) <= 1e-6 * std::max(std::fabs(a), std::fabs(b));
-}
-
-std::string checksum_differences(const Checksums& a, const Checksums& b) {
-    std::string out;
-    auto add = [&](const char* what, double x, double y, bool ok) {
-        if (ok) return;
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "%s%s %.9g (gpu) vs %.9g (cpu)", out.empty() ? "" : ", ",
-                      what, x, y);
-        out += buf;
-    };
-    add("primary hits", a.primary_hits, b.primary_hits, a.primary_hits == b.primary_hits);
-    add("primary sum_t", a.primary_sum_t, b.primary_sum_t, close(a.primary_sum_t, b.primary_sum_t));
-    add("shadow occluded", a.occluded, b.occluded, a.occluded == b.occluded);
-    add("diffuse hits", a.diffuse_hits, b.diffuse_hits, a.diffuse_hits == b.diffuse_hits);
-    add("diffuse sum_t", a.diffuse_sum_t, b.diffuse_sum_t, close(a.diffuse_sum_t, b.diffuse_sum_t));
-    return out;
-}
+using Checksums = bench::RayChecksums;
 
 /// Runs body(i) for i in [0, count) on `threads` threads, in chunks from an atomic counter.
 template <class Body>
@@ -435,7 +412,7 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
         if (cpu_td[s] >= 0.0f) ++cpu.diffuse_hits, cpu.diffuse_sum_t += cpu_td[s];
         differ_d += std::bit_cast<float>(hits_d[s].x) != cpu_td[s];
     });
-    const std::string differences = checksum_differences(gpu, cpu);
+    const std::string differences = bench::checksum_differences(gpu, cpu, "gpu", "cpu");
 
     if (in.json) {
         auto rate = [](const Rate& x) {
