@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Builds a libFuzzer target with clang (ASan + UBSan) and runs it for a bounded time on a
+# copy of its committed seed corpus. Used by ctest (fuzz.*); exit 77 = skipped (no clang or
+# no libFuzzer runtime). Usage: run_fuzzer.sh NAME SECONDS BUILD_DIR
+set -euo pipefail
+name=$1 seconds=$2 build=$3
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+command -v clang++ > /dev/null || { echo "fuzz.$name: clang++ not found, skipped"; exit 77; }
+mkdir -p "$build"
+exe="$build/${name}_fuzzer"
+sources=("$here/${name}_fuzzer.cpp")
+case $name in
+  obj_mesh) sources+=("$root/scene/obj_mesh.cpp"); libs=(-ltinyobjloader) ;;
+  *) echo "unknown fuzz target $name" >&2; exit 2 ;;
+esac
+if ! clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+     -I "$root/include" -I "$root" "${sources[@]}" "${libs[@]}" -o "$exe" 2> "$build/${name}_build.log"; then
+    if grep -q "libclang_rt.fuzzer\|fsanitize=fuzzer" "$build/${name}_build.log"; then
+        echo "fuzz.$name: no libFuzzer runtime (libclang-rt-14-dev), skipped"; exit 77
+    fi
+    cat "$build/${name}_build.log" >&2
+    exit 1
+fi
+corpus="$build/${name}_corpus"
+rm -rf "$corpus" && mkdir -p "$corpus" && cp "$here/corpus/${name%%_*}"/* "$corpus/"
+cd "$build"
+"$exe" -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 -print_final_stats=1 "$corpus" 2>&1 | tail -20
