@@ -11,7 +11,7 @@ mkdir -p "$build"
 exe="$build/${name}_fuzzer"
 sources=("$here/${name}_fuzzer.cpp")
 case $name in
-  obj_mesh) sources+=("$root/scene/obj_mesh.cpp"); libs=(-ltinyobjloader) ;;
+  obj_mesh) sources+=("$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"); libs=(-ltinyobjloader) ;;
   *) echo "unknown fuzz target $name" >&2; exit 2 ;;
 esac
 if ! clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \

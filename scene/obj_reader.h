@@ -1,0 +1,22 @@
+// Reading an OBJ (and its MTL) with tinyobjloader, with every error pointing at its file
+// and line: tinyobjloader reads "nan" or garbage coordinates as 0 and reports few lines, so
+// coordinates are checked here first and statements are mapped back to their lines.
+#pragma once
+
+#include <tiny_obj_loader.h>
+
+#include <string>
+
+namespace lucent::scene {
+
+/// Parses `path` (and, when asked, the MTL files it names). Throws lucent::Error
+/// "path:line: message" for a missing file, a non-finite coordinate or a parse error.
+tinyobj::ObjReader read_obj(const std::string& path, bool with_materials);
+
+/// 1-based line of the n-th (0-based) statement starting with `tag` ("v" or "f"), or 0.
+size_t line_of_statement(const std::string& path, const char* tag, size_t n);
+
+/// Throws lucent::Error "path:line: message".
+[[noreturn]] void fail(const std::string& path, size_t line, const std::string& message);
+
+}  // namespace lucent::scene

@@ -1,0 +1,78 @@
+// A renderable scene as the samples consume it: triangle meshes with per-triangle
+// materials, point and area lights, and a camera. Built in (`cornell`), or loaded from an
+// OBJ + MTL file or a JSON scene description.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lucent/device/vector_math.h"
+
+namespace lucent::scene {
+
+/// Phong-style material of OBJ's MTL: diffuse reflectance (rho), specular reflectance and
+/// exponent, emission, and an optional diffuse texture file (sRGB, linearised on load).
+struct Material {
+    std::string name;
+    float3 diffuse{0.8f, 0.8f, 0.8f};
+    float3 specular{0, 0, 0};
+    float shininess = 0;
+    float3 emission{0, 0, 0};
+    std::string diffuse_texture;  // a file path, resolved against the file that named it
+};
+
+struct Mesh {
+    std::string name;
+    std::vector<float3> positions;
+    std::vector<float3> normals;      // per vertex, empty when the file has none
+    std::vector<float2> uvs;          // per vertex, empty when the file has none
+    std::vector<uint3> indices;       // triangles
+    std::vector<unsigned> materials;  // per triangle, index into Scene::materials
+};
+
+struct PointLight {
+    float3 position;
+    float3 intensity;  // radiant intensity per colour channel
+};
+
+/// An emitting parallelogram: corner + s * edge1 + t * edge2 for s, t in [0, 1].
+struct AreaLight {
+    float3 corner, edge1, edge2;
+    float3 emission;  // radiance
+};
+
+struct Camera {
+    float3 eye{0, 0, 1}, look{0, 0, 0}, up{0, 1, 0};
+    float fov_degrees = 45;  // vertical
+};
+
+struct Scene {
+    std::string name;
+    std::vector<Mesh> meshes;
+    std::vector<Material> materials;
+    std::vector<PointLight> point_lights;
+    std::vector<AreaLight> area_lights;
+    Camera camera;
+
+    size_t triangle_count() const;
+};
+
+/// The names load_scene accepts without a file.
+std::vector<std::string> builtin_scene_names();
+
+/// A built-in scene by name, or a file: .obj (with its .mtl) or .json. Throws lucent::Error
+/// naming the file (and line, or JSON location) and the fix for anything malformed.
+Scene load_scene(const std::string& name_or_path);
+
+/// The Cornell box with its two blocks (Goral et al. 1984, measured data of the Cornell
+/// Program of Computer Graphics), in millimetres; lit by its ceiling light as an area light,
+/// or by a point light just below it.
+Scene cornell_box(bool area_light);
+
+/// OBJ + MTL through tinyobjloader (polygons fanned into triangles).
+Scene load_obj_scene(const std::string& path);
+
+/// A JSON scene description; see docs/scenes.md.
+Scene load_json_scene(const std::string& path);
+
+}  // namespace lucent::scene
