@@ -11,7 +11,6 @@
 
 namespace lucent::scene {
 
-
 ObjMesh load_obj_mesh(const std::string& path) {
     tinyobj::ObjReader reader = read_obj(path, /*with_materials=*/false);
 

@@ -59,7 +59,6 @@ void fail(const std::string& path, size_t line, const std::string& message) {
     throw Error(path + ":" + std::to_string(line) + ": " + message);
 }
 
-
 tinyobj::ObjReader read_obj(const std::string& path, bool with_materials) {
     {
         std::ifstream probe(path);

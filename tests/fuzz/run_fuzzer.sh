@@ -9,13 +9,21 @@ root=$(cd "$here/../.." && pwd)
 command -v clang++ > /dev/null || { echo "fuzz.$name: clang++ not found, skipped"; exit 77; }
 mkdir -p "$build"
 exe="$build/${name}_fuzzer"
-sources=("$here/${name}_fuzzer.cpp")
+scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$root/scene/obj_scene.cpp"
+               "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp")
+defines=()
 case $name in
-  obj_mesh) sources+=("$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"); libs=(-ltinyobjloader) ;;
+  obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp")
+            corpus_name=obj ;;
+  scene_obj) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".obj"')
+             corpus_name=obj ;;
+  scene_json) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".json"')
+              corpus_name=json ;;
   *) echo "unknown fuzz target $name" >&2; exit 2 ;;
 esac
+libs=(-ltinyobjloader)
 if ! clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-     -I "$root/include" -I "$root" "${sources[@]}" "${libs[@]}" -o "$exe" 2> "$build/${name}_build.log"; then
+     "${defines[@]}" -I "$root/include" -I "$root" "${sources[@]}" "${libs[@]}" -o "$exe" 2> "$build/${name}_build.log"; then
     if grep -q "libclang_rt.fuzzer\|fsanitize=fuzzer" "$build/${name}_build.log"; then
         echo "fuzz.$name: no libFuzzer runtime (libclang-rt-14-dev), skipped"; exit 77
     fi
@@ -23,6 +31,6 @@ if ! clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize
     exit 1
 fi
 corpus="$build/${name}_corpus"
-rm -rf "$corpus" && mkdir -p "$corpus" && cp "$here/corpus/${name%%_*}"/* "$corpus/"
+rm -rf "$corpus" && mkdir -p "$corpus" && cp "$here/corpus/$corpus_name"/* "$corpus/"
 cd "$build"
-"$exe" -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 -print_final_stats=1 "$corpus" 2>&1 | tail -20
+"$exe" -max_total_time="$seconds" -error_exitcode=1 -timeout=5 -rss_limit_mb=2048 -print_final_stats=1 "$corpus" 2>&1 | tail -20

@@ -1,0 +1,244 @@
+// A Scene from a JSON description (nlohmann-json): camera, materials, meshes (OBJ files or
+// inline triangles) and point or area lights. Syntax errors name file:line:column; other
+// errors name the file and the JSON location ("/lights/1/position") and what is expected.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "lucent/error.h"
+#include "scene/scene.h"
+
+namespace lucent::scene {
+
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class JsonReader {
+  public:
+    explicit JsonReader(std::string path) : m_path(std::move(path)) {}
+
+    [[noreturn]] void fail(const std::string& where, const std::string& message) const {
+        throw Error(m_path + ": " + where + ": " + message);
+    }
+
+    float number(const json& j, const std::string& where) const {
+        if (!j.is_number()) fail(where, "expected a number, got " + std::string(j.type_name()));
+        float v = j.get<float>();
+        if (!std::isfinite(v)) fail(where, "the number is not finite");
+        return v;
+    }
+
+    float3 vec3(const json& j, const std::string& where) const {
+        if (!j.is_array() || j.size() != 3)
+            fail(where, "expected an array of 3 numbers, like [0, 1, 0]");
+        return make_float3(number(j[0], where + "/0"), number(j[1], where + "/1"),
+                           number(j[2], where + "/2"));
+    }
+
+    const json& member(const json& object, const char* key, const std::string& where) const {
+        if (!object.is_object()) fail(where, "expected an object");
+        auto it = object.find(key);
+        if (it == object.end()) fail(where, std::string("missing \"") + key + "\"");
+        return *it;
+    }
+
+    /// Every key of `object` must be one of `known`: a typo is an error, not ignored.
+    void only(const json& object, std::initializer_list<const char*> known,
+              const std::string& where) const {
+        for (auto it = object.begin(); it != object.end(); ++it) {
+            bool ok = false;
+            for (const char* k : known) ok = ok || it.key() == k;
+            if (!ok) {
+                std::string list;
+                for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+                fail(where + "/" + it.key(), "unknown key; expected one of: " + list);
+            }
+        }
+    }
+
+    fs::path resolve(const std::string& file) const {
+        return fs::path(m_path).parent_path() / file;
+    }
+
+  private:
+    std::string m_path;
+};
+
+json parse_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path + ": cannot open the scene file (check the path)");
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const std::string text = buffer.str();
+    try {
+        return json::parse(text);
+    } catch (const json::parse_error& e) {
+        size_t line = 1, column = 1;
+        for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i, ++column)
+            if (text[i] == '\n') ++line, column = 0;
+        std::string what = e.what();
+        const size_t colon = what.find("syntax error");
+        throw Error(path + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
+                    (colon == std::string::npos ? what : what.substr(colon)));
+    } catch (const json::exception& e) {  // e.g. a number too large for a double
+        throw Error(path + ": " + e.what());
+    }
+}
+}  // namespace
+
+namespace detail {
+Scene read_json_scene(const std::string& path, const nlohmann::json& root);
+}
+
+Scene load_json_scene(const std::string& path) {
+    try {
+        return detail::read_json_scene(path, parse_file(path));
+    } catch (const json::exception& e) {  // a value of a type the checks above did not expect
+        throw Error(path + ": " + e.what());
+    }
+}
+
+Scene detail::read_json_scene(const std::string& path, const nlohmann::json& root) {
+    JsonReader r(path);
+    if (!root.is_object())
+        r.fail("/", "a scene is a JSON object with camera, materials, meshes, lights");
+    r.only(root, {"camera", "materials", "meshes", "lights"}, "");
+
+    Scene scene;
+    scene.name = fs::path(path).stem().string();
+    std::map<std::string, unsigned> material_ids;
+    if (root.contains("materials")) {
+        const json& list = root["materials"];
+        if (!list.is_array()) r.fail("/materials", "expected an array of materials");
+        for (size_t i = 0; i < list.size(); ++i) {
+            const std::string at = "/materials/" + std::to_string(i);
+            const json& m = list[i];
+            r.only(m, {"name", "diffuse", "specular", "shininess", "emission", "texture"}, at);
+            Material material;
+            const json& name = r.member(m, "name", at);
+            if (!name.is_string()) r.fail(at + "/name", "expected a string");
+            material.name = name.get<std::string>();
+            if (material_ids.count(material.name))
+                r.fail(at + "/name", "a second material named '" + material.name + "'");
+            if (m.contains("diffuse")) material.diffuse = r.vec3(m["diffuse"], at + "/diffuse");
+            if (m.contains("specular")) material.specular = r.vec3(m["specular"], at + "/specular");
+            if (m.contains("shininess"))
+                material.shininess = r.number(m["shininess"], at + "/shininess");
+            if (m.contains("emission")) material.emission = r.vec3(m["emission"], at + "/emission");
+            if (m.contains("texture")) {
+                if (!m["texture"].is_string()) r.fail(at + "/texture", "expected a file name");
+                fs::path texture = r.resolve(m["texture"].get<std::string>());
+                if (!fs::exists(texture))
+                    r.fail(at + "/texture", "texture '" + texture.string() + "' not found");
+                material.diffuse_texture = texture.string();
+            }
+            material_ids[material.name] = unsigned(scene.materials.size());
+            scene.materials.push_back(material);
+        }
+    }
+
+    if (!root.contains("meshes") || !root["meshes"].is_array() || root["meshes"].empty())
+        r.fail("/meshes", "a scene needs at least one mesh: [{\"file\": \"model.obj\"}]");
+    const json& meshes = root["meshes"];
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        const std::string at = "/meshes/" + std::to_string(i);
+        const json& m = meshes[i];
+        r.only(m, {"file", "positions", "triangles", "material"}, at);
+        int override_material = -1;
+        if (m.contains("material")) {
+            if (!m["material"].is_string() || !material_ids.count(m["material"].get<std::string>()))
+                r.fail(at + "/material", "not the name of a material in /materials");
+            override_material = int(material_ids[m["material"].get<std::string>()]);
+        }
+        if (m.contains("file")) {
+            if (!m["file"].is_string()) r.fail(at + "/file", "expected a file name");
+            Scene part = load_obj_scene(r.resolve(m["file"].get<std::string>()).string());
+            const unsigned base = unsigned(scene.materials.size());
+            scene.materials.insert(scene.materials.end(), part.materials.begin(),
+                                   part.materials.end());
+            for (Mesh& mesh : part.meshes) {
+                for (unsigned& id : mesh.materials)
+                    id = override_material >= 0 ? unsigned(override_material) : id + base;
+                scene.meshes.push_back(std::move(mesh));
+            }
+            continue;
+        }
+        Mesh mesh;
+        mesh.name = "mesh" + std::to_string(i);
+        const json& positions = r.member(m, "positions", at);
+        const json& triangles = r.member(m, "triangles", at);
+        if (!positions.is_array() || !triangles.is_array() || triangles.empty())
+            r.fail(
+                at,
+                "an inline mesh has \"positions\" [[x,y,z], ...] and \"triangles\" [[i,j,k], ...]");
+        for (size_t p = 0; p < positions.size(); ++p)
+            mesh.positions.push_back(r.vec3(positions[p], at + "/positions/" + std::to_string(p)));
+        if (override_material < 0) {
+            override_material = int(scene.materials.size());
+            scene.materials.push_back(
+                Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
+        }
+        for (size_t t = 0; t < triangles.size(); ++t) {
+            const std::string where = at + "/triangles/" + std::to_string(t);
+            const json& tri = triangles[t];
+            if (!tri.is_array() || tri.size() != 3) r.fail(where, "expected 3 vertex indices");
+            unsigned idx[3];
+            for (int k = 0; k < 3; ++k) {
+                if (!tri[k].is_number_integer() || tri[k].get<long long>() < 0 ||
+                    tri[k].get<long long>() >= (long long)mesh.positions.size())
+                    r.fail(where + "/" + std::to_string(k),
+                           "expected a vertex index in 0.." +
+                               std::to_string(mesh.positions.size()) + " (exclusive)");
+                idx[k] = tri[k].get<unsigned>();
+            }
+            mesh.indices.push_back(uint3{idx[0], idx[1], idx[2]});
+            mesh.materials.push_back(unsigned(override_material));
+        }
+        scene.meshes.push_back(std::move(mesh));
+    }
+
+    if (root.contains("lights")) {
+        const json& lights = root["lights"];
+        if (!lights.is_array()) r.fail("/lights", "expected an array of lights");
+        for (size_t i = 0; i < lights.size(); ++i) {
+            const std::string at = "/lights/" + std::to_string(i);
+            const json& l = lights[i];
+            const json& type = r.member(l, "type", at);
+            if (type == "point") {
+                r.only(l, {"type", "position", "intensity"}, at);
+                scene.point_lights.push_back(
+                    {r.vec3(r.member(l, "position", at), at + "/position"),
+                     r.vec3(r.member(l, "intensity", at), at + "/intensity")});
+            } else if (type == "area") {
+                r.only(l, {"type", "corner", "edge1", "edge2", "emission"}, at);
+                scene.area_lights.push_back(
+                    {r.vec3(r.member(l, "corner", at), at + "/corner"),
+                     r.vec3(r.member(l, "edge1", at), at + "/edge1"),
+                     r.vec3(r.member(l, "edge2", at), at + "/edge2"),
+                     r.vec3(r.member(l, "emission", at), at + "/emission")});
+            } else {
+                r.fail(at + "/type", "expected \"point\" or \"area\"");
+            }
+        }
+    }
+
+    const json& camera = r.member(root, "camera", "");
+    r.only(camera, {"eye", "look", "up", "fov"}, "/camera");
+    scene.camera.eye = r.vec3(r.member(camera, "eye", "/camera"), "/camera/eye");
+    scene.camera.look = r.vec3(r.member(camera, "look", "/camera"), "/camera/look");
+    if (camera.contains("up")) scene.camera.up = r.vec3(camera["up"], "/camera/up");
+    if (camera.contains("fov")) {
+        scene.camera.fov_degrees = r.number(camera["fov"], "/camera/fov");
+        if (!(scene.camera.fov_degrees > 0 && scene.camera.fov_degrees < 180))
+            r.fail("/camera/fov", "expected a vertical field of view in (0, 180) degrees");
+    }
+    if (length(scene.camera.look - scene.camera.eye) == 0)
+        r.fail("/camera", "eye and look are the same point");
+    return scene;
+}
+
+}  // namespace lucent::scene

@@ -1,0 +1,167 @@
+// Scenes: the built-in Cornell box, OBJ + MTL, and JSON descriptions, with errors that name
+// the file and line (or JSON location) and what is expected.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "lucent/error.h"
+#include "scene/scene.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using lucent::scene::load_scene;
+
+class SceneFiles : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir = fs::temp_directory_path() / ("lucent-scene-test-" + std::to_string(::getpid()));
+        fs::create_directories(dir);
+    }
+    void TearDown() override { fs::remove_all(dir); }
+    std::string write(const std::string& name, const std::string& text) {
+        std::ofstream(dir / name) << text;
+        return (dir / name).string();
+    }
+    /// The message of the lucent::Error that loading `path` throws ("" if none).
+    static std::string error_of(const std::string& path) {
+        try {
+            load_scene(path);
+        } catch (const lucent::Error& e) {
+            return e.what();
+        }
+        return "";
+    }
+    fs::path dir;
+};
+
+TEST(CornellBox, HasTheRoomTheBlocksAndTheCeilingLight) {
+    auto scene = load_scene("cornell");
+    EXPECT_EQ(scene.triangle_count(), 30u + 2u);  // 5 walls, 2 blocks of 5 faces, the light
+    ASSERT_EQ(scene.area_lights.size(), 1u);
+    EXPECT_TRUE(scene.point_lights.empty());
+    EXPECT_FLOAT_EQ(length(cross(scene.area_lights[0].edge1, scene.area_lights[0].edge2)),
+                    130.f * 105.f);
+    for (const auto& mesh : scene.meshes)
+        for (const float3& p : mesh.positions) {
+            EXPECT_GE(p.x, 0.f);
+            EXPECT_LE(p.x, 556.f);
+            EXPECT_GE(p.y, 0.f);
+            EXPECT_LE(p.y, 548.8f);
+            EXPECT_GE(p.z, 0.f);
+            EXPECT_LE(p.z, 559.2f);
+        }
+    auto point = load_scene("cornell-point");
+    EXPECT_EQ(point.triangle_count(), 30u);
+    ASSERT_EQ(point.point_lights.size(), 1u);
+    EXPECT_LT(point.point_lights[0].position.y, 548.8f);
+}
+
+TEST(CornellBox, OnlyTheLightEmits) {
+    auto scene = load_scene("cornell");
+    unsigned emitting = 0;
+    for (const auto& m : scene.materials) emitting += max_component(m.emission) > 0;
+    EXPECT_EQ(emitting, 1u);
+}
+
+TEST(ObjScene, LoadsTheSharedCornellBoxWithItsMaterials) {
+    const std::string file = std::string(LUCENT_SCENES_DIR) + "/cornell/CornellBox-Original.obj";
+    if (!fs::exists(file)) GTEST_SKIP() << file << " is not here";
+    auto scene = load_scene(file);
+    EXPECT_EQ(scene.triangle_count(), 36u);
+    bool light = false;
+    for (const auto& mesh : scene.meshes)
+        for (unsigned id : mesh.materials)
+            light = light || max_component(scene.materials[id].emission) > 0;
+    EXPECT_TRUE(light) << "the light's material has Ke";
+}
+
+TEST_F(SceneFiles, ObjWithoutItsMaterialLibraryNamesTheLine) {
+    auto path =
+        write("a.obj", "# header\nmtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    EXPECT_NE(error_of(path).find("a.obj:2:"), std::string::npos) << error_of(path);
+}
+
+TEST_F(SceneFiles, MissingTextureNamesTheMtlLine) {
+    write("m.mtl", "newmtl wood\nKd 1 1 1\nmap_Kd wood.png\n");
+    auto path = write("b.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n");
+    const std::string e = error_of(path);
+    EXPECT_NE(e.find("m.mtl:3:"), std::string::npos) << e;
+    EXPECT_NE(e.find("wood.png"), std::string::npos) << e;
+}
+
+TEST_F(SceneFiles, ObjNormalsUvsAndMaterialsArrive) {
+    write("c.mtl", "newmtl red\nKd 0.9 0.1 0.1\nKe 0 0 0\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+    auto path =
+        write("c.obj",
+              "mtllib c.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\n"
+              "vt 1 1\nvt 0 1\nusemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\nusemtl lamp\nf 1 2 3\n");
+    auto scene = load_scene(path);
+    ASSERT_EQ(scene.triangle_count(), 3u);
+    const auto& mesh = scene.meshes[0];
+    EXPECT_EQ(scene.materials[mesh.materials[0]].name, "red");
+    EXPECT_EQ(scene.materials[mesh.materials[2]].name, "lamp");
+    EXPECT_FLOAT_EQ(scene.materials[mesh.materials[2]].emission.x, 5.f);
+    ASSERT_FALSE(mesh.normals.empty());
+    ASSERT_FALSE(mesh.uvs.empty());
+}
+
+TEST_F(SceneFiles, JsonSceneWithInlineMeshLightsAndCamera) {
+    auto path = write("s.json", R"({
+      "camera": {"eye": [0, 1, 5], "look": [0, 1, 0], "fov": 40},
+      "materials": [{"name": "grey", "diffuse": [0.5, 0.5, 0.5]}],
+      "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]], "material": "grey"}],
+      "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [10, 10, 10]},
+                 {"type": "area", "corner": [0,2,0], "edge1": [1,0,0], "edge2": [0,0,1], "emission": [4,4,4]}]
+    })");
+    auto scene = load_scene(path);
+    EXPECT_EQ(scene.triangle_count(), 1u);
+    EXPECT_EQ(scene.point_lights.size(), 1u);
+    EXPECT_EQ(scene.area_lights.size(), 1u);
+    EXPECT_FLOAT_EQ(scene.camera.fov_degrees, 40.f);
+    EXPECT_EQ(scene.materials[scene.meshes[0].materials[0]].name, "grey");
+}
+
+TEST_F(SceneFiles, JsonErrorsNameTheLocation) {
+    auto syntax = write("bad1.json", "{\n  \"camera\": {\"eye\": [0,1,5],\n  \"look\" [0,0,0]}\n}");
+    EXPECT_NE(error_of(syntax).find("bad1.json:3:"), std::string::npos) << error_of(syntax);
+
+    auto unknown = write("bad2.json", R"({"camera": {"eye": [0,0,1], "look": [0,0,0]},
+      "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]]}],
+      "lights": [{"type": "point", "position": [0,1,0], "colour": [1,1,1]}]})");
+    EXPECT_NE(error_of(unknown).find("/lights/0/colour"), std::string::npos) << error_of(unknown);
+
+    auto index = write("bad3.json", R"({"camera": {"eye": [0,0,1], "look": [0,0,0]},
+      "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,7]]}]})");
+    EXPECT_NE(error_of(index).find("/meshes/0/triangles/0/2"), std::string::npos)
+        << error_of(index);
+
+    auto nan = write("bad4.json", R"({"camera": {"eye": [0,0,"one"], "look": [0,0,0]},
+      "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]]}]})");
+    EXPECT_NE(error_of(nan).find("/camera/eye/2"), std::string::npos) << error_of(nan);
+
+    auto no_mesh =
+        write("bad5.json", R"({"camera": {"eye": [0,0,1], "look": [0,0,0]}, "meshes": []})");
+    EXPECT_NE(error_of(no_mesh).find("/meshes"), std::string::npos) << error_of(no_mesh);
+
+    // Found by fuzz.scene_json: a number beyond double is an error, not a crash.
+    auto huge = write("bad7.json", R"({"camera": {"eye": [0,0,1e99999], "look": [0,0,0]}})");
+    EXPECT_NE(error_of(huge).find("bad7.json"), std::string::npos) << error_of(huge);
+
+    auto missing_obj = write("bad6.json", R"({"camera": {"eye": [0,0,1], "look": [0,0,0]},
+      "meshes": [{"file": "nowhere.obj"}]})");
+    EXPECT_NE(error_of(missing_obj).find("nowhere.obj"), std::string::npos)
+        << error_of(missing_obj);
+}
+
+TEST(SceneNames, UnknownNameListsTheBuiltInScenes) {
+    try {
+        load_scene("sponza-please");
+        FAIL();
+    } catch (const lucent::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("cornell"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
