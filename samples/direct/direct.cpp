@@ -1,0 +1,142 @@
+// Host setup of the direct-lighting sample: one GeometryTriangles per mesh with its material
+// indices, one Material per scene material, lights in buffers, and a pinhole camera.
+#include "samples/direct/direct.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "samples/direct/direct_programs.h"
+#include "samples/settings_error.h"
+#include "scene/scene.h"
+
+namespace lucent::samples {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+RenderResult render_direct(const RenderSettings& settings) {
+    const SampleInfo& info = direct_sample_info();
+    check_options(settings, info);
+    const int area_samples = get_int_option(settings, info, "area_samples", 1, 1024);
+    const float ambient = get_float_option(settings, info, "ambient", 0.0f, 1.0f);
+    const Clock::time_point setup_start = Clock::now();
+    const scene::Scene input =
+        scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+
+    RenderResult out;
+    Context ctx(settings.context_options());
+    out.backend = ctx.backend_name();
+    out.backend_notice = ctx.backend_notice();
+    ctx.set_ray_type<direct::RadiancePayload>(direct::kRadianceRay, "radiance");
+    ctx.set_ray_type<direct::ShadowPayload>(direct::kShadowRay, "shadow",
+                                            /*expects_closest_hit=*/false);
+    ctx.set_max_recursion_depth(2);  // camera ray, then shadow rays
+
+    // Lights; an emitter with no light source of its own still shows its emission.
+    std::vector<direct::PointLight> points;
+    for (const auto& l : input.point_lights) points.push_back({l.position, l.intensity});
+    std::vector<direct::AreaLight> areas;
+    for (const auto& l : input.area_lights)
+        areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
+    auto point_buffer =
+        ctx.create_buffer<direct::PointLight>(BufferType::kInput, unsigned(points.size()));
+    point_buffer->upload(points);
+    auto area_buffer =
+        ctx.create_buffer<direct::AreaLight>(BufferType::kInput, unsigned(areas.size()));
+    area_buffer->upload(areas);
+    ctx["point_lights"] = point_buffer;
+    ctx["area_lights"] = area_buffer;
+    ctx["area_samples"] = unsigned(area_samples);
+    // Offsets for secondary rays scale with the scene (the Cornell box is in millimetres).
+    float extent = 0;
+    for (const auto& mesh : input.meshes)
+        for (const float3& p : mesh.positions)
+            extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
+
+    auto lambert = ctx.create_program(LUCENT_PROGRAM(direct_lambert));
+    auto blocked = ctx.create_program(LUCENT_PROGRAM(direct_shadow_blocked));
+    std::vector<std::shared_ptr<Material>> materials;
+    for (const auto& m : input.materials) {
+        auto material = ctx.create_material();
+        material->set_name(m.name);
+        material->set_closest_hit(direct::kRadianceRay, lambert);
+        material->set_any_hit(direct::kShadowRay, blocked);
+        (*material)["Kd"] = m.diffuse + make_float3(ambient);
+        (*material)["Ke"] = m.emission;
+        materials.push_back(material);
+    }
+    auto top = ctx.create_geometry_group();
+    for (const auto& mesh : input.meshes) {
+        auto vertices =
+            ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
+        vertices->upload(mesh.positions);
+        auto indices = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.indices.size()));
+        indices->upload(mesh.indices);
+        auto material_ids =
+            ctx.create_buffer<unsigned>(BufferType::kInput, unsigned(mesh.materials.size()));
+        material_ids->upload(mesh.materials);
+        auto triangles = ctx.create_geometry_triangles();
+        triangles->set_name(mesh.name);
+        triangles->set_vertices(vertices);
+        triangles->set_indices(indices);
+        triangles->set_material_indices(material_ids);
+        auto instance = ctx.create_geometry_instance();
+        instance->set_geometry(triangles);
+        for (const auto& material : materials) instance->add_material(material);
+        top->add_child(instance);
+    }
+    ctx["top_object"] = top;
+
+    // Pinhole camera: W to the image centre, U and V half its width and height.
+    const scene::Camera& c = input.camera;
+    const float3 W = normalize(c.look - c.eye);
+    const float3 U = normalize(cross(W, c.up)), V = cross(U, W);
+    const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);
+    const float aspect = float(settings.width) / float(settings.height);
+    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    auto camera = ctx.create_program(LUCENT_PROGRAM(direct_camera));
+    (*camera)["eye"] = c.eye;
+    (*camera)["W"] = W;
+    (*camera)["U"] = U * (half_height * aspect);
+    (*camera)["V"] = V * half_height;
+    (*camera)["output"] = output;
+    ctx.set_ray_generation_program(0, camera);
+    auto miss = ctx.create_program(LUCENT_PROGRAM(direct_miss));
+    (*miss)["background"] = make_float3(0.0f);
+    ctx.set_miss_program(direct::kRadianceRay, miss);
+    out.stages.push_back(
+        {"scene setup",
+         std::chrono::duration<double, std::milli>(Clock::now() - setup_start).count(),
+         input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
+
+    timed_launch(ctx, 0, settings, out);
+    out.image.width = settings.width;
+    out.image.height = settings.height;
+    const float4* pixels = output->data<float4>();
+    out.image.pixels.resize(size_t(settings.width) * settings.height);
+    for (size_t i = 0; i < out.image.pixels.size(); ++i)
+        out.image.pixels[i] = make_float3(pixels[i]);
+    return out;
+}
+
+}  // namespace
+
+const SampleInfo& direct_sample_info() {
+    static const SampleInfo info{
+        "direct",
+        "Direct lighting of any scene (--scene cornell, cornell-point, FILE.obj or FILE.json): "
+        "Lambertian surfaces, emission, point and area lights with shadow rays",
+        {
+            {"area_samples", "16",
+             "shadow rays per area light per pixel, a stratified grid (1..1024)"},
+            {"ambient", "0", "added to every diffuse reflectance, to see unlit parts (0..1)"},
+        },
+        render_direct,
+    };
+    return info;
+}
+
+}  // namespace lucent::samples

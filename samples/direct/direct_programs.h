@@ -1,0 +1,125 @@
+// Direct lighting of any scene (scene/scene.h): Lambertian surfaces with emission, point
+// lights and parallelogram area lights, with shadow rays. The building block of the global
+// illumination samples, and a quick look at a scene file on either backend.
+#pragma once
+
+#include "lucent/device.h"
+
+namespace direct {
+
+struct RadiancePayload {
+    float3 color;
+};
+struct ShadowPayload {
+    float visible;
+};
+
+struct PointLight {
+    float3 position;
+    float3 intensity;
+};
+struct AreaLight {
+    float3 corner, edge1, edge2;
+    float3 emission;
+};
+
+enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
+
+struct CameraRecord {
+    float3 eye, U, V, W;  // W: to the image centre; U, V: half the image's extent
+    lucent::BufferView<float4> output;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(CameraRecord, eye, U, V, W, output, top_object)
+
+struct SurfaceRecord {
+    float3 Kd, Ke;
+    lucent::BufferView<PointLight> point_lights;
+    lucent::BufferView<AreaLight> area_lights;
+    unsigned area_samples;  // per area light: a stratified sqrt(n) x sqrt(n) grid
+    float scene_epsilon;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(SurfaceRecord, Kd, Ke, point_lights, area_lights, area_samples, scene_epsilon,
+              top_object)
+
+struct MissRecord {
+    float3 background;
+};
+LUCENT_RECORD(MissRecord, background)
+
+/// Fraction of light from `p` that reaches `target` (0 or 1: opaque any-hit).
+LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 p, float3 target) {
+    float3 d = target - p;
+    ShadowPayload s{1.0f};
+    // The ray stops just short of the target, so an emitter's own surface does not shadow it.
+    lucent::trace(rec.top_object, lucent::make_ray(p, d, kShadowRay, rec.scene_epsilon, 0.999f), s);
+    return s.visible;
+}
+
+}  // namespace direct
+
+LUCENT_RAY_GENERATION(direct_camera, direct::CameraRecord) {
+    const uint3 i = lucent::launch_index(), n = lucent::launch_size();
+    const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
+    direct::RadiancePayload prd{make_float3(0.0f)};
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
+                                   direct::kRadianceRay, 0.0f),
+                  prd);
+    rec.output[make_uint2(i.x, i.y)] = make_float4(prd.color, 1.0f);
+}
+
+LUCENT_MISS(direct_miss, direct::MissRecord, direct::RadiancePayload) {
+    prd.color = rec.background;
+}
+
+LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayload,
+                   lucent::TriangleAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    const float3 p = ray.origin + lucent::t_hit() * ray.direction;
+    const float3 n = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
+                                 ray.direction);
+    const float3 origin = p + rec.scene_epsilon * n;
+    float3 color = rec.Ke;
+    const float3 albedo = rec.Kd * (1.0f / 3.14159265f);  // Lambert: rho / pi
+    for (unsigned l = 0; l < rec.point_lights.count(); ++l) {
+        const direct::PointLight light = rec.point_lights[l];
+        const float3 to = light.position - p;
+        const float d2 = dot(to, to), cos_theta = dot(n, to) / sqrtf(d2);
+        if (cos_theta > 0.0f)
+            color += albedo * light.intensity *
+                     (cos_theta / d2 * direct::visibility(rec, origin, light.position));
+    }
+    // Area lights: a stratified grid of points, one shadow ray each (TEA jitter per pixel).
+    const uint3 index = lucent::launch_index();
+    const unsigned side = rec.area_samples > 1 ? unsigned(sqrtf(float(rec.area_samples))) : 1u;
+    for (unsigned l = 0; l < rec.area_lights.count(); ++l) {
+        const direct::AreaLight light = rec.area_lights[l];
+        const float3 ln = cross(light.edge1, light.edge2);
+        const float area = length(ln);
+        const float3 light_normal = ln / area;
+        float3 sum = make_float3(0.0f);
+        for (unsigned s = 0; s < side * side; ++s) {
+            const uint2 r = lucent::tea<4>(make_uint2(index.y * 65536u + index.x, s * 16u + l),
+                                           lucent::zafar_tea_key());
+            const float u = (float(s % side) + lucent::tea_unit_float(r.x)) / float(side);
+            const float v = (float(s / side) + lucent::tea_unit_float(r.y)) / float(side);
+            const float3 q = light.corner + u * light.edge1 + v * light.edge2;
+            const float3 to = q - p;
+            const float d2 = dot(to, to), d = sqrtf(d2);
+            const float cos_surface = dot(n, to) / d, cos_light = fabsf(dot(light_normal, to)) / d;
+            if (cos_surface > 0.0f)
+                sum += light.emission *
+                       (cos_surface * cos_light / d2 * direct::visibility(rec, origin, q));
+        }
+        color += albedo * sum * (area / float(side * side));
+    }
+    prd.color = color;
+}
+
+LUCENT_ANY_HIT(direct_shadow_blocked, lucent::NoRecord, direct::ShadowPayload,
+               lucent::TriangleAttributes) {
+    prd.visible = 0.0f;
+    lucent::terminate_ray();
+}

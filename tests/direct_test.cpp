@@ -1,0 +1,51 @@
+// The direct-lighting sample on the built-in Cornell box: the light shows its emission, the
+// walls their colours, and faces turned away from the light stay black.
+#include <gtest/gtest.h>
+
+#include "samples/direct/direct.h"
+
+namespace {
+
+using lucent::samples::RenderResult;
+using lucent::samples::RenderSettings;
+
+RenderResult render(const std::string& scene, unsigned size = 96) {
+    RenderSettings settings;
+    settings.width = settings.height = size;
+    settings.backend = lucent::BackendKind::kCpu;
+    settings.scene = scene;
+    settings.sets["area_samples"] = "16";
+    return lucent::samples::direct_sample_info().render(settings);
+}
+
+float3 pixel(const RenderResult& r, float fx, float fy) {
+    return r.image.pixels[size_t(fy * r.image.height) * r.image.width + size_t(fx * r.image.width)];
+}
+
+TEST(DirectSample, CornellLightWallsAndFacesTurnedAway) {
+    const RenderResult r = render("cornell");
+    EXPECT_EQ(r.report.exception_count(), 0u);
+    // The ceiling light, top centre: its emission exactly (it faces away from itself).
+    const float3 light = pixel(r, 0.5f, 0.13f);
+    EXPECT_FLOAT_EQ(light.x, 17.f);
+    EXPECT_FLOAT_EQ(light.y, 12.f);
+    EXPECT_FLOAT_EQ(light.z, 4.f);
+    const float3 left = pixel(r, 0.06f, 0.5f), right = pixel(r, 0.94f, 0.5f);
+    EXPECT_GT(left.x, 3 * left.y) << "the left wall is red";
+    EXPECT_GT(right.y, 2 * right.x) << "the right wall is green";
+    // The floor left of the blocks is lit; the short block's front face, turned away from
+    // the ceiling light, receives exactly nothing.
+    const float3 floor = pixel(r, 0.4f, 0.9f), turned_away = pixel(r, 0.6f, 0.9f);
+    EXPECT_GT(floor.x + floor.y + floor.z, 0.2f);
+    EXPECT_EQ(turned_away.x + turned_away.y + turned_away.z, 0.0f);
+}
+
+TEST(DirectSample, PointLightVariantLightsTheFloor) {
+    const RenderResult r = render("cornell-point", 96);
+    const float3 floor = pixel(r, 0.4f, 0.9f), ceiling = pixel(r, 0.5f, 0.03f);
+    EXPECT_GT(floor.x + floor.y + floor.z, 0.05f);
+    // The point hangs 1 mm below the ceiling: the ceiling sees it at grazing angles only.
+    EXPECT_LT(ceiling.x + ceiling.y + ceiling.z, 0.05f * (floor.x + floor.y + floor.z));
+}
+
+}  // namespace
