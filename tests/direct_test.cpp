@@ -2,7 +2,11 @@
 // walls their colours, and faces turned away from the light stay black.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "samples/direct/direct.h"
+#include "scene/image_io.h"
 
 namespace {
 
@@ -46,6 +50,32 @@ TEST(DirectSample, PointLightVariantLightsTheFloor) {
     EXPECT_GT(floor.x + floor.y + floor.z, 0.05f);
     // The point hangs 1 mm below the ceiling: the ceiling sees it at grazing angles only.
     EXPECT_LT(ceiling.x + ceiling.y + ceiling.z, 0.05f * (floor.x + floor.y + floor.z));
+}
+
+TEST(DirectSample, DiffuseMapFromAnMtlTexturesTheSurface) {
+    // A quad facing the camera with a 2x2 texture: red on the left, blue on the right.
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("lucent-direct-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    lucent::scene::Image texture;
+    texture.width = texture.height = 2;
+    texture.pixels = {make_float3(1, 0, 0), make_float3(0, 0, 1), make_float3(1, 0, 0),
+                      make_float3(0, 0, 1)};
+    lucent::scene::write_image((dir / "rb.png").string(), texture);
+    std::ofstream(dir / "quad.mtl") << "newmtl tex\nKd 1 1 1\nmap_Kd rb.png\n";
+    std::ofstream(dir / "quad.obj") << "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl tex\n"
+                                       "f 1/1 2/2 3/3 4/4\n";
+    std::ofstream(dir / "scene.json")
+        << R"({"camera": {"eye": [0, 0, 3], "look": [0, 0, 0], "fov": 50},
+               "meshes": [{"file": "quad.obj"}],
+               "lights": [{"type": "point", "position": [0, 0, 2], "intensity": [10, 10, 10]}]})";
+    const RenderResult r = render((dir / "scene.json").string(), 64);
+    fs::remove_all(dir);
+    const float3 left = pixel(r, 0.3f, 0.5f), right = pixel(r, 0.7f, 0.5f);
+    EXPECT_GT(left.x, 10 * left.z) << "left half red";
+    EXPECT_GT(right.z, 10 * right.x) << "right half blue";
 }
 
 }  // namespace

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "samples/direct/direct_programs.h"
 #include "samples/settings_error.h"
 #include "scene/scene.h"
+#include "scene/texture_image.h"
 
 namespace lucent::samples {
 
@@ -56,6 +58,25 @@ RenderResult render_direct(const RenderSettings& settings) {
             extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
 
+    // Diffuse maps, each file loaded once; materials without one get a white texel.
+    std::map<std::string, std::shared_ptr<TextureSampler>> textures;
+    auto texture_for = [&](const std::string& file) {
+        auto& sampler = textures[file];
+        if (sampler) return sampler;
+        scene::TextureImage image;
+        if (file.empty())
+            image = {1, 1, {make_float4(1, 1, 1, 1)}};
+        else
+            image = scene::load_texture(file);
+        auto texels = ctx.create_buffer<float4>(BufferType::kInput, image.width, image.height);
+        texels->upload(image.texels);
+        sampler = ctx.create_texture_sampler();
+        sampler->set_buffer(texels);
+        sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kRepeat);
+        sampler->set_filter(FilterMode::kLinear);
+        return sampler;
+    };
+
     auto lambert = ctx.create_program(LUCENT_PROGRAM(direct_lambert));
     auto blocked = ctx.create_program(LUCENT_PROGRAM(direct_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;
@@ -66,8 +87,10 @@ RenderResult render_direct(const RenderSettings& settings) {
         material->set_any_hit(direct::kShadowRay, blocked);
         (*material)["Kd"] = m.diffuse + make_float3(ambient);
         (*material)["Ke"] = m.emission;
+        (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(direct_attributes));
     auto top = ctx.create_geometry_group();
     for (const auto& mesh : input.meshes) {
         auto vertices =
@@ -78,11 +101,17 @@ RenderResult render_direct(const RenderSettings& settings) {
         auto material_ids =
             ctx.create_buffer<unsigned>(BufferType::kInput, unsigned(mesh.materials.size()));
         material_ids->upload(mesh.materials);
+        auto uvs = ctx.create_buffer<float2>(BufferType::kInput, unsigned(mesh.uvs.size()));
+        if (!mesh.uvs.empty()) uvs->upload(mesh.uvs);
         auto triangles = ctx.create_geometry_triangles();
         triangles->set_name(mesh.name);
         triangles->set_vertices(vertices);
         triangles->set_indices(indices);
         triangles->set_material_indices(material_ids);
+        triangles->set_attribute_program(attributes);
+        (*triangles)["positions"] = vertices;
+        (*triangles)["triangles"] = indices;
+        (*triangles)["uvs"] = uvs;
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(triangles);
         for (const auto& material : materials) instance->add_material(material);

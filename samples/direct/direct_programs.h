@@ -25,6 +25,20 @@ struct AreaLight {
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
+/// What a triangle hit gives the hit programs: its normal and its texture coordinate.
+struct HitAttributes {
+    float3 geometric_normal;  // object space, not normalised
+    float2 uv;
+};
+
+/// The mesh's vertex data, for the attribute program (set on each GeometryTriangles).
+struct MeshRecord {
+    lucent::BufferView<float3> positions;
+    lucent::BufferView<uint3> triangles;
+    lucent::BufferView<float2> uvs;  // per vertex; empty when the mesh has none
+};
+LUCENT_RECORD(MeshRecord, positions, triangles, uvs)
+
 struct CameraRecord {
     float3 eye, U, V, W;  // W: to the image centre; U, V: half the image's extent
     lucent::BufferView<float4> output;
@@ -34,14 +48,15 @@ LUCENT_RECORD(CameraRecord, eye, U, V, W, output, top_object)
 
 struct SurfaceRecord {
     float3 Kd, Ke;
+    lucent::TextureView diffuse_map;  // multiplies Kd; a 1x1 white texel when there is none
     lucent::BufferView<PointLight> point_lights;
     lucent::BufferView<AreaLight> area_lights;
     unsigned area_samples;  // per area light: a stratified sqrt(n) x sqrt(n) grid
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ke, point_lights, area_lights, area_samples, scene_epsilon,
-              top_object)
+LUCENT_RECORD(SurfaceRecord, Kd, Ke, diffuse_map, point_lights, area_lights, area_samples,
+              scene_epsilon, top_object)
 
 struct MissRecord {
     float3 background;
@@ -74,15 +89,29 @@ LUCENT_MISS(direct_miss, direct::MissRecord, direct::RadiancePayload) {
     prd.color = rec.background;
 }
 
+LUCENT_ATTRIBUTE(direct_attributes, direct::MeshRecord, direct::HitAttributes) {
+    const uint3 t = rec.triangles[prim];
+    const float3 p0 = rec.positions[t.x], p1 = rec.positions[t.y], p2 = rec.positions[t.z];
+    attr.geometric_normal = cross(p1 - p0, p2 - p0);
+    attr.uv = make_float2(0.0f, 0.0f);
+    if (rec.uvs.count() > 0) {
+        const float w = 1.0f - barycentrics.x - barycentrics.y;
+        attr.uv = w * rec.uvs[t.x] + barycentrics.x * rec.uvs[t.y] + barycentrics.y * rec.uvs[t.z];
+    }
+}
+
 LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayload,
-                   lucent::TriangleAttributes) {
+                   direct::HitAttributes) {
     const lucent::Ray& ray = lucent::current_ray();
     const float3 p = ray.origin + lucent::t_hit() * ray.direction;
     const float3 n = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
                                  ray.direction);
     const float3 origin = p + rec.scene_epsilon * n;
     float3 color = rec.Ke;
-    const float3 albedo = rec.Kd * (1.0f / 3.14159265f);  // Lambert: rho / pi
+    // OBJ texture coordinates start at the bottom of the image; texel row 0 is its top.
+    const float3 texel =
+        make_float3(lucent::tex2D(rec.diffuse_map, make_float2(attr.uv.x, 1.0f - attr.uv.y)));
+    const float3 albedo = rec.Kd * texel * (1.0f / 3.14159265f);  // Lambert: rho / pi
     for (unsigned l = 0; l < rec.point_lights.count(); ++l) {
         const direct::PointLight light = rec.point_lights[l];
         const float3 to = light.position - p;
@@ -119,7 +148,7 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
 }
 
 LUCENT_ANY_HIT(direct_shadow_blocked, lucent::NoRecord, direct::ShadowPayload,
-               lucent::TriangleAttributes) {
+               direct::HitAttributes) {
     prd.visible = 0.0f;
     lucent::terminate_ray();
 }

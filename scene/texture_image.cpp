@@ -1,0 +1,42 @@
+#include "scene/texture_image.h"
+
+#include <stb_image.h>
+
+#include <cmath>
+#include <memory>
+
+#include "lucent/error.h"
+
+namespace lucent::scene {
+
+namespace {
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+float srgb_to_linear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+}  // namespace
+
+TextureImage load_texture(const std::string& path) {
+    int width = 0, height = 0, channels = 0;
+    std::unique_ptr<unsigned char, void (*)(void*)> data(
+        stbi_load(path.c_str(), &width, &height, &channels, 4), stbi_image_free);
+    if (!data) {
+        const char* reason = stbi_failure_reason();
+        throw Error("cannot read the texture '" + path +
+                    "': " + (reason ? reason : "unknown format"));
+    }
+    // A lookup table: 256 entries instead of a pow per channel.
+    float to_linear[256];
+    for (int i = 0; i < 256; ++i) to_linear[i] = srgb_to_linear(i / 255.0f);
+    TextureImage image;
+    image.width = unsigned(width);
+    image.height = unsigned(height);
+    image.texels.resize(size_t(width) * height);
+    const unsigned char* p = data.get();
+    for (size_t i = 0; i < image.texels.size(); ++i, p += 4)
+        image.texels[i] =
+            make_float4(to_linear[p[0]], to_linear[p[1]], to_linear[p[2]], p[3] / 255.0f);
+    return image;
+}
+
+}  // namespace lucent::scene
