@@ -156,7 +156,15 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
         }
         if (m.contains("file")) {
             if (!m["file"].is_string()) r.fail(at + "/file", "expected a file name");
-            Scene part = load_obj_scene(r.resolve(m["file"].get<std::string>()).string());
+            const fs::path file = r.resolve(m["file"].get<std::string>());
+            Scene part;
+            if (file.extension() == ".ply") {
+                part.meshes.push_back(load_ply_mesh(file.string()));
+                part.materials.push_back(
+                    Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
+            } else {
+                part = load_obj_scene(file.string());
+            }
             const unsigned base = unsigned(scene.materials.size());
             scene.materials.insert(scene.materials.end(), part.materials.begin(),
                                    part.materials.end());

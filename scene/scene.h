@@ -72,6 +72,10 @@ Scene cornell_box(bool area_light);
 /// OBJ + MTL through tinyobjloader (polygons fanned into triangles).
 Scene load_obj_scene(const std::string& path);
 
+/// A PLY mesh (ASCII or binary): positions, optional normals and uvs, faces fanned into
+/// triangles, all with material 0.
+Mesh load_ply_mesh(const std::string& path);
+
 /// A JSON scene description; see docs/scenes.md.
 Scene load_json_scene(const std::string& path);
 

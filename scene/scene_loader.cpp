@@ -17,6 +17,26 @@ std::vector<std::string> builtin_scene_names() {
     return {"cornell", "cornell-point"};
 }
 
+namespace {
+/// A scene around one mesh: a grey material, a camera on +z framing its bounds, and a point
+/// light at the camera (a JSON file that names the mesh gives any other setup).
+Scene single_mesh_scene(Mesh mesh) {
+    Scene scene;
+    scene.name = std::filesystem::path(mesh.name).stem().string();
+    float3 lo = mesh.positions[0], hi = lo;
+    for (const float3& p : mesh.positions) lo = fminf(lo, p), hi = fmaxf(hi, p);
+    const float3 centre = 0.5f * (lo + hi);
+    const float radius = std::max(0.5f * length(hi - lo), 1e-6f);
+    scene.camera = Camera{centre + make_float3(0, 0, 2.8f * radius), centre, {0, 1, 0}, 45};
+    const float power = 4.0f * radius * radius;  // a few times the mesh's own scale
+    scene.point_lights.push_back(
+        {scene.camera.eye + make_float3(0, radius, 0), make_float3(power)});
+    scene.materials.push_back(Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
+    scene.meshes.push_back(std::move(mesh));
+    return scene;
+}
+}  // namespace
+
 Scene load_scene(const std::string& name_or_path) {
     if (name_or_path == "cornell") return cornell_box(/*area_light=*/true);
     if (name_or_path == "cornell-point") return cornell_box(/*area_light=*/false);
@@ -25,10 +45,11 @@ Scene load_scene(const std::string& name_or_path) {
                    [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".obj") return load_obj_scene(name_or_path);
     if (ext == ".json") return load_json_scene(name_or_path);
+    if (ext == ".ply") return single_mesh_scene(load_ply_mesh(name_or_path));
     std::string names;
     for (const std::string& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
     throw Error("scene '" + name_or_path + "': not a built-in scene (" + names +
-                ") nor a .obj or .json file");
+                ") nor a .obj, .ply or .json file");
 }
 
 }  // namespace lucent::scene

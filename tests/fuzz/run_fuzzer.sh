@@ -10,7 +10,7 @@ command -v clang++ > /dev/null || { echo "fuzz.$name: clang++ not found, skipped
 mkdir -p "$build"
 exe="$build/${name}_fuzzer"
 scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$root/scene/obj_scene.cpp"
-               "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp")
+               "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp" "$root/scene/ply_mesh.cpp")
 defines=()
 case $name in
   obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp")
@@ -19,6 +19,8 @@ case $name in
              corpus_name=obj ;;
   scene_json) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".json"')
               corpus_name=json ;;
+  scene_ply) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".ply"')
+             corpus_name=ply ;;
   *) echo "unknown fuzz target $name" >&2; exit 2 ;;
 esac
 libs=(-ltinyobjloader)

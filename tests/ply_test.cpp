@@ -1,0 +1,116 @@
+// PLY meshes: ASCII and binary of both byte orders, faces fanned into triangles, and
+// errors that name the header line or the element at fault.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "lucent/error.h"
+#include "scene/scene.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class Ply : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir = fs::temp_directory_path() / ("lucent-ply-" + std::to_string(::getpid()));
+        fs::create_directories(dir);
+    }
+    void TearDown() override { fs::remove_all(dir); }
+    std::string write(const std::string& name, const std::string& bytes) {
+        std::ofstream(dir / name, std::ios::binary) << bytes;
+        return (dir / name).string();
+    }
+    static std::string error_of(const std::string& path) {
+        try {
+            lucent::scene::load_ply_mesh(path);
+        } catch (const lucent::Error& e) {
+            return e.what();
+        }
+        return "";
+    }
+    fs::path dir;
+};
+
+const char* kQuadHeader =
+    "ply\nformat ascii 1.0\ncomment a unit quad\nelement vertex 4\nproperty float x\n"
+    "property float y\nproperty float z\nproperty float u\nproperty float v\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+TEST_F(Ply, AsciiQuadIsFannedIntoTwoTriangles) {
+    auto path = write("quad.ply", std::string(kQuadHeader) +
+                                      "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n");
+    auto mesh = lucent::scene::load_ply_mesh(path);
+    ASSERT_EQ(mesh.positions.size(), 4u);
+    ASSERT_EQ(mesh.indices.size(), 2u);
+    EXPECT_EQ(mesh.indices[1].x, 0u);
+    EXPECT_EQ(mesh.indices[1].z, 3u);
+    ASSERT_EQ(mesh.uvs.size(), 4u);
+    EXPECT_FLOAT_EQ(mesh.uvs[2].y, 1.f);
+}
+
+std::string binary_triangle(bool big_endian) {
+    std::string s =
+        std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+        " 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty double z\n"
+        "element face 1\nproperty list uchar uint vertex_index\nend_header\n";
+    auto put = [&](const void* p, size_t n) {
+        std::string bytes(static_cast<const char*>(p), n);
+        if (big_endian) std::reverse(bytes.begin(), bytes.end());  // the host is little-endian
+        s += bytes;
+    };
+    const float xy[3][2] = {{0, 0}, {2, 0}, {0, 3}};
+    for (int i = 0; i < 3; ++i) {
+        put(&xy[i][0], 4);
+        put(&xy[i][1], 4);
+        double z = 5.0 + i;
+        put(&z, 8);
+    }
+    unsigned char n = 3;
+    s += char(n);
+    for (unsigned i : {0u, 1u, 2u}) put(&i, 4);
+    return s;
+}
+
+TEST_F(Ply, BinaryBothByteOrders) {
+    for (bool big : {false, true}) {
+        auto mesh = lucent::scene::load_ply_mesh(
+            write(big ? "big.ply" : "little.ply", binary_triangle(big)));
+        ASSERT_EQ(mesh.indices.size(), 1u) << big;
+        EXPECT_FLOAT_EQ(mesh.positions[1].x, 2.f) << big;
+        EXPECT_FLOAT_EQ(mesh.positions[2].y, 3.f) << big;
+        EXPECT_FLOAT_EQ(mesh.positions[2].z, 7.f) << big;
+    }
+}
+
+TEST_F(Ply, ErrorsNameTheLineOrElement) {
+    EXPECT_NE(error_of(write("a.ply", "plyx\n")).find("a.ply:1:"), std::string::npos);
+    auto no_end = write("b.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n");
+    EXPECT_NE(error_of(no_end).find("end_header"), std::string::npos) << error_of(no_end);
+    auto bad_type =
+        write("c.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n");
+    EXPECT_NE(error_of(bad_type).find("c.ply:4:"), std::string::npos) << error_of(bad_type);
+    auto index = write("d.ply", std::string(kQuadHeader) +
+                                    "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n3 0 1 9\n");
+    EXPECT_NE(error_of(index).find("element 'face' 0"), std::string::npos) << error_of(index);
+    std::string truncated = binary_triangle(false);
+    truncated.resize(truncated.size() - 3);
+    EXPECT_NE(error_of(write("e.ply", truncated)).find("ends early"), std::string::npos);
+    auto nan = write("f.ply", std::string(kQuadHeader) + "0 0 nan 0 0\n");
+    EXPECT_NE(error_of(nan).find("not finite"), std::string::npos) << error_of(nan);
+}
+
+TEST_F(Ply, LoadSceneFramesAPlyMesh) {
+    auto path = write("q.ply", std::string(kQuadHeader) +
+                                   "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n");
+    auto scene = lucent::scene::load_scene(path);
+    EXPECT_EQ(scene.triangle_count(), 2u);
+    EXPECT_EQ(scene.point_lights.size(), 1u);
+    EXPECT_GT(scene.camera.eye.z, 1.f);
+}
+
+}  // namespace
