@@ -19,16 +19,6 @@ namespace {
 using testing::HasSubstr;
 using testing::Not;
 
-constexpr float kEps = 1e-4f;
-
-#define EXPECT_FLOAT3_NEAR(a, b, eps)        \
-    do {                                     \
-        const float3 a_ = (a), b_ = (b);     \
-        EXPECT_NEAR(a_.x, b_.x, eps) << "x"; \
-        EXPECT_NEAR(a_.y, b_.y, eps) << "y"; \
-        EXPECT_NEAR(a_.z, b_.z, eps) << "z"; \
-    } while (0)
-
 // ---- ray generation ------------------------------------------------------------
 
 class RayGenerationTest : public testing::Test {

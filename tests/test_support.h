@@ -20,6 +20,17 @@
 
 namespace lucent_tests {
 
+/// Tolerance of the value checks on positions, normals and colours.
+constexpr float kEps = 1e-4f;
+
+#define EXPECT_FLOAT3_NEAR(a, b, eps)        \
+    do {                                     \
+        const float3 a_ = (a), b_ = (b);     \
+        EXPECT_NEAR(a_.x, b_.x, eps) << "x"; \
+        EXPECT_NEAR(a_.y, b_.y, eps) << "y"; \
+        EXPECT_NEAR(a_.z, b_.z, eps) << "z"; \
+    } while (0)
+
 /// The backend the suites run on: the CPU, so values never depend on what `auto` finds;
 /// LUCENT_TEST_BACKEND=cuda runs the same suites on the GPU (CPU/GPU parity runs).
 inline BackendKind test_backend() {
