@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "samples/direct/direct.h"
+#include "samples/igi/igi.h"
 #include "samples/sample.h"
 #include "samples/settings_error.h"
 #include "samples/whitted/whitted.h"
@@ -77,7 +78,8 @@ T parse_option(const RenderSettings& s, const SampleInfo& info, const std::strin
 }  // namespace
 
 const std::vector<SampleInfo>& all_samples() {
-    static const std::vector<SampleInfo> samples = {whitted_sample_info(), direct_sample_info()};
+    static const std::vector<SampleInfo> samples = {whitted_sample_info(), direct_sample_info(),
+                                                    igi_sample_info()};
     return samples;
 }
 

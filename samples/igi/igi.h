@@ -1,0 +1,10 @@
+// The Instant Global Illumination sample (Marques and Santos, seed §4), canonical form.
+#pragma once
+
+#include "samples/sample.h"
+
+namespace lucent::samples {
+
+const SampleInfo& igi_sample_info();
+
+}  // namespace lucent::samples
