@@ -31,6 +31,10 @@ struct RayTypeDesc {
     std::string name;
     const TypeInfo* payload = nullptr;
     bool expects_closest_hit = true;
+    /// The graphs rays of this type are traced against, when only some: then only the
+    /// materials below them need this ray type's closest hit (IGI traces visibility rays
+    /// against a second graph of boxes). Empty: every graph.
+    std::vector<std::shared_ptr<Node>> roots;
 };
 
 constexpr int kAllExceptions = -1;
@@ -81,9 +85,10 @@ class Context : public VariableScope {
 
     /// Declares ray type `index` (ray types are 0, 1, ... with no gaps).
     template <class Payload>
-    void set_ray_type(unsigned index, std::string name, bool expects_closest_hit = true) {
-        set_ray_type(index,
-                     RayTypeDesc{std::move(name), &type_info_of<Payload>(), expects_closest_hit});
+    void set_ray_type(unsigned index, std::string name, bool expects_closest_hit = true,
+                      std::vector<std::shared_ptr<Node>> roots = {}) {
+        set_ray_type(index, RayTypeDesc{std::move(name), &type_info_of<Payload>(),
+                                        expects_closest_hit, std::move(roots)});
     }
     void set_ray_type(unsigned index, RayTypeDesc desc);
     unsigned ray_type_count() const;

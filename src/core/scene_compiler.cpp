@@ -74,9 +74,13 @@ void SceneCompiler::compile_graph() {
     for (unsigned r = 0; r < m_state.ray_types.size(); ++r)
         scene.miss.push_back(pack(m_state.miss[r], context_scope, ray_type_label(m_state, r)));
 
+    for (const RayTypeDesc& r : m_state.ray_types)
+        for (const auto& root : r.roots)
+            if (root) node_index(root);
     // Nodes are discovered while packing (Handle variables) and compiled breadth-first.
     for (size_t i = 0; i < m_node_queue.size(); ++i) compile_node(m_node_queue[i]);
     check_cycles();
+    find_reached_instances();
     check_types();
 }
 
@@ -292,6 +296,27 @@ void SceneCompiler::check_cycles() const {
         if (state[n] == 0) visit(visit, n);
 }
 
+void SceneCompiler::find_reached_instances() {
+    const CompiledScene& scene = *m_scene;
+    m_reaches.assign(scene.ray_types.size(), {});
+    for (unsigned r = 0; r < scene.ray_types.size(); ++r) {
+        if (scene.ray_types[r].roots.empty()) continue;
+        std::vector<bool> reached(scene.instances.size(), false), seen(scene.nodes.size(), false);
+        std::vector<unsigned> stack;
+        for (const auto& root : scene.ray_types[r].roots)
+            if (root) stack.push_back(m_node_ids.at(root.get()));
+        while (!stack.empty()) {
+            unsigned n = stack.back();
+            stack.pop_back();
+            if (seen[n]) continue;
+            seen[n] = true;
+            for (unsigned c : scene.nodes[n].children) stack.push_back(c);
+            for (unsigned i : scene.nodes[n].instances) reached[i] = true;
+        }
+        m_reaches[r] = std::move(reached);
+    }
+}
+
 void SceneCompiler::check_types() const {
     const CompiledScene& scene = *m_scene;
     auto payload_check = [&](const CompiledProgram& p, unsigned r) {
@@ -316,13 +341,15 @@ void SceneCompiler::check_types() const {
                                     "; use the same attribute type in the intersection (or "
                                     "attribute) program and the hit programs");
                 }
-                if (scene.ray_types[r].expects_closest_hit && !mat.closest_hit[r])
+                const size_t self = size_t(&inst - scene.instances.data());
+                const bool reached = m_reaches[r].empty() || m_reaches[r][self];
+                if (scene.ray_types[r].expects_closest_hit && reached && !mat.closest_hit[r])
                     throw Error(
                         inst.source->material(m)->describe() + " in " + inst.source->describe() +
                         " has no closest-hit program for " + ray_type_label(m_state, r) +
                         ", which reaches it; bind one with set_closest_hit(" + std::to_string(r) +
-                        ", program), or declare the ray type with "
-                        "expects_closest_hit = false if it only needs any-hit");
+                        ", program), declare the ray type with expects_closest_hit = false "
+                        "if it only needs any-hit, or name the graphs it traces as its roots");
             }
         }
     }

@@ -43,6 +43,7 @@ class SceneCompiler {
     void compile_instance(unsigned index);
     void check_cycles() const;
     void check_types() const;
+    void find_reached_instances();
     void build_accelerations();
     void build_geometry_accel(CompiledNode& node);
     Aabb node_bounds(unsigned index, std::vector<int>& state);
@@ -64,6 +65,7 @@ class SceneCompiler {
     std::map<const Program*, std::shared_ptr<PackedRecord>> m_callables;
     std::vector<std::shared_ptr<Node>> m_node_refs;  // keep nodes alive during compile
     std::vector<unsigned> m_node_queue;
+    std::vector<std::vector<bool>> m_reaches;  // per ray type with roots: instance reached?
     double m_accel_ms = 0;
 };
 
