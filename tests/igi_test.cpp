@@ -46,6 +46,22 @@ TEST(Igi, VplsLightWhatThePointLightCannotSee) {
     EXPECT_EQ(global.report.exception_count(), 0u);
 }
 
+TEST(Igi, ImperfectVisibilityTracesTheBoxesGraph) {
+    // Seed §4.1: VPL shadow rays against one box per triangle, a second root and ray type.
+    // Boxes hide at least as much as the triangles in them, never more light arrives.
+    const RenderResult exact = render({{"imperfect_visibility", "0"}});
+    const RenderResult boxes = render({{"imperfect_visibility", "1"}});
+    EXPECT_EQ(boxes.report.exception_count(), 0u);
+    double sum_exact = 0, sum_boxes = 0;
+    for (size_t i = 0; i < exact.image.pixels.size(); ++i) {
+        sum_exact += exact.image.pixels[i].x + exact.image.pixels[i].y + exact.image.pixels[i].z;
+        sum_boxes += boxes.image.pixels[i].x + boxes.image.pixels[i].y + boxes.image.pixels[i].z;
+    }
+    EXPECT_LE(sum_boxes, sum_exact * 1.0001);
+    EXPECT_GT(sum_boxes, 0.8 * sum_exact) << "the boxes approximate the scene";
+    EXPECT_GT(brightness(boxes, 0.6f, 0.85f), 0.0f) << "VPL light still arrives";
+}
+
 TEST(Igi, SceneWithoutPointLightsIsAClearError) {
     RenderSettings settings;
     settings.width = settings.height = 8;

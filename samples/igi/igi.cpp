@@ -26,6 +26,7 @@ RenderResult render_igi(const RenderSettings& settings) {
     const int bounces = get_int_option(settings, info, "bounces", 1, 8);
     const float min_d_fraction = get_float_option(settings, info, "min_d", 0.0f, 10.0f);
     const int max_depth = get_int_option(settings, info, "max_depth", 1, 16);
+    const int imperfect = get_int_option(settings, info, "imperfect_visibility", 0, 1);
     const Clock::time_point setup_start = Clock::now();
     const scene::Scene input =
         scene::load_scene(settings.scene.empty() ? "cornell-point" : settings.scene);
@@ -41,6 +42,8 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance");
     ctx.set_ray_type<igi::ShadowPayload>(igi::kShadowRay, "shadow", /*expects_closest_hit=*/false);
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle");
+    ctx.set_ray_type<igi::ShadowPayload>(igi::kVplShadowRay, "vpl shadow",
+                                         /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(unsigned(max_depth) + 1);
 
     float extent = 0;
@@ -78,6 +81,14 @@ RenderResult render_igi(const RenderSettings& settings) {
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(igi_attributes));
     auto top = ctx.create_geometry_group();
+    // Imperfect visibility (seed §4.1): a second graph, one box per triangle as custom
+    // primitives, traced only by VPL shadow rays.
+    auto boxes = ctx.create_geometry_group();
+    auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_bounds));
+    auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_intersect));
+    auto box_material = ctx.create_material();
+    box_material->set_name("box");
+    box_material->set_any_hit(igi::kVplShadowRay, blocked);
     for (const auto& mesh : input.meshes) {
         auto vertices =
             ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
@@ -98,8 +109,24 @@ RenderResult render_igi(const RenderSettings& settings) {
         instance->set_geometry(triangles);
         for (const auto& material : materials) instance->add_material(material);
         top->add_child(instance);
+
+        auto box_geometry = ctx.create_geometry();
+        box_geometry->set_primitive_count(unsigned(mesh.indices.size()));
+        box_geometry->set_bounding_box_program(box_bounds);
+        box_geometry->set_intersection_program(box_intersect);
+        (*box_geometry)["positions"] = vertices;
+        (*box_geometry)["triangles"] = indices;
+        auto box_instance = ctx.create_geometry_instance();
+        box_instance->set_geometry(box_geometry);
+        box_instance->add_material(box_material);
+        boxes->add_child(box_instance);
     }
     ctx["top_object"] = top;
+    ctx["vpl_shadow_object"] = boxes;
+    ctx["imperfect_visibility"] = unsigned(imperfect);
+    // Radiance and particle rays trace the scene; the boxes need none of their programs.
+    ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
+    ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
 
     const scene::Camera& c = input.camera;
     const float3 W = normalize(c.look - c.eye), U = normalize(cross(W, c.up)), V = cross(U, W);
@@ -160,6 +187,8 @@ const SampleInfo& igi_sample_info() {
             {"min_d", "0.1",
              "Eq. (1)'s bounding distance, as a fraction of the scene's size (0..10)"},
             {"max_depth", "4", "deepest specular reflection tree (1..16)"},
+            {"imperfect_visibility", "0",
+             "1: VPL shadow rays against the triangles' bounding boxes (seed §4.1), 0: exact"},
         },
         render_igi,
     };

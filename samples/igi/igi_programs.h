@@ -9,7 +9,7 @@
 
 namespace igi {
 
-enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2 };
+enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2, kVplShadowRay = 3 };
 
 struct PointLight {
     float3 position;
@@ -92,8 +92,11 @@ struct SurfaceRecord {
     unsigned max_depth;
     float scene_epsilon;
     lucent::Handle top_object;
+    unsigned imperfect_visibility;  // VPL shadow rays against the boxes graph (seed §4.1)
+    lucent::Handle vpl_shadow_object;
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_epsilon, top_object)
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
+              imperfect_visibility, vpl_shadow_object)
 
 struct ParticleRecord {
     float3 Kd;
@@ -113,6 +116,16 @@ LUCENT_HD inline bool visible(const SurfaceRecord& rec, float3 from, float3 to) 
     return s.visible > 0.0f;
 }
 
+/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (seed §4.1), against
+/// the crude second graph of the triangles' bounding boxes (a different root and ray type).
+LUCENT_HD inline bool vpl_visible(const SurfaceRecord& rec, float3 from, float3 to) {
+    if (!rec.imperfect_visibility) return visible(rec, from, to);
+    ShadowPayload s{1.0f};
+    lucent::trace(rec.vpl_shadow_object,
+                  lucent::make_ray(from, to - from, kVplShadowRay, rec.scene_epsilon, 0.999f), s);
+    return s.visible > 0.0f;
+}
+
 /// Eq. (1) at x with normal n: sum over the VPLs of Le,k V(x, yk) G(x, yk), where G is
 /// bounded by f(0.8 min_d, 1.2 min_d, |x - yk|). Irradiance-like: rho/pi multiplies it.
 LUCENT_HD inline float3 indirect(const SurfaceRecord& rec, float3 x, float3 n) {
@@ -125,7 +138,7 @@ LUCENT_HD inline float3 indirect(const SurfaceRecord& rec, float3 x, float3 n) {
         const float cos_x = dot(n, to) / d, cos_y = -dot(vpl.normal, to) / d;
         if (cos_x <= 0.0f || cos_y <= 0.0f) continue;
         const float g = cos_x * cos_y / d2 * smoothing(0.8f * rec.min_d, 1.2f * rec.min_d, d);
-        if (g > 0.0f && visible(rec, x, vpl.position)) sum += vpl.radiance * g;
+        if (g > 0.0f && vpl_visible(rec, x, vpl.position)) sum += vpl.radiance * g;
     }
     return sum;
 }
@@ -225,4 +238,43 @@ LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {
     const uint3 t = rec.triangles[prim];
     attr.geometric_normal =
         cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
+}
+
+// ---- the crude scene of imperfect visibility: one box per triangle -------------------------
+LUCENT_BOUNDING_BOX(igi_triangle_box_bounds, igi::MeshRecord) {
+    const uint3 t = rec.triangles[prim];
+    const float3 a = rec.positions[t.x], b = rec.positions[t.y], c = rec.positions[t.z];
+    box.lo = fminf(a, fminf(b, c));
+    box.hi = fmaxf(a, fmaxf(b, c));
+}
+
+LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttributes) {
+    const uint3 t = rec.triangles[prim];
+    const float3 a = rec.positions[t.x], b = rec.positions[t.y], c = rec.positions[t.z];
+    const float3 lo = fminf(a, fminf(b, c)), hi = fmaxf(a, fmaxf(b, c));
+    const lucent::Ray& ray = lucent::current_ray();
+    // Slab test; a flat box (an axis-aligned triangle) still stops rays that cross its plane.
+    float t0 = ray.tmin, t1 = ray.tmax;
+    const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+    const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+    const float l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0.0f) {
+            if (o[k] < l[k] || o[k] > h[k]) return;
+            continue;
+        }
+        float near = (l[k] - o[k]) / d[k], far = (h[k] - o[k]) / d[k];
+        if (near > far) {
+            const float tmp = near;
+            near = far;
+            far = tmp;
+        }
+        t0 = lc_max(t0, near);
+        t1 = lc_min(t1, far * 1.00000024f);
+        if (t0 > t1) return;
+    }
+    if (lucent::potential_intersection(t0)) {
+        attr.geometric_normal = cross(b - a, c - a);
+        lucent::report_intersection(0);
+    }
 }
