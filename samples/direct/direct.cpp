@@ -8,6 +8,7 @@
 #include <map>
 
 #include "samples/direct/direct_programs.h"
+#include "samples/scene_setup.h"
 #include "samples/settings_error.h"
 #include "scene/scene.h"
 #include "scene/texture_image.h"
@@ -51,12 +52,7 @@ RenderResult render_direct(const RenderSettings& settings) {
     ctx["point_lights"] = point_buffer;
     ctx["area_lights"] = area_buffer;
     ctx["area_samples"] = unsigned(area_samples);
-    // Offsets for secondary rays scale with the scene (the Cornell box is in millimetres).
-    float extent = 0;
-    for (const auto& mesh : input.meshes)
-        for (const float3& p : mesh.positions)
-            extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
+    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 
     // Diffuse maps, each file loaded once; materials without one get a white texel.
     std::map<std::string, std::shared_ptr<TextureSampler>> textures;
@@ -93,25 +89,16 @@ RenderResult render_direct(const RenderSettings& settings) {
     auto attributes = ctx.create_program(LUCENT_PROGRAM(direct_attributes));
     auto top = ctx.create_geometry_group();
     for (const auto& mesh : input.meshes) {
-        auto vertices =
-            ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
-        vertices->upload(mesh.positions);
-        auto indices = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.indices.size()));
-        indices->upload(mesh.indices);
-        auto material_ids =
-            ctx.create_buffer<unsigned>(BufferType::kInput, unsigned(mesh.materials.size()));
-        material_ids->upload(mesh.materials);
-        auto uvs = ctx.create_buffer<float2>(BufferType::kInput, unsigned(mesh.uvs.size()));
-        if (!mesh.uvs.empty()) uvs->upload(mesh.uvs);
+        const MeshBuffers buffers = upload_mesh(ctx, mesh);
         auto triangles = ctx.create_geometry_triangles();
         triangles->set_name(mesh.name);
-        triangles->set_vertices(vertices);
-        triangles->set_indices(indices);
-        triangles->set_material_indices(material_ids);
+        triangles->set_vertices(buffers.positions);
+        triangles->set_indices(buffers.triangles);
+        triangles->set_material_indices(buffers.materials);
         triangles->set_attribute_program(attributes);
-        (*triangles)["positions"] = vertices;
-        (*triangles)["triangles"] = indices;
-        (*triangles)["uvs"] = uvs;
+        (*triangles)["positions"] = buffers.positions;
+        (*triangles)["triangles"] = buffers.triangles;
+        (*triangles)["uvs"] = buffers.uvs;
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(triangles);
         for (const auto& material : materials) instance->add_material(material);
@@ -119,18 +106,14 @@ RenderResult render_direct(const RenderSettings& settings) {
     }
     ctx["top_object"] = top;
 
-    // Pinhole camera: W to the image centre, U and V half its width and height.
-    const scene::Camera& c = input.camera;
-    const float3 W = normalize(c.look - c.eye);
-    const float3 U = normalize(cross(W, c.up)), V = cross(U, W);
-    const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);
-    const float aspect = float(settings.width) / float(settings.height);
+    const PinholeFrame frame =
+        pinhole_frame(input.camera, float(settings.width) / float(settings.height));
     auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
     auto camera = ctx.create_program(LUCENT_PROGRAM(direct_camera));
-    (*camera)["eye"] = c.eye;
-    (*camera)["W"] = W;
-    (*camera)["U"] = U * (half_height * aspect);
-    (*camera)["V"] = V * half_height;
+    (*camera)["eye"] = input.camera.eye;
+    (*camera)["W"] = frame.W;
+    (*camera)["U"] = frame.U;
+    (*camera)["V"] = frame.V;
     (*camera)["output"] = output;
     ctx.set_ray_generation_program(0, camera);
     auto miss = ctx.create_program(LUCENT_PROGRAM(direct_miss));
@@ -142,12 +125,7 @@ RenderResult render_direct(const RenderSettings& settings) {
          input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
 
     timed_launch(ctx, 0, settings, out);
-    out.image.width = settings.width;
-    out.image.height = settings.height;
-    const float4* pixels = output->data<float4>();
-    out.image.pixels.resize(size_t(settings.width) * settings.height);
-    for (size_t i = 0; i < out.image.pixels.size(); ++i)
-        out.image.pixels[i] = make_float3(pixels[i]);
+    out.image = image_from_output(*output);
     return out;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "samples/igi/igi_programs.h"
+#include "samples/scene_setup.h"
 #include "samples/settings_error.h"
 #include "scene/scene.h"
 
@@ -46,10 +47,7 @@ RenderResult render_igi(const RenderSettings& settings) {
                                          /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(unsigned(max_depth) + 1);
 
-    float extent = 0;
-    for (const auto& mesh : input.meshes)
-        for (const float3& p : mesh.positions)
-            extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    const float extent = scene_extent(input);
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
     ctx["min_d"] = min_d_fraction * extent;
     ctx["max_depth"] = unsigned(max_depth);
@@ -90,18 +88,13 @@ RenderResult render_igi(const RenderSettings& settings) {
     box_material->set_name("box");
     box_material->set_any_hit(igi::kVplShadowRay, blocked);
     for (const auto& mesh : input.meshes) {
-        auto vertices =
-            ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
-        vertices->upload(mesh.positions);
-        auto indices = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.indices.size()));
-        indices->upload(mesh.indices);
-        auto material_ids =
-            ctx.create_buffer<unsigned>(BufferType::kInput, unsigned(mesh.materials.size()));
-        material_ids->upload(mesh.materials);
+        const MeshBuffers buffers = upload_mesh(ctx, mesh);
+        const auto& vertices = buffers.positions;
+        const auto& indices = buffers.triangles;
         auto triangles = ctx.create_geometry_triangles();
         triangles->set_vertices(vertices);
         triangles->set_indices(indices);
-        triangles->set_material_indices(material_ids);
+        triangles->set_material_indices(buffers.materials);
         triangles->set_attribute_program(attributes);
         (*triangles)["positions"] = vertices;
         (*triangles)["triangles"] = indices;
@@ -128,16 +121,14 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
 
-    const scene::Camera& c = input.camera;
-    const float3 W = normalize(c.look - c.eye), U = normalize(cross(W, c.up)), V = cross(U, W);
-    const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);
-    const float aspect = float(settings.width) / float(settings.height);
+    const PinholeFrame frame =
+        pinhole_frame(input.camera, float(settings.width) / float(settings.height));
     auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
     auto camera = ctx.create_program(LUCENT_PROGRAM(igi_camera));
-    (*camera)["eye"] = c.eye;
-    (*camera)["W"] = W;
-    (*camera)["U"] = U * (half_height * aspect);
-    (*camera)["V"] = V * half_height;
+    (*camera)["eye"] = input.camera.eye;
+    (*camera)["W"] = frame.W;
+    (*camera)["U"] = frame.U;
+    (*camera)["V"] = frame.V;
     (*camera)["output"] = output;
     ctx.set_entry_point_count(2);
     ctx.set_ray_generation_program(0, camera);
@@ -165,12 +156,7 @@ RenderResult render_igi(const RenderSettings& settings) {
             stage.ms += generation.compile_ms + generation.accel_ms;
     out.report.jit_ms = std::max(out.report.jit_ms, generation.jit_ms);
     out.report.jit_cached = out.report.jit_cached || generation.jit_cached;
-    out.image.width = settings.width;
-    out.image.height = settings.height;
-    const float4* pixels = output->data<float4>();
-    out.image.pixels.resize(size_t(settings.width) * settings.height);
-    for (size_t i = 0; i < out.image.pixels.size(); ++i)
-        out.image.pixels[i] = make_float3(pixels[i]);
+    out.image = image_from_output(*output);
     return out;
 }
 

@@ -3,6 +3,8 @@
 // glass sphere, three materials, point lights, and two ray types (radiance, shadow).
 #include "samples/whitted/whitted.h"
 
+#include "samples/scene_setup.h"
+
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -253,12 +255,7 @@ RenderResult render_whitted(const RenderSettings& settings) {
 
     timed_launch(ctx, 0, settings, out);
 
-    out.image.width = settings.width;
-    out.image.height = settings.height;
-    out.image.pixels.resize(size_t(settings.width) * settings.height);
-    const float4* pixels = output->data<float4>();
-    for (size_t i = 0; i < out.image.pixels.size(); ++i)
-        out.image.pixels[i] = make_float3(pixels[i]);
+    out.image = image_from_output(*output);
     return out;
 }
 

@@ -1,0 +1,45 @@
+#include "samples/scene_setup.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lucent::samples {
+
+float scene_extent(const scene::Scene& scene) {
+    float extent = 0;
+    for (const auto& mesh : scene.meshes)
+        for (const float3& p : mesh.positions)
+            extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    return extent;
+}
+
+MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh) {
+    MeshBuffers b;
+    b.positions = ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
+    b.positions->upload(mesh.positions);
+    b.triangles = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.indices.size()));
+    b.triangles->upload(mesh.indices);
+    b.materials = ctx.create_buffer<unsigned>(BufferType::kInput, unsigned(mesh.materials.size()));
+    b.materials->upload(mesh.materials);
+    b.uvs = ctx.create_buffer<float2>(BufferType::kInput, unsigned(mesh.uvs.size()));
+    if (!mesh.uvs.empty()) b.uvs->upload(mesh.uvs);
+    return b;
+}
+
+PinholeFrame pinhole_frame(const scene::Camera& c, float aspect) {
+    const float3 W = normalize(c.look - c.eye), U = normalize(cross(W, c.up)), V = cross(U, W);
+    const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);
+    return {U * (half_height * aspect), V * half_height, W};
+}
+
+scene::Image image_from_output(const Buffer& output) {
+    scene::Image image;
+    image.width = output.size().x;
+    image.height = output.size().y;
+    const float4* pixels = output.data<float4>();
+    image.pixels.resize(size_t(image.width) * image.height);
+    for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = make_float3(pixels[i]);
+    return image;
+}
+
+}  // namespace lucent::samples

@@ -1,0 +1,32 @@
+// Host-side steps the samples that render a scene/ Scene share: its size, its meshes as
+// buffers, the pinhole camera frame, and the output buffer as an image.
+#pragma once
+
+#include <memory>
+
+#include "lucent/context.h"
+#include "scene/image_io.h"
+#include "scene/scene.h"
+
+namespace lucent::samples {
+
+/// The largest coordinate magnitude of any vertex: offsets for secondary rays scale with
+/// it (the Cornell box is in millimetres).
+float scene_extent(const scene::Scene& scene);
+
+/// A mesh's arrays as input buffers (uvs may be an empty buffer).
+struct MeshBuffers {
+    std::shared_ptr<Buffer> positions, triangles, materials, uvs;
+};
+MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh);
+
+/// Pinhole camera: W to the image centre, U and V half the image's width and height.
+struct PinholeFrame {
+    float3 U, V, W;
+};
+PinholeFrame pinhole_frame(const scene::Camera& camera, float aspect);
+
+/// The float4 output buffer of a launch as a linear RGB image.
+scene::Image image_from_output(const Buffer& output);
+
+}  // namespace lucent::samples
