@@ -73,6 +73,7 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.verbose = args.verbose;
     if (!args.jit_check.empty()) s.jit_check_sm = parse_sm("--jit-check", args.jit_check);
     s.repeat = args.repeat;
+    s.spp = args.spp;
     for (const std::string& text : args.sets) {
         auto [name, value] = parse_set("--set", text);
         s.sets[name] = value;  // a later --set of the same name wins, as in most CLIs
@@ -112,6 +113,12 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
         ->type_name("N")
         ->check(CLI::Range(1u, 100000u).description(""))
         ->capture_default_str();
+    cmd->add_option("--spp", args.spp,
+                    "Samples per pixel of a progressive sample (the path tracer), one launch "
+                    "each; 0 = the sample's default")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 1000000u).description(""))
+        ->capture_default_str();
     cmd->add_option("--jit-check", args.jit_check,
                     "Also generate the CUDA megakernel and compile it with NVRTC for this GPU "
                     "architecture (works without a GPU)")
@@ -123,7 +130,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "  lucent render --out whitted.exr      # linear float image (or .pfm)\n"
                 "  lucent render --backend cuda         # on the GPU; a clear error without one\n"
                 "  lucent render --repeat 500           # median launch time and frames/s\n"
-                "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n");
+                "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n"
+                "  lucent render --sample pathtracer --scene cornell-materials --spp 256\n");
     return cmd;
 }
 
@@ -142,8 +150,7 @@ int run_render(const RenderArgs& args) {
 
     ProgressBar bar("render", "launches");
     samples::RenderSettings run = settings;
-    if (settings.repeat > 1)
-        run.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
+    run.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
     const Clock::time_point start = Clock::now();
     samples::RenderResult result = info.render(run);
     bar.finish();
@@ -157,10 +164,10 @@ int run_render(const RenderArgs& args) {
                 result.backend.c_str());
 
     for (const samples::StageTiming& stage : result.stages)
-        std::printf("  %-16s %10.3f ms%s%s\n", stage.name.c_str(), stage.ms,
+        std::printf("  %-20s %10.3f ms%s%s\n", stage.name.c_str(), stage.ms,
                     stage.note.empty() ? "" : "  ", stage.note.c_str());
-    std::printf("  %-16s %10.3f ms\n", "write image", write_ms);
-    std::printf("  %-16s %10.3f ms (wall clock)\n", "total", total_ms);
+    std::printf("  %-20s %10.3f ms\n", "write image", write_ms);
+    std::printf("  %-20s %10.3f ms (wall clock)\n", "total", total_ms);
     if (result.report.exception_count() > 0) {
         std::string summary = result.report.summary();
         if (!summary.empty() && summary.back() != '\n') summary += '\n';

@@ -18,6 +18,7 @@ struct RenderArgs {
     unsigned threads = 0;
     bool verbose = false;
     unsigned repeat = 1;    // launches; >1 reports the median launch time
+    unsigned spp = 0;       // samples per pixel of progressive samples; 0 = the sample's default
     std::string jit_check;  // e.g. "sm_90": also compile the CUDA megakernel (no GPU needed)
 };
 

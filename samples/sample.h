@@ -28,6 +28,9 @@ struct RenderSettings {
     bool verbose = false;
     int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel
     unsigned repeat = 1;   // --repeat: launches timed after the first
+    unsigned spp = 0;      // --spp: samples per pixel of progressive samples; 0 = the sample's default
+    /// Also return the sample's intermediate images (RenderResult::layers), for tests.
+    bool keep_layers = false;
     /// Called as launches complete (done, total), e.g. for a progress bar; may be empty.
     std::function<void(unsigned, unsigned)> progress;
 
@@ -49,6 +52,9 @@ struct RenderResult {
     std::string backend_notice;       // Context::backend_notice(): why auto chose the CPU
     std::vector<StageTiming> stages;  // in order: e.g. scene setup, compile, accel, launch
     LaunchReport report;              // exceptions of the last launch
+    /// With RenderSettings::keep_layers: named intermediate images (e.g. IGI's "direct",
+    /// "indirect", "normal"), each at the resolution it was computed at.
+    std::map<std::string, scene::Image> layers;
 };
 
 struct SampleInfo {

@@ -59,18 +59,21 @@ Scene cornell_box(bool area_light) {
     scene.meshes.push_back(std::move(room));
 
     // The light's opening in the ceiling, 0.1 mm below it so it does not coincide.
-    const float3 corner{343, 548.7f, 227}, edge1{-130, 0, 0}, edge2{0, 0, 105};
+    // Edges ordered so that cross(edge1, edge2) points down, into the box: the lit side.
+    const float3 corner{343, 548.7f, 227}, edge1{0, 0, 105}, edge2{-130, 0, 0};
     if (area_light) {
         Mesh light;
         light.name = "light";
         QuadList l{light};
-        l.add({corner, corner + edge2, corner + edge1 + edge2, corner + edge1}, kLight);
+        l.add({corner, corner + edge1, corner + edge1 + edge2, corner + edge2}, kLight);
         scene.meshes.push_back(std::move(light));
         scene.area_lights.push_back({corner, edge1, edge2, scene.materials[kLight].emission});
     } else {
-        // The same power from a point: radiance x area x pi, over 4 pi steradians.
+        // The same power from a point: radiance x area x pi, over 4 pi steradians. It hangs
+        // 10 cm below the opening, so that it lights the ceiling as well (a point light just
+        // under the ceiling would pour half its power into a spot of a few millimetres).
         const float area = length(cross(edge1, edge2));
-        scene.point_lights.push_back({corner + 0.5f * (edge1 + edge2) - make_float3(0, 1, 0),
+        scene.point_lights.push_back({corner + 0.5f * (edge1 + edge2) - make_float3(0, 100, 0),
                                       scene.materials[kLight].emission * (area / 4.0f)});
     }
     scene.camera = Camera{{278, 273, -800}, {278, 273, 0}, {0, 1, 0}, 39.3077f};

@@ -10,8 +10,18 @@
 
 namespace lucent::scene {
 
+/// How a physically based renderer (the path tracer) reads a Material; the other samples
+/// read its Phong fields only.
+enum class MaterialKind {
+    kLambert,     // diffuse reflectance `diffuse`
+    kMetal,       // GGX microfacet conductor, Schlick Fresnel with `specular` as its colour
+    kDielectric,  // smooth glass of index `ior`
+    kCoated,      // a clear GGX coat of index `ior` and `roughness` over a Lambert `diffuse`
+};
+
 /// Phong-style material of OBJ's MTL: diffuse reflectance (rho), specular reflectance and
-/// exponent, emission, and an optional diffuse texture file (sRGB, linearised on load).
+/// exponent, emission, and an optional diffuse texture file (sRGB, linearised on load); and
+/// for physically based renderers a kind with its roughness and index of refraction.
 struct Material {
     std::string name;
     float3 diffuse{0.8f, 0.8f, 0.8f};
@@ -19,6 +29,9 @@ struct Material {
     float shininess = 0;
     float3 emission{0, 0, 0};
     std::string diffuse_texture;  // a file path, resolved against the file that named it
+    MaterialKind kind = MaterialKind::kLambert;
+    float roughness = 0.3f;  // perceptual, in [0, 1]: GGX alpha = roughness^2
+    float ior = 1.5f;        // of glass and of the coat, > 1
 };
 
 struct Mesh {
@@ -35,7 +48,8 @@ struct PointLight {
     float3 intensity;  // radiant intensity per colour channel
 };
 
-/// An emitting parallelogram: corner + s * edge1 + t * edge2 for s, t in [0, 1].
+/// An emitting parallelogram: corner + s * edge1 + t * edge2 for s, t in [0, 1]. It emits on
+/// one side, the one cross(edge1, edge2) points to (as a ceiling light emits downwards).
 struct AreaLight {
     float3 corner, edge1, edge2;
     float3 emission;  // radiance
@@ -66,8 +80,12 @@ Scene load_scene(const std::string& name_or_path);
 
 /// The Cornell box with its two blocks (Goral et al. 1984, measured data of the Cornell
 /// Program of Computer Graphics), in millimetres; lit by its ceiling light as an area light,
-/// or by a point light just below it.
+/// or by a point light of the same power hanging 10 cm below it.
 Scene cornell_box(bool area_light);
+
+/// The area-lit Cornell box with a rough metal tall block, a glass short block and a coated
+/// (clear varnish over white) floor: every MaterialKind in one built-in scene.
+Scene cornell_materials_box();
 
 /// OBJ + MTL through tinyobjloader (polygons fanned into triangles).
 Scene load_obj_scene(const std::string& path);

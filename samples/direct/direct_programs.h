@@ -137,8 +137,9 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
             const float3 q = light.corner + u * light.edge1 + v * light.edge2;
             const float3 to = q - p;
             const float d2 = dot(to, to), d = sqrtf(d2);
-            const float cos_surface = dot(n, to) / d, cos_light = fabsf(dot(light_normal, to)) / d;
-            if (cos_surface > 0.0f)
+            // One-sided: the light emits towards cross(edge1, edge2) (scene.h).
+            const float cos_surface = dot(n, to) / d, cos_light = -dot(light_normal, to) / d;
+            if (cos_surface > 0.0f && cos_light > 0.0f)
                 sum += light.emission *
                        (cos_surface * cos_light / d2 * direct::visibility(rec, origin, q));
         }

@@ -1,11 +1,14 @@
-// Host setup of the IGI sample: the scene as triangles with per-triangle materials, point
-// lights, a VPL buffer filled by its own entry point, then the camera entry point.
+// Host setup of the IGI sample: the scene as triangles with per-triangle materials, its
+// lights as point emitters, a second graph of per-triangle boxes for imperfect visibility,
+// and the passes of seed Fig. 3 as entry points launched in order each frame.
 #include "samples/igi/igi.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
+#include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
 #include "samples/scene_setup.h"
 #include "samples/settings_error.h"
@@ -20,21 +23,58 @@ double ms_since(Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
+/// The scene's lights as IGI's point emitters: point lights as they are; each area light as
+/// a side x side grid of cosine lobes at its cells' centres, sharing its power L A pi.
+std::vector<igi::PointLight> point_emitters(const scene::Scene& input, int side) {
+    std::vector<igi::PointLight> lights;
+    for (const auto& l : input.point_lights)
+        lights.push_back({l.position, l.intensity, make_float3(0.0f)});
+    for (const auto& a : input.area_lights) {
+        const float3 cross_edges = cross(a.edge1, a.edge2);
+        const float area = length(cross_edges);
+        if (!(area > 0.0f)) continue;  // degenerate: emits nothing
+        const float3 normal = cross_edges / area;
+        const float cells = float(side * side);
+        for (int j = 0; j < side; ++j)
+            for (int i = 0; i < side; ++i) {
+                const float u = (float(i) + 0.5f) / float(side), v = (float(j) + 0.5f) / float(side);
+                lights.push_back({a.corner + u * a.edge1 + v * a.edge2,
+                                  a.emission * (area / cells), normal});
+            }
+    }
+    return lights;
+}
+
+IgiConfig read_config(const RenderSettings& settings, const SampleInfo& info) {
+    IgiConfig c;
+    c.paths = unsigned(get_int_option(settings, info, "vpls", 1, 65536));
+    c.bounces = unsigned(get_int_option(settings, info, "bounces", 1, 8));
+    c.downsample = unsigned(get_int_option(settings, info, "downsample", 1, 16));
+    c.interleave = unsigned(get_int_option(settings, info, "interleave", 1, 8));
+    c.width = settings.width;
+    c.height = settings.height;
+    return c;
+}
+
 RenderResult render_igi(const RenderSettings& settings) {
     const SampleInfo& info = igi_sample_info();
     check_options(settings, info);
-    const int paths = get_int_option(settings, info, "vpls", 1, 65536);
-    const int bounces = get_int_option(settings, info, "bounces", 1, 8);
+    const IgiConfig config = read_config(settings, info);
     const float min_d_fraction = get_float_option(settings, info, "min_d", 0.0f, 10.0f);
     const int max_depth = get_int_option(settings, info, "max_depth", 1, 16);
     const int imperfect = get_int_option(settings, info, "imperfect_visibility", 0, 1);
+    const float depth_threshold = get_float_option(settings, info, "depth_threshold", 0.0f, 10.0f);
+    const float normal_threshold = get_float_option(settings, info, "normal_threshold", -1.0f, 1.0f);
+    const float sigma = get_float_option(settings, info, "sigma", 0.1f, 16.0f);
+    const int area_side = get_int_option(settings, info, "area_samples", 1, 64);
     const Clock::time_point setup_start = Clock::now();
     const scene::Scene input =
-        scene::load_scene(settings.scene.empty() ? "cornell-point" : settings.scene);
-    if (input.point_lights.empty())
+        scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    const std::vector<igi::PointLight> lights = point_emitters(input, area_side);
+    if (lights.empty())
         throw SettingsError("igi: scene '" + input.name +
-                            "' has no point lights; IGI traces its particles from point lights "
-                            "(try --scene cornell-point, or add a point light in a JSON scene)");
+                            "' has no lights; IGI traces its particles from point and area "
+                            "lights (try --scene cornell, or add a light to a JSON scene)");
 
     RenderResult out;
     Context ctx(settings.context_options());
@@ -51,15 +91,19 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
     ctx["min_d"] = min_d_fraction * extent;
     ctx["max_depth"] = unsigned(max_depth);
-    ctx["bounces"] = unsigned(bounces);
+    ctx["bounces"] = config.bounces;
+    ctx["downsample"] = config.downsample;
+    ctx["interleave"] = config.interleave;
+    ctx["depth_threshold"] = depth_threshold;
+    ctx["normal_threshold"] = normal_threshold;
+    ctx["sigma"] = sigma;
 
-    std::vector<igi::PointLight> lights;
-    for (const auto& l : input.point_lights) lights.push_back({l.position, l.intensity});
     auto light_buffer =
         ctx.create_buffer<igi::PointLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
-    auto vpls = ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, unsigned(paths * bounces));
+    auto vpls = ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput,
+                                            config.paths * config.bounces);
     ctx["vpls"] = vpls;
 
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi_surface));
@@ -89,15 +133,13 @@ RenderResult render_igi(const RenderSettings& settings) {
     box_material->set_any_hit(igi::kVplShadowRay, blocked);
     for (const auto& mesh : input.meshes) {
         const MeshBuffers buffers = upload_mesh(ctx, mesh);
-        const auto& vertices = buffers.positions;
-        const auto& indices = buffers.triangles;
         auto triangles = ctx.create_geometry_triangles();
-        triangles->set_vertices(vertices);
-        triangles->set_indices(indices);
+        triangles->set_vertices(buffers.positions);
+        triangles->set_indices(buffers.triangles);
         triangles->set_material_indices(buffers.materials);
         triangles->set_attribute_program(attributes);
-        (*triangles)["positions"] = vertices;
-        (*triangles)["triangles"] = indices;
+        (*triangles)["positions"] = buffers.positions;
+        (*triangles)["triangles"] = buffers.triangles;
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(triangles);
         for (const auto& material : materials) instance->add_material(material);
@@ -107,8 +149,8 @@ RenderResult render_igi(const RenderSettings& settings) {
         box_geometry->set_primitive_count(unsigned(mesh.indices.size()));
         box_geometry->set_bounding_box_program(box_bounds);
         box_geometry->set_intersection_program(box_intersect);
-        (*box_geometry)["positions"] = vertices;
-        (*box_geometry)["triangles"] = indices;
+        (*box_geometry)["positions"] = buffers.positions;
+        (*box_geometry)["triangles"] = buffers.triangles;
         auto box_instance = ctx.create_geometry_instance();
         box_instance->set_geometry(box_geometry);
         box_instance->add_material(box_material);
@@ -121,42 +163,51 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
 
+    // The images of seed Fig. 3: full resolution G-buffer and direct image, the indirect
+    // irradiance at 1/N resolution, merged, and upsampled.
+    const IgiImages images = create_igi_images(ctx, config);
     const PinholeFrame frame =
         pinhole_frame(input.camera, float(settings.width) / float(settings.height));
-    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
     auto camera = ctx.create_program(LUCENT_PROGRAM(igi_camera));
     (*camera)["eye"] = input.camera.eye;
     (*camera)["W"] = frame.W;
     (*camera)["U"] = frame.U;
     (*camera)["V"] = frame.V;
-    (*camera)["output"] = output;
-    ctx.set_entry_point_count(2);
-    ctx.set_ray_generation_program(0, camera);
-    ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(igi_generate_vpls)));
+    auto indirect = ctx.create_program(LUCENT_PROGRAM(igi_indirect));
+    (*indirect)["indirect"] = images.indirect;
+    auto discontinuity = ctx.create_program(LUCENT_PROGRAM(igi_discontinuity));
+    (*discontinuity)["indirect"] = images.indirect;
+    (*discontinuity)["merged"] = images.merged;
+    auto upsample = ctx.create_program(LUCENT_PROGRAM(igi_upsample));
+    (*upsample)["low"] = config.interleave > 1 ? images.merged : images.indirect;
+    (*upsample)["full"] = images.upsampled;
+    auto compose = ctx.create_program(LUCENT_PROGRAM(igi_compose));
+    (*compose)["indirect"] = images.irradiance_at_full_resolution(config);
+    (*compose)["output"] = images.output;
+    ctx.set_entry_point_count(igi::kEntryCount);
+    ctx.set_ray_generation_program(igi::kDirectEntry, camera);
+    ctx.set_ray_generation_program(igi::kVplEntry,
+                                   ctx.create_program(LUCENT_PROGRAM(igi_generate_vpls)));
+    ctx.set_ray_generation_program(igi::kIndirectEntry, indirect);
+    ctx.set_ray_generation_program(igi::kDiscontinuityEntry, discontinuity);
+    ctx.set_ray_generation_program(igi::kUpsampleEntry, upsample);
+    ctx.set_ray_generation_program(igi::kComposeEntry, compose);
     ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi_miss)));
     out.stages.push_back(
         {"scene setup", ms_since(setup_start),
-         input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
+         input.name + ", " + std::to_string(input.triangle_count()) + " triangles, " +
+             std::to_string(lights.size()) + " point emitters"});
 
-    // VPL generation: one launch, one thread per light path (seed §4).
-    ctx.launch(1, unsigned(paths));
-    const LaunchReport generation = ctx.last_launch();
-    if (generation.jit_ms > 0)
-        out.stages.push_back(
-            {"megakernel JIT", generation.jit_ms,
-             generation.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
-    out.stages.push_back(
-        {"VPL generation", generation.launch_ms,
-         std::to_string(paths) + " paths x " + std::to_string(bounces) + " bounces"});
-    timed_launch(ctx, 0, settings, out);
-    out.stages.back().name = "direct + specular + indirect";
-    // The scene was compiled by the VPL launch: report it under compile, not generation.
-    for (StageTiming& stage : out.stages)
-        if (stage.name == "compile + accel")
-            stage.ms += generation.compile_ms + generation.accel_ms;
-    out.report.jit_ms = std::max(out.report.jit_ms, generation.jit_ms);
-    out.report.jit_cached = out.report.jit_cached || generation.jit_cached;
-    out.image = image_from_output(*output);
+    render_igi_frames(ctx, config, settings, out);
+    out.image = image_from_output(*images.output);
+    if (settings.keep_layers) {
+        out.layers["direct"] = image_from_output(*images.direct);
+        out.layers["albedo"] = image_from_output(*images.gbuffer_albedo);
+        out.layers["normal"] = image_from_output(*images.gbuffer_normal);
+        out.layers["position"] = image_from_output(*images.gbuffer_position);
+        out.layers["indirect"] = image_from_output(*images.irradiance_at_full_resolution(config));
+        out.layers["indirect_low"] = image_from_output(*images.indirect);
+    }
     return out;
 }
 
@@ -165,16 +216,30 @@ RenderResult render_igi(const RenderSettings& settings) {
 const SampleInfo& igi_sample_info() {
     static const SampleInfo info{
         "igi",
-        "Instant Global Illumination (Marques and Santos, seed §4), canonical form: VPLs from the "
-        "point lights along Halton paths, direct light, specular reflections and Eq. (1)",
+        "Instant Global Illumination (Marques and Santos, seed §4): VPLs from the lights along "
+        "Halton paths, direct light, specular reflections, Eq. (1), and the paper's three "
+        "accelerations",
         {
-            {"vpls", "180", "light paths traced from the point lights (1..65536)"},
+            {"vpls", "180", "light paths traced from the lights (1..65536)"},
             {"bounces", "1", "VPLs per path: diffuse bounces recorded (1..8)"},
             {"min_d", "0.1",
              "Eq. (1)'s bounding distance, as a fraction of the scene's size (0..10)"},
             {"max_depth", "4", "deepest specular reflection tree (1..16)"},
             {"imperfect_visibility", "0",
              "1: VPL shadow rays against the triangles' bounding boxes (seed §4.1), 0: exact"},
+            {"downsample", "1",
+             "N: indirect light at 1/N of the resolution, joint bilateral upsampling (1..16)"},
+            {"interleave", "1",
+             "M: VPLs split into M x M subsets over M x M pixel tiles, merged by the "
+             "discontinuity buffer (1..8)"},
+            {"depth_threshold", "0.1",
+             "discontinuity buffer: largest relative depth difference of neighbours (0..10)"},
+            {"normal_threshold", "0.9",
+             "discontinuity buffer: smallest cosine between neighbours' normals (-1..1)"},
+            {"sigma", "1",
+             "upsampling: spatial Gaussian's sigma in low-resolution pixels (0.1..16)"},
+            {"area_samples", "4",
+             "each area light becomes a side x side grid of point emitters; the side (1..64)"},
         },
         render_igi,
     };

@@ -1,8 +1,10 @@
-// Instant Global Illumination (Marques and Santos, seed §4), canonical form: virtual point
-// lights (VPLs) from particles traced out of the point lights along Halton paths; per pixel,
-// direct light and a Whitted tree of specular reflections; indirect diffuse light from the
-// VPLs by Eq. (1) with the bounded geometry term at every diffuse hit of the tree. (The
-// paper's accelerations separate the indirect term at the primary hit: not done yet.)
+// Instant Global Illumination (Marques and Santos, seed §4): virtual point lights (VPLs) from
+// particles traced out of the lights along Halton paths; per pixel, direct light and a
+// Whitted tree of specular reflections; indirect diffuse light from the VPLs by Eq. (1) with
+// the bounded geometry term. As in the paper's Fig. 3 the indirect term of the primary hit
+// is a stage of its own (at 1/N resolution, with interleaved VPL subsets), merged by the
+// discontinuity buffer, upsampled by Eq. (2) and composed with the direct image; hits further
+// down the specular tree get their indirect inline.
 #pragma once
 
 #include "lucent/device.h"
@@ -11,10 +13,38 @@ namespace igi {
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2, kVplShadowRay = 3 };
 
+/// The passes of a frame, one entry point each (seed Fig. 3).
+enum : unsigned {
+    kDirectEntry = 0,         // full resolution: direct + specular, and the G-buffer
+    kVplEntry = 1,            // one thread per light path
+    kIndirectEntry = 2,       // Eq. (1) at the primary hits, 1/N resolution, interleaved
+    kDiscontinuityEntry = 3,  // merges the interleaved VPL subsets (seed §4.3)
+    kUpsampleEntry = 4,       // joint bilateral upsampling, Eq. (2) (seed §4.2)
+    kComposeEntry = 5,        // direct + rho / pi x indirect irradiance
+    kEntryCount = 6
+};
+
+/// A light the particles start from and the direct stage samples. Isotropic when `normal`
+/// is zero; otherwise a cosine lobe around `normal` (a piece of an area light), whose
+/// intensity along the normal is `intensity`.
 struct PointLight {
     float3 position;
     float3 intensity;
+    float3 normal;
 };
+
+LUCENT_HD inline bool is_oriented(const PointLight& light) { return dot(light.normal, light.normal) > 0.0f; }
+
+/// Radiant intensity of `light` towards the unit direction `w` (from the light).
+LUCENT_HD inline float3 intensity_towards(const PointLight& light, float3 w) {
+    if (!is_oriented(light)) return light.intensity;
+    return light.intensity * lc_max(0.0f, dot(light.normal, w));
+}
+
+/// Total flux: 4 pi I for an isotropic light, pi I for a cosine lobe.
+LUCENT_HD inline float3 flux(const PointLight& light) {
+    return light.intensity * (is_oriented(light) ? 3.14159265f : 4.0f * 3.14159265f);
+}
 
 /// A VPL: where a light path met a diffuse surface, and Le,k of Eq. (1): the flux that
 /// arrived there times rho / pi (it reflects diffusely).
@@ -28,9 +58,14 @@ struct HitAttributes {
     float3 geometric_normal;  // object space, not normalised
 };
 
+/// The radiance ray's payload. At the primary hit (depth 0) the closest hit leaves the
+/// indirect term out and hands the G-buffer of Fig. 3 back instead: position, distance,
+/// normal and rho.
 struct RadiancePayload {
     float3 color;
     int depth;
+    float3 position, normal, albedo;
+    float distance;  // along the primary ray; < 0: it missed
 };
 struct ShadowPayload {
     float visible;
@@ -68,6 +103,10 @@ LUCENT_HD inline float3 cosine_direction(float3 n, float u1, float u2) {
                      n * sqrtf(lc_max(0.0f, 1.0f - u1)));
 }
 
+/// Fractional part, for Cranley-Patterson rotations of a Halton point.
+LUCENT_HD inline float wrap01(float x) { return x - floorf(x); }
+
+// ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
     lucent::BufferView<PointLight> lights;
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
@@ -77,26 +116,85 @@ struct GenerateRecord {
 };
 LUCENT_RECORD(GenerateRecord, lights, vpls, bounces, scene_epsilon, top_object)
 
+/// The full-resolution G-buffer of the direct stage (seed Fig. 3).
+struct GBuffer {
+    lucent::BufferView<float4> position;  // xyz, w = distance along the primary ray (< 0: miss)
+    lucent::BufferView<float4> normal;    // xyz
+    lucent::BufferView<float4> albedo;    // rho
+};
+
 struct CameraRecord {
     float3 eye, U, V, W;
-    lucent::BufferView<float4> output;
+    lucent::BufferView<float4> direct;  // direct + specular (+ inline indirect below the tree)
+    lucent::BufferView<float4> gbuffer_position, gbuffer_normal, gbuffer_albedo;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, output, top_object)
+LUCENT_RECORD(CameraRecord, eye, U, V, W, direct, gbuffer_position, gbuffer_normal,
+              gbuffer_albedo, top_object)
 
-struct SurfaceRecord {
-    float3 Kd, Ks, Ke;
-    lucent::BufferView<PointLight> lights;
+/// What Eq. (1) needs wherever it is evaluated: the VPLs and how to test their visibility.
+struct IndirectParams {
     lucent::BufferView<Vpl> vpls;
     float min_d;  // Eq. (1)'s bounding distance
-    unsigned max_depth;
     float scene_epsilon;
     lucent::Handle top_object;
     unsigned imperfect_visibility;  // VPL shadow rays against the boxes graph (seed §4.1)
     lucent::Handle vpl_shadow_object;
 };
+
+struct SurfaceRecord {
+    float3 Kd, Ks, Ke;
+    lucent::BufferView<PointLight> lights;
+    lucent::BufferView<Vpl> vpls;
+    float min_d;
+    unsigned max_depth;
+    float scene_epsilon;
+    lucent::Handle top_object;
+    unsigned imperfect_visibility;
+    lucent::Handle vpl_shadow_object;
+};
 LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
               imperfect_visibility, vpl_shadow_object)
+
+struct IndirectRecord {
+    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<float4> indirect;  // 1/downsample resolution: irradiance, w = 1 if valid
+    lucent::BufferView<Vpl> vpls;
+    unsigned downsample, interleave;
+    float min_d;
+    float scene_epsilon;
+    lucent::Handle top_object;
+    unsigned imperfect_visibility;
+    lucent::Handle vpl_shadow_object;
+};
+LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, downsample,
+              interleave, min_d, scene_epsilon, top_object, imperfect_visibility,
+              vpl_shadow_object)
+
+struct DiscontinuityRecord {
+    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<float4> indirect, merged;  // both at 1/downsample resolution
+    unsigned downsample, interleave;
+    float depth_threshold;   // largest relative depth difference of continuous neighbours
+    float normal_threshold;  // smallest cosine between the normals of continuous neighbours
+};
+LUCENT_RECORD(DiscontinuityRecord, gbuffer_position, gbuffer_normal, indirect, merged, downsample,
+              interleave, depth_threshold, normal_threshold)
+
+struct UpsampleRecord {
+    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<float4> low, full;  // 1/downsample and full resolution
+    unsigned downsample;
+    float sigma;  // of the spatial Gaussian, in low-resolution pixels
+};
+LUCENT_RECORD(UpsampleRecord, gbuffer_position, gbuffer_normal, low, full, downsample, sigma)
+
+struct ComposeRecord {
+    lucent::BufferView<float4> direct, gbuffer_albedo;
+    lucent::BufferView<float4> indirect;  // full resolution irradiance
+    lucent::BufferView<float4> output;
+};
+LUCENT_RECORD(ComposeRecord, direct, gbuffer_albedo, indirect, output)
 
 struct ParticleRecord {
     float3 Kd;
@@ -109,38 +207,59 @@ struct MeshRecord {
 };
 LUCENT_RECORD(MeshRecord, positions, triangles)
 
-LUCENT_HD inline bool visible(const SurfaceRecord& rec, float3 from, float3 to) {
+template <class Record>
+LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
+    return IndirectParams{rec.vpls,       rec.min_d,
+                          rec.scene_epsilon, rec.top_object,
+                          rec.imperfect_visibility, rec.vpl_shadow_object};
+}
+
+LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float epsilon, float3 from,
+                              float3 to) {
     ShadowPayload s{1.0f};
-    lucent::trace(rec.top_object,
-                  lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f), s);
+    lucent::trace(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f), s);
     return s.visible > 0.0f;
 }
 
 /// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (seed §4.1), against
 /// the crude second graph of the triangles' bounding boxes (a different root and ray type).
-LUCENT_HD inline bool vpl_visible(const SurfaceRecord& rec, float3 from, float3 to) {
-    if (!rec.imperfect_visibility) return visible(rec, from, to);
-    ShadowPayload s{1.0f};
-    lucent::trace(rec.vpl_shadow_object,
-                  lucent::make_ray(from, to - from, kVplShadowRay, rec.scene_epsilon, 0.999f), s);
-    return s.visible > 0.0f;
+LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 to) {
+    if (p.imperfect_visibility)
+        return visible(p.vpl_shadow_object, kVplShadowRay, p.scene_epsilon, from, to);
+    return visible(p.top_object, kShadowRay, p.scene_epsilon, from, to);
 }
 
-/// Eq. (1) at x with normal n: sum over the VPLs of Le,k V(x, yk) G(x, yk), where G is
-/// bounded by f(0.8 min_d, 1.2 min_d, |x - yk|). Irradiance-like: rho/pi multiplies it.
-LUCENT_HD inline float3 indirect(const SurfaceRecord& rec, float3 x, float3 n) {
+/// Eq. (1) at x with normal n over the VPLs first, first + stride, ...: the sum of
+/// Le,k V(x, yk) G(x, yk), with G bounded by f(0.8 min_d, 1.2 min_d, |x - yk|). Incident
+/// irradiance: rho / pi multiplies it at composition (seed §4.2).
+LUCENT_HD inline float3 indirect(const IndirectParams& p, float3 x, float3 n, unsigned first = 0,
+                                 unsigned stride = 1) {
     float3 sum = make_float3(0.0f);
-    for (unsigned k = 0; k < rec.vpls.count(); ++k) {
-        const Vpl vpl = rec.vpls[k];
+    for (unsigned k = first; k < p.vpls.count(); k += stride) {
+        const Vpl vpl = p.vpls[k];
         if (max_component(vpl.radiance) <= 0.0f) continue;
         const float3 to = vpl.position - x;
         const float d2 = dot(to, to), d = sqrtf(d2);
         const float cos_x = dot(n, to) / d, cos_y = -dot(vpl.normal, to) / d;
         if (cos_x <= 0.0f || cos_y <= 0.0f) continue;
-        const float g = cos_x * cos_y / d2 * smoothing(0.8f * rec.min_d, 1.2f * rec.min_d, d);
-        if (g > 0.0f && vpl_visible(rec, x, vpl.position)) sum += vpl.radiance * g;
+        const float g = cos_x * cos_y / d2 * smoothing(0.8f * p.min_d, 1.2f * p.min_d, d);
+        if (g > 0.0f && vpl_visible(p, x, vpl.position)) sum += vpl.radiance * g;
     }
     return sum;
+}
+
+/// The full-resolution pixel whose G-buffer stands for low-resolution pixel q: the centre
+/// of its N x N block, clamped to the image.
+LUCENT_HD inline uint2 representative_pixel(uint2 q, unsigned downsample, uint2 full_size) {
+    return make_uint2(lc_min(q.x * downsample + downsample / 2, full_size.x - 1),
+                      lc_min(q.y * downsample + downsample / 2, full_size.y - 1));
+}
+
+LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+
+template <class T>
+LUCENT_HD inline uint2 size2(const lucent::BufferView<T>& b) {
+    return make_uint2(b.size.x, b.size.y);
 }
 
 }  // namespace igi
@@ -149,16 +268,26 @@ LUCENT_HD inline float3 indirect(const SurfaceRecord& rec, float3 x, float3 n) {
 LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
     const unsigned path = lucent::launch_index().x, paths = lucent::launch_size().x;
     for (unsigned b = 0; b < rec.bounces; ++b) rec.vpls[path * rec.bounces + b] = igi::Vpl{};
-    const igi::PointLight light = rec.lights[path % rec.lights.count()];
-    // Uniform direction on the sphere from Halton dimensions 2 and 3.
-    const unsigned i = path + 1;
-    const float z = 1.0f - 2.0f * igi::halton(i, 2), phi = 6.2831853f * igi::halton(i, 3);
-    const float s = sqrtf(lc_max(0.0f, 1.0f - z * z));
-    float3 direction = make_float3(s * cosf(phi), s * sinf(phi), z);
+    // Paths go round the lights; each light walks its own Halton sequence (index i), rotated
+    // per light (Cranley-Patterson) so that lights of one area light do not share directions.
+    const unsigned count = rec.lights.count(), light_index = path % count;
+    const igi::PointLight light = rec.lights[light_index];
+    const unsigned i = path / count + 1;
+    const float r2 = igi::halton(light_index + 1, 5), r3 = igi::halton(light_index + 1, 7);
+    const float u1 = igi::wrap01(igi::halton(i, 2) + r2), u2 = igi::wrap01(igi::halton(i, 3) + r3);
+    float3 direction;
+    if (igi::is_oriented(light)) {
+        direction = igi::cosine_direction(light.normal, u1, u2);
+    } else {  // uniform on the sphere
+        const float z = 1.0f - 2.0f * u1, phi = 6.2831853f * u2;
+        const float s = sqrtf(lc_max(0.0f, 1.0f - z * z));
+        direction = make_float3(s * cosf(phi), s * sinf(phi), z);
+    }
     float3 origin = light.position;
-    // Each path carries an equal share of the lights' total flux 4 pi I.
-    float3 flux = light.intensity * (4.0f * 3.14159265f * float(rec.lights.count()) / float(paths));
-    const unsigned primes[] = {5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43};
+    // The light's flux shared by its paths (paths / count of them, rounded).
+    const unsigned light_paths = paths / count + (light_index < paths % count ? 1u : 0u);
+    float3 flux = igi::flux(light) * (1.0f / float(light_paths));
+    const unsigned primes[] = {11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71};
     for (unsigned b = 0; b < rec.bounces; ++b) {
         igi::ParticlePayload hit{};
         lucent::trace(rec.top_object,
@@ -170,8 +299,8 @@ LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
             igi::Vpl{hit.position, n, flux * hit.albedo * (1.0f / 3.14159265f)};
         flux = flux * hit.albedo;  // cosine sampling cancels the cosine and pi
         origin = hit.position + rec.scene_epsilon * n;
-        direction = igi::cosine_direction(n, igi::halton(i, primes[(2 * b) % 12]),
-                                          igi::halton(i, primes[(2 * b + 1) % 12]));
+        direction = igi::cosine_direction(n, igi::halton(i, primes[(2 * b) % 16]),
+                                          igi::halton(i, primes[(2 * b + 1) % 16]));
     }
 }
 
@@ -184,16 +313,21 @@ LUCENT_CLOSEST_HIT(igi_particle_hit, igi::ParticleRecord, igi::ParticlePayload,
     prd.albedo = rec.Kd;
 }
 
-// ---- per pixel: direct light, the specular tree, and Eq. (1) -------------------------------
+// ---- the direct stage: direct light, the specular tree, the G-buffer -----------------------
 LUCENT_RAY_GENERATION(igi_camera, igi::CameraRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
     const float sx = 2.0f * (p.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (p.y + 0.5f) / n.y;
-    igi::RadiancePayload prd{make_float3(0.0f), 0};
+    igi::RadiancePayload prd{};
+    prd.distance = -1.0f;
     lucent::trace(rec.top_object,
                   lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
                                    igi::kRadianceRay, 0.0f),
                   prd);
-    rec.output[make_uint2(p.x, p.y)] = make_float4(prd.color, 1.0f);
+    const uint2 pixel = make_uint2(p.x, p.y);
+    rec.direct[pixel] = make_float4(prd.color, 1.0f);
+    rec.gbuffer_position[pixel] = make_float4(prd.position, prd.distance);
+    rec.gbuffer_normal[pixel] = make_float4(prd.normal, 0.0f);
+    rec.gbuffer_albedo[pixel] = make_float4(prd.albedo, 0.0f);
 }
 
 LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::HitAttributes) {
@@ -208,14 +342,26 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
         for (unsigned l = 0; l < rec.lights.count(); ++l) {
             const igi::PointLight light = rec.lights[l];
             const float3 to = light.position - x;
-            const float d2 = dot(to, to), c = dot(n, to) / sqrtf(d2);
-            if (c > 0.0f && igi::visible(rec, origin, light.position))
-                color += albedo * light.intensity * (c / d2);
+            const float d2 = dot(to, to), d = sqrtf(d2), c = dot(n, to) / d;
+            if (c <= 0.0f) continue;
+            const float3 intensity = igi::intensity_towards(light, -to / d);
+            if (max_component(intensity) > 0.0f &&
+                igi::visible(rec.top_object, igi::kShadowRay, rec.scene_epsilon, origin,
+                             light.position))
+                color += albedo * intensity * (c / d2);
         }
-        color += albedo * igi::indirect(rec, origin, n);
+        // The primary hit's indirect term is a stage of its own; deeper hits get it here.
+        if (prd.depth > 0) color += albedo * igi::indirect(igi::indirect_params(rec), origin, n);
+    }
+    if (prd.depth == 0) {
+        prd.position = origin;
+        prd.normal = n;
+        prd.albedo = rec.Kd;
+        prd.distance = lucent::t_hit();
     }
     if (max_component(rec.Ks) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
-        igi::RadiancePayload reflected{make_float3(0.0f), prd.depth + 1};
+        igi::RadiancePayload reflected{};
+        reflected.depth = prd.depth + 1;
         lucent::trace(
             rec.top_object,
             lucent::make_ray(origin, reflect(normalize(ray.direction), n), igi::kRadianceRay, 0.0f),
@@ -240,6 +386,112 @@ LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {
         cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
 }
 
+// ---- the indirect stage: Eq. (1) at the primary hits (seed §4.2, §4.3) --------------------
+LUCENT_RAY_GENERATION(igi_indirect, igi::IndirectRecord) {
+    const uint3 q = lucent::launch_index();
+    const uint2 low = make_uint2(q.x, q.y);
+    const uint2 full = igi::representative_pixel(low, rec.downsample, igi::size2(rec.gbuffer_position));
+    const float4 position = rec.gbuffer_position[full];
+    if (position.w < 0.0f) {
+        rec.indirect[low] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+        return;
+    }
+    // Interleaved sampling: pixel (x, y) of each M x M tile takes VPL subset x + M y, every
+    // M^2-th VPL; M^2 times its sum estimates the whole set's.
+    const unsigned m = rec.interleave, subset = (q.x % m) + m * (q.y % m);
+    const float3 e = igi::indirect(igi::indirect_params(rec), igi::xyz(position),
+                                   igi::xyz(rec.gbuffer_normal[full]), subset, m * m);
+    rec.indirect[low] = make_float4(e * float(m * m), 1.0f);
+}
+
+// The discontinuity buffer (seed §4.3): a pixel averages the irradiance of the neighbours of
+// its M x M window whose depth and normal say the surface is continuous.
+LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
+    const uint3 q = lucent::launch_index(), size = lucent::launch_size();
+    const uint2 full_size = igi::size2(rec.gbuffer_position);
+    const uint2 centre = make_uint2(q.x, q.y);
+    const uint2 c_full = igi::representative_pixel(centre, rec.downsample, full_size);
+    const float4 c_position = rec.gbuffer_position[c_full];
+    if (c_position.w < 0.0f) {
+        rec.merged[centre] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+        return;
+    }
+    const float3 c_normal = igi::xyz(rec.gbuffer_normal[c_full]);
+    const int radius = int(rec.interleave / 2);
+    float3 sum = make_float3(0.0f);
+    float count = 0.0f;
+    for (int dy = -radius; dy <= radius; ++dy)
+        for (int dx = -radius; dx <= radius; ++dx) {
+            const int x = int(q.x) + dx, y = int(q.y) + dy;
+            if (x < 0 || y < 0 || x >= int(size.x) || y >= int(size.y)) continue;
+            const uint2 nb = make_uint2(unsigned(x), unsigned(y));
+            const uint2 nb_full = igi::representative_pixel(nb, rec.downsample, full_size);
+            const float4 position = rec.gbuffer_position[nb_full];
+            const bool is_centre = dx == 0 && dy == 0;  // always counts, whatever the thresholds
+            if (!is_centre) {
+                if (position.w < 0.0f) continue;
+                if (fabsf(position.w - c_position.w) > rec.depth_threshold * c_position.w)
+                    continue;
+                if (dot(igi::xyz(rec.gbuffer_normal[nb_full]), c_normal) < rec.normal_threshold)
+                    continue;
+            }
+            sum += igi::xyz(rec.indirect[nb]);
+            count += 1.0f;
+        }
+    rec.merged[centre] = make_float4(sum / count, 1.0f);  // count >= 1: the centre itself
+}
+
+// Joint bilateral upsampling, Eq. (2) (seed §4.2, after Kopf et al. 2007): a Gaussian over the
+// low-resolution neighbours q of p, times the cosine between the full-resolution normals at p~
+// and at q~, normalised.
+LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
+    const uint3 p = lucent::launch_index();
+    const uint2 full = make_uint2(p.x, p.y), full_size = igi::size2(rec.gbuffer_position);
+    const uint2 low_size = igi::size2(rec.low);
+    if (rec.gbuffer_position[full].w < 0.0f) {
+        rec.full[full] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+        return;
+    }
+    const float3 n = igi::xyz(rec.gbuffer_normal[full]);
+    // p in low-resolution pixel coordinates (pixel centres at integers).
+    const float n_down = float(rec.downsample);
+    const float cx = (float(p.x) + 0.5f) / n_down - 0.5f, cy = (float(p.y) + 0.5f) / n_down - 0.5f;
+    const int x0 = int(floorf(cx)), y0 = int(floorf(cy));
+    const float inv_two_sigma2 = 1.0f / (2.0f * rec.sigma * rec.sigma);
+    float3 sum = make_float3(0.0f), nearest = make_float3(0.0f);
+    float k = 0.0f, nearest_d2 = 1e30f;
+    for (int y = y0 - 1; y <= y0 + 2; ++y)
+        for (int x = x0 - 1; x <= x0 + 2; ++x) {
+            if (x < 0 || y < 0 || x >= int(low_size.x) || y >= int(low_size.y)) continue;
+            const uint2 q = make_uint2(unsigned(x), unsigned(y));
+            const uint2 q_full = igi::representative_pixel(q, rec.downsample, full_size);
+            if (rec.gbuffer_position[q_full].w < 0.0f) continue;  // background: no irradiance
+            const float d2 = (float(x) - cx) * (float(x) - cx) + (float(y) - cy) * (float(y) - cy);
+            const float3 value = igi::xyz(rec.low[q]);
+            if (d2 < nearest_d2) {
+                nearest_d2 = d2;
+                nearest = value;
+            }
+            const float w =
+                expf(-d2 * inv_two_sigma2) * lc_max(0.0f, dot(n, igi::xyz(rec.gbuffer_normal[q_full])));
+            sum += value * w;
+            k += w;
+        }
+    // No neighbour faces p's way (a thin feature between low-resolution samples): the
+    // nearest sample is the best guess left.
+    rec.full[full] = make_float4(k > 0.0f ? sum / k : nearest, 1.0f);
+}
+
+// Composition (seed Fig. 3): the direct image plus rho / pi times the indirect irradiance.
+LUCENT_RAY_GENERATION(igi_compose, igi::ComposeRecord) {
+    const uint3 p = lucent::launch_index();
+    const uint2 pixel = make_uint2(p.x, p.y);
+    const float3 rho = igi::xyz(rec.gbuffer_albedo[pixel]);
+    const float3 color =
+        igi::xyz(rec.direct[pixel]) + rho * (1.0f / 3.14159265f) * igi::xyz(rec.indirect[pixel]);
+    rec.output[pixel] = make_float4(color, 1.0f);
+}
+
 // ---- the crude scene of imperfect visibility: one box per triangle -------------------------
 LUCENT_BOUNDING_BOX(igi_triangle_box_bounds, igi::MeshRecord) {
     const uint3 t = rec.triangles[prim];
@@ -253,8 +505,11 @@ LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttribu
     const float3 a = rec.positions[t.x], b = rec.positions[t.y], c = rec.positions[t.z];
     const float3 lo = fminf(a, fminf(b, c)), hi = fmaxf(a, fmaxf(b, c));
     const lucent::Ray& ray = lucent::current_ray();
-    // Slab test; a flat box (an axis-aligned triangle) still stops rays that cross its plane.
-    float t0 = ray.tmin, t1 = ray.tmax;
+    // Slab test over the whole line; a flat box (an axis-aligned triangle) still stops rays
+    // that cross its plane. A box that holds either end of the segment does not stop it: a
+    // tilted triangle's box holds the triangle and its neighbours, which would otherwise
+    // shadow themselves from every VPL. Only boxes wholly between the ends occlude.
+    float t0 = -1e30f, t1 = 1e30f;
     const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
     const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     const float l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
@@ -273,6 +528,7 @@ LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttribu
         t1 = lc_min(t1, far * 1.00000024f);
         if (t0 > t1) return;
     }
+    if (t0 <= ray.tmin || t1 >= ray.tmax) return;
     if (lucent::potential_intersection(t0)) {
         attr.geometric_normal = cross(b - a, c - a);
         lucent::report_intersection(0);

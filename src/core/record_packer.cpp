@@ -125,7 +125,9 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
                 const_cast<unsigned char*>(static_cast<const unsigned char*>(b.raw())), b.size(),
                 checked ? unsigned(kViewBoundsChecked) : 0u};
             std::memcpy(dst, &view, sizeof view);
-            if (output_buffers && b.type() != BufferType::kInput) output_buffers->push_back(&b);
+            // Only pure output buffers must match the launch: input-output ones are often
+            // images of another size that the program reads (IGI's G-buffer, accumulators).
+            if (output_buffers && b.type() == BufferType::kOutput) output_buffers->push_back(&b);
             return;
         }
         case FieldKind::kTexture: {

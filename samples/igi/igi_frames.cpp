@@ -1,0 +1,135 @@
+// The passes of an IGI frame, launched in order and timed one by one.
+#include "samples/igi/igi_frames.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "samples/igi/igi_programs.h"
+
+namespace lucent::samples {
+
+std::shared_ptr<Buffer> IgiImages::irradiance_at_full_resolution(const IgiConfig& config) const {
+    if (config.downsample > 1) return upsampled;
+    return config.interleave > 1 ? merged : indirect;
+}
+
+IgiImages create_igi_images(Context& ctx, const IgiConfig& config) {
+    const unsigned w = config.width, h = config.height;
+    const unsigned lw = config.low_width(), lh = config.low_height();
+    auto image = [&ctx](unsigned width, unsigned height, BufferType type = BufferType::kInputOutput) {
+        return ctx.create_buffer<float4>(type, width, height);
+    };
+    IgiImages images;
+    images.direct = image(w, h);
+    images.gbuffer_position = image(w, h);
+    images.gbuffer_normal = image(w, h);
+    images.gbuffer_albedo = image(w, h);
+    images.indirect = image(lw, lh);
+    images.merged = config.interleave > 1 ? image(lw, lh) : image(1, 1);
+    images.upsampled = config.downsample > 1 ? image(w, h) : image(1, 1);
+    images.output = image(w, h, BufferType::kOutput);
+    ctx["direct"] = images.direct;
+    ctx["gbuffer_position"] = images.gbuffer_position;
+    ctx["gbuffer_normal"] = images.gbuffer_normal;
+    ctx["gbuffer_albedo"] = images.gbuffer_albedo;
+    return images;
+}
+
+namespace {
+
+/// Adds the exceptions of `from` to `into`.
+void add_exceptions(LaunchReport& into, const LaunchReport& from) {
+    for (const auto& [code, summary] : from.exceptions) {
+        auto& total = into.exceptions[code];
+        if (total.count == 0) total.first_index = summary.first_index;
+        total.count += summary.count;
+    }
+}
+
+/// One frame's launches; fills ms[stage] (0 for a skipped stage). Returns the first launch's
+/// report (it compiles the scene and JITs the megakernel) with every launch's exceptions.
+LaunchReport launch_frame(Context& ctx, const IgiConfig& config,
+                          std::array<double, kIgiStageNames.size()>& ms) {
+    ms.fill(0.0);
+    LaunchReport frame;
+    auto run = [&](unsigned stage, unsigned entry, unsigned width, unsigned height) {
+        ctx.launch(entry, width, height);
+        const LaunchReport& report = ctx.last_launch();
+        if (stage == 0) {
+            frame = report;
+            frame.exceptions.clear();
+        }
+        add_exceptions(frame, report);
+        ms[stage] = report.launch_ms;
+    };
+    run(0, igi::kVplEntry, config.paths, 1);
+    run(1, igi::kDirectEntry, config.width, config.height);
+    run(2, igi::kIndirectEntry, config.low_width(), config.low_height());
+    if (config.interleave > 1)
+        run(3, igi::kDiscontinuityEntry, config.low_width(), config.low_height());
+    if (config.downsample > 1) run(4, igi::kUpsampleEntry, config.width, config.height);
+    run(5, igi::kComposeEntry, config.width, config.height);
+    return frame;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+}  // namespace
+
+void render_igi_frames(Context& ctx, const IgiConfig& config, const RenderSettings& settings,
+                       RenderResult& result) {
+    constexpr size_t kStages = kIgiStageNames.size();
+    std::array<double, kStages> ms{};
+    const LaunchReport first = launch_frame(ctx, config, ms);
+    result.stages.push_back({"compile + accel", first.compile_ms + first.accel_ms, ""});
+    if (first.jit_ms > 0)
+        result.stages.push_back(
+            {"megakernel JIT", first.jit_ms,
+             first.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+    const unsigned frames = std::max(1u, settings.repeat);
+    if (settings.progress) settings.progress(1, frames);
+    // Per stage, its times over the frames after the first (or the first, if alone).
+    std::array<std::vector<double>, kStages> times;
+    std::vector<double> totals;
+    auto record = [&] {
+        double total = 0;
+        for (size_t s = 0; s < kStages; ++s) {
+            times[s].push_back(ms[s]);
+            total += ms[s];
+        }
+        totals.push_back(total);
+    };
+    if (frames == 1) record();
+    LaunchReport last = first;
+    for (unsigned f = 1; f < frames; ++f) {
+        last = launch_frame(ctx, config, ms);
+        record();
+        if (settings.progress) settings.progress(f + 1, frames);
+    }
+    result.report = first;
+    result.report.exceptions.clear();
+    add_exceptions(result.report, last);
+    const double frame_ms = median(totals);
+    const char* of = totals.size() > 1 ? "median" : "one frame";
+    for (size_t s = 0; s < kStages; ++s) {
+        if (s == 3 && config.interleave == 1) continue;
+        if (s == 4 && config.downsample == 1) continue;
+        const double stage_ms = median(times[s]);
+        char note[120];
+        std::snprintf(note, sizeof note, "%.1f%% of the frame (%s)", 100.0 * stage_ms / frame_ms,
+                      of);
+        result.stages.push_back({kIgiStageNames[s], stage_ms, note});
+    }
+    char note[160];
+    std::snprintf(note, sizeof note, "%.1f frames/s (%s of %zu; min %.3f, max %.3f)",
+                  1000.0 / frame_ms, of, totals.size(),
+                  *std::min_element(totals.begin(), totals.end()),
+                  *std::max_element(totals.begin(), totals.end()));
+    result.stages.push_back({"frame", frame_ms, note});
+}
+
+}  // namespace lucent::samples
