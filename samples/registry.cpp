@@ -7,6 +7,7 @@
 
 #include "samples/direct/direct.h"
 #include "samples/igi/igi.h"
+#include "samples/pathtracer/pathtracer.h"
 #include "samples/sample.h"
 #include "samples/settings_error.h"
 #include "samples/whitted/whitted.h"
@@ -79,7 +80,7 @@ T parse_option(const RenderSettings& s, const SampleInfo& info, const std::strin
 
 const std::vector<SampleInfo>& all_samples() {
     static const std::vector<SampleInfo> samples = {whitted_sample_info(), direct_sample_info(),
-                                                    igi_sample_info()};
+                                                    igi_sample_info(), pathtracer_sample_info()};
     return samples;
 }
 

@@ -28,7 +28,7 @@ struct RenderSettings {
     bool verbose = false;
     int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel
     unsigned repeat = 1;   // --repeat: launches timed after the first
-    unsigned spp = 0;      // --spp: samples per pixel of progressive samples; 0 = the sample's default
+    unsigned spp = 0;      // --spp: progressive samples' samples per pixel; 0 = their default
     /// Also return the sample's intermediate images (RenderResult::layers), for tests.
     bool keep_layers = false;
     /// Called as launches complete (done, total), e.g. for a progress bar; may be empty.

@@ -117,7 +117,10 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
         for (size_t i = 0; i < list.size(); ++i) {
             const std::string at = "/materials/" + std::to_string(i);
             const json& m = list[i];
-            r.only(m, {"name", "diffuse", "specular", "shininess", "emission", "texture"}, at);
+            r.only(m,
+                   {"name", "diffuse", "specular", "shininess", "emission", "texture", "type",
+                    "roughness", "ior"},
+                   at);
             Material material;
             const json& name = r.member(m, "name", at);
             if (!name.is_string()) r.fail(at + "/name", "expected a string");
@@ -135,6 +138,30 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
                 if (!fs::exists(texture))
                     r.fail(at + "/texture", "texture '" + texture.string() + "' not found");
                 material.diffuse_texture = texture.string();
+            }
+            if (m.contains("type")) {
+                const json& type = m["type"];
+                if (type == "lambert")
+                    material.kind = MaterialKind::kLambert;
+                else if (type == "metal")
+                    material.kind = MaterialKind::kMetal;
+                else if (type == "dielectric")
+                    material.kind = MaterialKind::kDielectric;
+                else if (type == "coated")
+                    material.kind = MaterialKind::kCoated;
+                else
+                    r.fail(at + "/type",
+                           "expected \"lambert\", \"metal\", \"dielectric\" or \"coated\"");
+            }
+            if (m.contains("roughness")) {
+                material.roughness = r.number(m["roughness"], at + "/roughness");
+                if (!(material.roughness >= 0 && material.roughness <= 1))
+                    r.fail(at + "/roughness", "expected a roughness in [0, 1]");
+            }
+            if (m.contains("ior")) {
+                material.ior = r.number(m["ior"], at + "/ior");
+                if (!(material.ior > 1 && material.ior <= 4))
+                    r.fail(at + "/ior", "expected an index of refraction in (1, 4]");
             }
             material_ids[material.name] = unsigned(scene.materials.size());
             scene.materials.push_back(material);

@@ -14,7 +14,7 @@ size_t Scene::triangle_count() const {
 }
 
 std::vector<std::string> builtin_scene_names() {
-    return {"cornell", "cornell-point"};
+    return {"cornell", "cornell-point", "cornell-materials"};
 }
 
 namespace {
@@ -40,6 +40,7 @@ Scene single_mesh_scene(Mesh mesh) {
 Scene load_scene(const std::string& name_or_path) {
     if (name_or_path == "cornell") return cornell_box(/*area_light=*/true);
     if (name_or_path == "cornell-point") return cornell_box(/*area_light=*/false);
+    if (name_or_path == "cornell-materials") return cornell_materials_box();
     std::string ext = std::filesystem::path(name_or_path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });

@@ -155,6 +155,49 @@ TEST_F(SceneFiles, JsonErrorsNameTheLocation) {
         << error_of(missing_obj);
 }
 
+TEST_F(SceneFiles, JsonMaterialKindsRoughnessAndIor) {
+    auto good = write("kinds.json", R"({"camera": {"eye": [0,0,1], "look": [0,0,0]},
+      "materials": [{"name": "m", "type": "metal", "specular": [1, 0.7, 0.3], "roughness": 0.2},
+                    {"name": "g", "type": "dielectric", "ior": 1.33},
+                    {"name": "c", "type": "coated", "roughness": 0.1, "ior": 1.6},
+                    {"name": "l"}],
+      "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]], "material": "m"}]})");
+    const auto scene = load_scene(good);
+    using lucent::scene::MaterialKind;
+    EXPECT_EQ(scene.materials[0].kind, MaterialKind::kMetal);
+    EXPECT_FLOAT_EQ(scene.materials[0].roughness, 0.2f);
+    EXPECT_EQ(scene.materials[1].kind, MaterialKind::kDielectric);
+    EXPECT_FLOAT_EQ(scene.materials[1].ior, 1.33f);
+    EXPECT_EQ(scene.materials[2].kind, MaterialKind::kCoated);
+    EXPECT_FLOAT_EQ(scene.materials[2].ior, 1.6f);
+    EXPECT_EQ(scene.materials[3].kind, MaterialKind::kLambert) << "the default kind";
+
+    const std::string mesh =
+        R"("meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]]}]})";
+    const std::string head = R"({"camera": {"eye": [0,0,1], "look": [0,0,0]}, "materials": [)";
+    auto kind = write("badk.json", head + R"({"name": "x", "type": "plastic"}],)" + mesh);
+    EXPECT_NE(error_of(kind).find("badk.json: /materials/0/type: expected"), std::string::npos)
+        << error_of(kind);
+    auto rough = write("badr.json", head + R"({"name": "x", "roughness": 1.5}],)" + mesh);
+    EXPECT_NE(error_of(rough).find("/materials/0/roughness"), std::string::npos) << error_of(rough);
+    auto ior = write("badi.json", head + R"({"name": "x", "ior": "glass"}],)" + mesh);
+    EXPECT_NE(error_of(ior).find("/materials/0/ior: expected a number"), std::string::npos)
+        << error_of(ior);
+    auto low = write("badl.json", head + R"({"name": "x", "ior": 0.9}],)" + mesh);
+    EXPECT_NE(error_of(low).find("/materials/0/ior"), std::string::npos) << error_of(low);
+}
+
+TEST(CornellMaterials, BlocksAndFloorGetEveryMaterialKind) {
+    using lucent::scene::MaterialKind;
+    const auto scene = load_scene("cornell-materials");
+    const auto& room = scene.meshes[0];
+    EXPECT_EQ(scene.materials[room.materials[0]].kind, MaterialKind::kCoated) << "floor";
+    EXPECT_EQ(scene.materials[room.materials[2]].kind, MaterialKind::kLambert) << "ceiling";
+    EXPECT_EQ(scene.materials[room.materials[10]].kind, MaterialKind::kDielectric) << "short";
+    EXPECT_EQ(scene.materials[room.materials[29]].kind, MaterialKind::kMetal) << "tall";
+    EXPECT_EQ(scene.area_lights.size(), 1u);
+}
+
 TEST(SceneNames, UnknownNameListsTheBuiltInScenes) {
     try {
         load_scene("sponza-please");

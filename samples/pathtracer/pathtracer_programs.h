@@ -1,0 +1,309 @@
+// A progressive Monte Carlo path tracer in the structure of the OptiX paper's Design Garage
+// (seed CACM §6.2, Figure 8): the ray-generation program iterates over the bounces of a path
+// instead of recursing; each material's closest-hit program returns the next ray, the
+// throughput of the bounce and the light it found (emission, and next-event estimation with
+// multiple importance sampling, Veach 1997 §9.2, power heuristic) through the payload. Every
+// launch adds one sample per pixel to a float4 accumulation buffer whose w counts them.
+#pragma once
+
+#include "lucent/device.h"
+#include "samples/pathtracer/pathtracer_bsdf.h"
+
+namespace pathtracer {
+
+enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
+
+struct PointLight {
+    float3 position;
+    float3 intensity;
+};
+/// An emitting parallelogram corner + s edge1 + t edge2 (s, t in [0, 1]); it emits on the
+/// side cross(edge1, edge2) points to (scene::AreaLight).
+struct AreaLight {
+    float3 corner, edge1, edge2;
+    float3 emission;
+};
+
+/// What a bounce hands back to the ray-generation loop.
+struct PathPayload {
+    unsigned rng;     // in: the path's random state; out: advanced
+    unsigned nee;     // in: 1 to sample the lights at this vertex
+    unsigned done;    // out: 1 when the path ends here (miss, or absorbed)
+    unsigned delta;   // out: the next direction came from a delta lobe
+    float3 emitted;   // out: emitted radiance towards the ray (Le)
+    float light_pdf;  // out: solid-angle pdf of light sampling choosing that point
+    float3 direct;    // out: light arriving by next-event estimation, reflected (MIS-weighted)
+    float3 weight;    // out: f cos / pdf of the next direction
+    float pdf;        // out: solid-angle pdf of the next direction
+    float3 origin, direction;  // out: the next ray
+};
+struct ShadowPayload {
+    float visible;
+};
+
+struct HitAttributes {
+    float3 geometric_normal;  // object space, not normalised; faces outwards by winding
+};
+
+/// PCG-RXS-M-XS 32 (O'Neill 2014) as a stream: advances the state, returns [0, 1).
+LUCENT_HD inline float next_random(unsigned& state) {
+    state = state * 747796405u + 2891336453u;
+    unsigned word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    word = (word >> 22u) ^ word;
+    return float(word >> 8) * (1.0f / 16777216.0f);
+}
+
+/// The first state of the path of pixel `pixel` in frame `frame`: TEA as a hash (Zafar et
+/// al. 2010), the same on both backends; `seed` selects an independent set of streams.
+LUCENT_HD inline unsigned path_seed(unsigned pixel, unsigned frame, unsigned seed) {
+    const uint4 k = lucent::zafar_tea_key();
+    return lucent::tea<16>(make_uint2(pixel, frame), make_uint4(k.x, k.y ^ seed, k.z, k.w)).x;
+}
+
+/// Veach's power heuristic with beta = 2 for one sample of each strategy.
+LUCENT_HD inline float power_heuristic(float pdf_a, float pdf_b) {
+    const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/// Solid-angle pdf with which next_event would choose the point at distance t along the unit
+/// direction from origin: one light of n uniformly, then a uniform point on its area.
+LUCENT_HD inline float area_light_pdf(lucent::BufferView<AreaLight> lights, float3 origin,
+                                      float3 direction, float t) {
+    float pdf = 0.0f;
+    const unsigned n = lights.count();
+    for (unsigned l = 0; l < n; ++l) {
+        const AreaLight light = lights[l];
+        const float3 normal = cross(light.edge1, light.edge2);
+        const float denom = dot(direction, normal);
+        if (denom >= 0.0f) continue;  // its back, which does not emit
+        const float tl = dot(light.corner - origin, normal) / denom;
+        if (fabsf(tl - t) > 1e-3f * t + 1e-6f) continue;  // the hit is not on this light
+        const float3 w = origin + tl * direction - light.corner;
+        const float area2 = dot(normal, normal);
+        const float s = dot(cross(w, light.edge2), normal) / area2;
+        const float v = dot(cross(light.edge1, w), normal) / area2;
+        if (s < 0.0f || s > 1.0f || v < 0.0f || v > 1.0f) continue;
+        const float area = sqrtf(area2), cos_light = fabsf(denom) / area;
+        pdf += tl * tl / (cos_light * area * float(n));
+    }
+    return pdf;
+}
+
+struct CameraRecord {
+    float3 eye, U, V, W;                // W: to the image centre; U, V: half its extent
+    lucent::BufferView<float4> accum;   // running sums; w counts the samples (the frame)
+    lucent::BufferView<float4> output;  // the average, exposed and tone mapped
+    lucent::Handle top_object;
+    unsigned max_depth;  // path segments from the eye
+    unsigned rr_depth;   // bounces before Russian roulette starts
+    unsigned nee;        // 0: BSDF sampling only
+    unsigned seed;
+    float exposure;
+    unsigned reinhard;  // 1: L / (1 + L) per channel after the exposure
+};
+LUCENT_RECORD(CameraRecord, eye, U, V, W, accum, output, top_object, max_depth, rr_depth, nee, seed,
+              exposure, reinhard)
+
+struct SurfaceRecord {
+    float3 Kd, Ks, Ke;
+    float alpha, ior;
+    lucent::BufferView<AreaLight> area_lights;
+    lucent::BufferView<PointLight> point_lights;
+    float scene_epsilon;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, alpha, ior, area_lights, point_lights, scene_epsilon,
+              top_object)
+
+struct MissRecord {
+    float3 environment;  // uniform radiance from every direction
+};
+LUCENT_RECORD(MissRecord, environment)
+
+struct MeshRecord {
+    lucent::BufferView<float3> positions;
+    lucent::BufferView<uint3> triangles;
+};
+LUCENT_RECORD(MeshRecord, positions, triangles)
+
+LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 direction,
+                                 float distance) {
+    ShadowPayload s{1.0f};
+    lucent::trace(
+        rec.top_object,
+        lucent::make_ray(from, direction, kShadowRay, 0.0f, distance - 2.0f * rec.scene_epsilon),
+        s);
+    return s.visible > 0.0f;
+}
+
+/// Next-event estimation at p: one point on one area light chosen uniformly, weighted by the
+/// power heuristic against BSDF sampling; every point light (delta: no MIS).
+LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, const Frame& frame,
+                                   float3 wo, float3 p, unsigned& rng) {
+    float3 sum = make_float3(0.0f);
+    const unsigned n = rec.area_lights.count();
+    if (n > 0) {
+        unsigned l = unsigned(next_random(rng) * float(n));
+        if (l >= n) l = n - 1;
+        const float u = next_random(rng), v = next_random(rng);
+        const AreaLight light = rec.area_lights[l];
+        const float3 q = light.corner + u * light.edge1 + v * light.edge2;
+        const float3 normal = cross(light.edge1, light.edge2);
+        const float area = length(normal);
+        const float3 to = q - p;
+        const float d2 = dot(to, to), d = sqrtf(d2);
+        const float3 wi = to / d;
+        const float cos_light = -dot(normal, wi) / area;  // > 0 on its emitting side
+        const float3 wi_local = to_local(frame, wi);
+        if (cos_light > 0.0f && wi_local.z > 0.0f) {
+            const float pdf_light = d2 / (cos_light * area * float(n));
+            const float3 f = bsdf_eval(bsdf, wo, wi_local);
+            if (max_component(f) > 0.0f && unoccluded(rec, p, wi, d)) {
+                const float w = power_heuristic(pdf_light, bsdf_pdf(bsdf, wo, wi_local));
+                sum += f * light.emission * (wi_local.z * w / pdf_light);
+            }
+        }
+    }
+    for (unsigned l = 0; l < rec.point_lights.count(); ++l) {
+        const PointLight light = rec.point_lights[l];
+        const float3 to = light.position - p;
+        const float d2 = dot(to, to), d = sqrtf(d2);
+        const float3 wi = to / d, wi_local = to_local(frame, wi);
+        if (wi_local.z <= 0.0f) continue;
+        const float3 f = bsdf_eval(bsdf, wo, wi_local);
+        if (max_component(f) > 0.0f && unoccluded(rec, p, wi, d))
+            sum += f * light.intensity * (wi_local.z / d2);
+    }
+    return sum;
+}
+
+/// The closest hit every material shares (CACM §6.2: a generic light loop; the BSDF of
+/// `Kind` samples and evaluates): emission, next-event estimation, the next ray.
+template <unsigned Kind>
+LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const HitAttributes& attr) {
+    const lucent::Ray& ray = lucent::current_ray();
+    const float t = lucent::t_hit();
+    const float3 x = ray.origin + t * ray.direction;
+    const float3 ng = normalize(lucent::object_to_world_normal(attr.geometric_normal));
+    const bool outside = dot(ng, ray.direction) < 0.0f;
+    const float3 n = outside ? ng : -ng;
+    // Surfaces emit on the side their winding makes the front, as area lights do.
+    prd.emitted = outside ? rec.Ke : make_float3(0.0f);
+    prd.light_pdf = outside && max_component(rec.Ke) > 0.0f
+                        ? area_light_pdf(rec.area_lights, ray.origin, ray.direction, t)
+                        : 0.0f;
+
+    const Bsdf bsdf{Kind, rec.Kd, rec.Ks, rec.alpha,
+                    Kind == kDielectric && !outside ? 1.0f / rec.ior : rec.ior};
+    const Frame frame = make_frame(n);
+    const float3 wo = to_local(frame, -ray.direction);
+    const float3 above = x + rec.scene_epsilon * n;
+    prd.direct = make_float3(0.0f);
+    if (prd.nee && !is_delta(bsdf)) prd.direct = next_event(rec, bsdf, frame, wo, above, prd.rng);
+
+    const float u1 = next_random(prd.rng), u2 = next_random(prd.rng), u3 = next_random(prd.rng);
+    const BsdfSample s = bsdf_sample(bsdf, wo, u1, u2, u3);
+    if (s.pdf <= 0.0f || max_component(s.weight) <= 0.0f) {
+        prd.done = 1;
+        return;
+    }
+    prd.weight = s.weight;
+    prd.pdf = s.pdf;
+    prd.delta = s.delta ? 1u : 0u;
+    prd.direction = normalize(to_world(frame, s.wi));
+    prd.origin = s.wi.z > 0.0f ? above : x - rec.scene_epsilon * n;
+}
+
+}  // namespace pathtracer
+
+// ---- the path loop (CACM Figure 8) -----------------------------------------------------------
+LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
+    using namespace pathtracer;
+    const uint3 i = lucent::launch_index(), n = lucent::launch_size();
+    const uint2 pixel = make_uint2(i.x, i.y);
+    float4 accum = rec.accum[pixel];
+    unsigned rng = path_seed(i.y * n.x + i.x, unsigned(accum.w), rec.seed);
+    // A uniformly jittered position in the pixel: the box filter's antialiasing.
+    const float sx = 2.0f * (float(i.x) + next_random(rng)) / float(n.x) - 1.0f;
+    const float sy = 1.0f - 2.0f * (float(i.y) + next_random(rng)) / float(n.y);
+    float3 origin = rec.eye, direction = normalize(rec.W + sx * rec.U + sy * rec.V);
+    float3 radiance = make_float3(0.0f), throughput = make_float3(1.0f);
+    float previous_pdf = 0.0f;
+    bool previous_delta = true;  // the camera's ray is found by no other strategy
+    for (unsigned depth = 0; depth < rec.max_depth; ++depth) {
+        PathPayload prd;
+        prd.rng = rng;
+        prd.nee = rec.nee && depth + 1 < rec.max_depth ? 1u : 0u;
+        prd.done = 0;
+        prd.delta = 0;
+        lucent::trace(rec.top_object, lucent::make_ray(origin, direction, kRadianceRay, 0.0f), prd);
+        rng = prd.rng;
+        if (max_component(prd.emitted) > 0.0f) {
+            // An emitter found by BSDF sampling: MIS against light sampling from the last
+            // vertex, which was tried there unless that bounce was a delta lobe.
+            const float w =
+                rec.nee && !previous_delta ? power_heuristic(previous_pdf, prd.light_pdf) : 1.0f;
+            radiance += throughput * prd.emitted * w;
+        }
+        if (prd.done) break;
+        radiance += throughput * prd.direct;
+        throughput *= prd.weight;
+        if (depth + 1 >= rec.rr_depth) {
+            // Russian roulette: continue with probability q, divide by it (unbiased).
+            const float q = lc_min(max_component(throughput), 0.95f);
+            if (next_random(rng) >= q) break;
+            throughput = throughput / q;
+        }
+        previous_pdf = prd.pdf;
+        previous_delta = prd.delta != 0;
+        origin = prd.origin;
+        direction = prd.direction;
+    }
+    // A NaN or infinity would poison the pixel for every later frame: drop that sample.
+    const float sum = radiance.x + radiance.y + radiance.z;
+    if (!(sum == sum) || sum > 3.0e38f) radiance = make_float3(0.0f);
+    accum = make_float4(accum.x + radiance.x, accum.y + radiance.y, accum.z + radiance.z,
+                        accum.w + 1.0f);
+    rec.accum[pixel] = accum;
+    float3 mean = make_float3(accum.x, accum.y, accum.z) * (rec.exposure / accum.w);
+    if (rec.reinhard)
+        mean = make_float3(mean.x / (1.0f + mean.x), mean.y / (1.0f + mean.y),
+                           mean.z / (1.0f + mean.z));
+    rec.output[pixel] = make_float4(mean, 1.0f);
+}
+
+LUCENT_MISS(pt_miss, pathtracer::MissRecord, pathtracer::PathPayload) {
+    prd.emitted = rec.environment;
+    prd.light_pdf = 0.0f;  // the environment is never light-sampled
+    prd.done = 1;
+}
+
+LUCENT_CLOSEST_HIT(pt_lambert, pathtracer::SurfaceRecord, pathtracer::PathPayload,
+                   pathtracer::HitAttributes) {
+    pathtracer::shade<pathtracer::kLambert>(rec, prd, attr);
+}
+LUCENT_CLOSEST_HIT(pt_metal, pathtracer::SurfaceRecord, pathtracer::PathPayload,
+                   pathtracer::HitAttributes) {
+    pathtracer::shade<pathtracer::kMetal>(rec, prd, attr);
+}
+LUCENT_CLOSEST_HIT(pt_dielectric, pathtracer::SurfaceRecord, pathtracer::PathPayload,
+                   pathtracer::HitAttributes) {
+    pathtracer::shade<pathtracer::kDielectric>(rec, prd, attr);
+}
+LUCENT_CLOSEST_HIT(pt_coated, pathtracer::SurfaceRecord, pathtracer::PathPayload,
+                   pathtracer::HitAttributes) {
+    pathtracer::shade<pathtracer::kCoated>(rec, prd, attr);
+}
+
+LUCENT_ANY_HIT(pt_shadow_blocked, lucent::NoRecord, pathtracer::ShadowPayload,
+               pathtracer::HitAttributes) {
+    prd.visible = 0.0f;
+    lucent::terminate_ray();
+}
+
+LUCENT_ATTRIBUTE(pt_attributes, pathtracer::MeshRecord, pathtracer::HitAttributes) {
+    const uint3 t = rec.triangles[prim];
+    attr.geometric_normal =
+        cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
+}
