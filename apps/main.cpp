@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "bench_command.h"
+#include "bench_igi_command.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "noise_command.h"
@@ -40,12 +41,14 @@ int main(int argc, char** argv) {
     BenchRaysArgs rays_args;
     BenchBuildArgs build_args;
     BenchTeaArgs bench_tea_args;
+    BenchIgiArgs bench_igi_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
         BenchCommands bench = add_bench_commands(app, rays_args, build_args, bench_tea_args);
+        CLI::App* bench_igi = add_bench_igi_command(bench.bench, bench_igi_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         try {
@@ -69,6 +72,10 @@ int main(int argc, char** argv) {
         if (bench.tea->parsed()) {
             where = "lucent bench tea";
             return run_bench_tea_command(bench_tea_args);
+        }
+        if (bench_igi->parsed()) {
+            where = "lucent bench igi";
+            return run_bench_igi_command(bench_igi_args);
         }
         if (tea->parsed()) {
             where = "lucent tea";

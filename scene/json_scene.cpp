@@ -2,6 +2,7 @@
 // inline triangles) and point or area lights. Syntax errors name file:line:column; other
 // errors name the file and the JSON location ("/lights/1/position") and what is expected.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -60,8 +61,23 @@ class JsonReader {
         }
     }
 
+    /// A file named by the scene: relative to the JSON file, else (for a relative name not
+    /// found there) in the directories of $LUCENT_SCENE_PATH, ':'-separated, so that a scene
+    /// description can name a large model kept elsewhere (e.g. ../shared/scenes).
     fs::path resolve(const std::string& file) const {
-        return fs::path(m_path).parent_path() / file;
+        const fs::path beside = fs::path(m_path).parent_path() / file;
+        std::error_code ec;
+        if (fs::path(file).is_absolute() || fs::exists(beside, ec)) return beside;
+        if (const char* search = std::getenv("LUCENT_SCENE_PATH")) {
+            std::string dirs = search;
+            for (size_t start = 0; start <= dirs.size();) {
+                const size_t end = std::min(dirs.find(':', start), dirs.size());
+                const fs::path candidate = fs::path(dirs.substr(start, end - start)) / file;
+                if (end > start && fs::exists(candidate, ec)) return candidate;
+                start = end + 1;
+            }
+        }
+        return beside;
     }
 
   private:

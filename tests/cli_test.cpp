@@ -195,3 +195,26 @@ TEST_F(CliTest, RenderWritesAPfmByExtension) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CliBenchIgi, RunsEveryConfigurationForEveryVplCount) {
+    CliRun run = run_cli("bench igi --size 32x24 --frames 1 --vpls 4,8 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    for (const char* c : {"canonical", "+imperfect visibility", "+downsampling", "+interleaving"})
+        for (const char* v : {"\"vpls\": 4", "\"vpls\": 8"})
+            EXPECT_NE(run.output.find("\"configuration\": \"" + std::string(c) + "\", " + v),
+                      std::string::npos)
+                << c << " " << v << "\n"
+                << run.output;
+    EXPECT_NE(run.output.find("\"discontinuity filter\""), std::string::npos) << run.output;
+}
+
+TEST(CliBenchIgi, BadVplCountNamesTheFlagAndRange) {
+    CliRun run = run_cli("bench igi --vpls 30,0");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--vpls"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("65536"), std::string::npos) << run.output;
+}
+
+}  // namespace

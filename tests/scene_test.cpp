@@ -36,6 +36,21 @@ class SceneFiles : public ::testing::Test {
     fs::path dir;
 };
 
+TEST_F(SceneFiles, JsonFindsMeshFilesOnTheScenePath) {
+    // A relative mesh file not beside the JSON file is looked for in $LUCENT_SCENE_PATH.
+    fs::create_directories(dir / "models");
+    std::ofstream(dir / "models" / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    auto path = write("s.json", R"({"camera": {"eye": [0,0,3], "look": [0,0,0]},
+        "meshes": [{"file": "tri.obj"}]})");
+    ::unsetenv("LUCENT_SCENE_PATH");
+    EXPECT_NE(error_of(path).find("tri.obj"), std::string::npos) << "not found without the path";
+    const std::string search = "/nonexistent:" + (dir / "models").string();
+    ::setenv("LUCENT_SCENE_PATH", search.c_str(), 1);
+    EXPECT_EQ(error_of(path), "");
+    EXPECT_EQ(load_scene(path).triangle_count(), 1u);
+    ::unsetenv("LUCENT_SCENE_PATH");
+}
+
 TEST(CornellBox, HasTheRoomTheBlocksAndTheCeilingLight) {
     auto scene = load_scene("cornell");
     EXPECT_EQ(scene.triangle_count(), 30u + 2u);  // 5 walls, 2 blocks of 5 faces, the light

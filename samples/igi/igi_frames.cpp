@@ -115,14 +115,17 @@ void render_igi_frames(Context& ctx, const IgiConfig& config, const RenderSettin
     add_exceptions(result.report, last);
     const double frame_ms = median(totals);
     const char* of = totals.size() > 1 ? "median" : "one frame";
+    // Shares of the sum of the stage medians, so that they add up to 100%.
+    std::array<double, kStages> stage_ms{};
+    double stage_sum = 0;
+    for (size_t s = 0; s < kStages; ++s) stage_sum += stage_ms[s] = median(times[s]);
     for (size_t s = 0; s < kStages; ++s) {
         if (s == 3 && config.interleave == 1) continue;
         if (s == 4 && config.downsample == 1) continue;
-        const double stage_ms = median(times[s]);
         char note[120];
-        std::snprintf(note, sizeof note, "%.1f%% of the frame (%s)", 100.0 * stage_ms / frame_ms,
-                      of);
-        result.stages.push_back({kIgiStageNames[s], stage_ms, note});
+        std::snprintf(note, sizeof note, "%.1f%% of the frame (%s)",
+                      100.0 * stage_ms[s] / stage_sum, of);
+        result.stages.push_back({kIgiStageNames[s], stage_ms[s], note});
     }
     char note[160];
     std::snprintf(note, sizeof note, "%.1f frames/s (%s of %zu; min %.3f, max %.3f)",
