@@ -8,6 +8,7 @@
 #include "samples/direct/direct.h"
 #include "samples/igi/igi.h"
 #include "samples/pathtracer/pathtracer.h"
+#include "samples/radiosity/radiosity.h"
 #include "samples/sample.h"
 #include "samples/settings_error.h"
 #include "samples/whitted/whitted.h"
@@ -79,8 +80,9 @@ T parse_option(const RenderSettings& s, const SampleInfo& info, const std::strin
 }  // namespace
 
 const std::vector<SampleInfo>& all_samples() {
-    static const std::vector<SampleInfo> samples = {whitted_sample_info(), direct_sample_info(),
-                                                    igi_sample_info(), pathtracer_sample_info()};
+    static const std::vector<SampleInfo> samples = {
+        whitted_sample_info(), direct_sample_info(),     igi_sample_info(),
+        radiosity_sample_info(), pathtracer_sample_info()};
     return samples;
 }
 

@@ -1,5 +1,7 @@
 #include "samples/scene_setup.h"
 
+#include "scene/texture_image.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -40,6 +42,20 @@ scene::Image image_from_output(const Buffer& output) {
     image.pixels.resize(size_t(image.width) * image.height);
     for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = make_float3(pixels[i]);
     return image;
+}
+
+std::shared_ptr<TextureSampler> DiffuseTextures::operator()(const std::string& file) {
+    auto& sampler = m_samplers[file];
+    if (sampler) return sampler;
+    const scene::TextureImage image =
+        file.empty() ? scene::TextureImage{1, 1, {make_float4(1, 1, 1, 1)}} : scene::load_texture(file);
+    auto texels = m_ctx.create_buffer<float4>(BufferType::kInput, image.width, image.height);
+    texels->upload(image.texels);
+    sampler = m_ctx.create_texture_sampler();
+    sampler->set_buffer(texels);
+    sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kRepeat);
+    sampler->set_filter(FilterMode::kLinear);
+    return sampler;
 }
 
 }  // namespace lucent::samples

@@ -2,7 +2,9 @@
 // buffers, the pinhole camera frame, and the output buffer as an image.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <string>
 
 #include "lucent/context.h"
 #include "scene/image_io.h"
@@ -28,5 +30,17 @@ PinholeFrame pinhole_frame(const scene::Camera& camera, float aspect);
 
 /// The float4 output buffer of a launch as a linear RGB image.
 scene::Image image_from_output(const Buffer& output);
+
+/// Diffuse maps as texture samplers (bilinear, repeating), each file loaded once; a
+/// material without one ("") gets a 1x1 white texel, so programs always sample a texture.
+class DiffuseTextures {
+  public:
+    explicit DiffuseTextures(Context& ctx) : m_ctx(ctx) {}
+    std::shared_ptr<TextureSampler> operator()(const std::string& file);
+
+  private:
+    Context& m_ctx;
+    std::map<std::string, std::shared_ptr<TextureSampler>> m_samplers;
+};
 
 }  // namespace lucent::samples

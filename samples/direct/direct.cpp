@@ -11,7 +11,6 @@
 #include "samples/scene_setup.h"
 #include "samples/settings_error.h"
 #include "scene/scene.h"
-#include "scene/texture_image.h"
 
 namespace lucent::samples {
 
@@ -54,25 +53,7 @@ RenderResult render_direct(const RenderSettings& settings) {
     ctx["area_samples"] = unsigned(area_samples);
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 
-    // Diffuse maps, each file loaded once; materials without one get a white texel.
-    std::map<std::string, std::shared_ptr<TextureSampler>> textures;
-    auto texture_for = [&](const std::string& file) {
-        auto& sampler = textures[file];
-        if (sampler) return sampler;
-        scene::TextureImage image;
-        if (file.empty())
-            image = {1, 1, {make_float4(1, 1, 1, 1)}};
-        else
-            image = scene::load_texture(file);
-        auto texels = ctx.create_buffer<float4>(BufferType::kInput, image.width, image.height);
-        texels->upload(image.texels);
-        sampler = ctx.create_texture_sampler();
-        sampler->set_buffer(texels);
-        sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kRepeat);
-        sampler->set_filter(FilterMode::kLinear);
-        return sampler;
-    };
-
+    DiffuseTextures texture_for(ctx);
     auto lambert = ctx.create_program(LUCENT_PROGRAM(direct_lambert));
     auto blocked = ctx.create_program(LUCENT_PROGRAM(direct_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;

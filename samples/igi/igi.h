@@ -1,4 +1,4 @@
-// The Instant Global Illumination sample (Marques and Santos, seed §4), canonical form.
+// The Instant Global Illumination sample (Marques and Santos, seed §4) with its accelerations.
 #pragma once
 
 #include "samples/sample.h"

@@ -1,0 +1,297 @@
+// Instant radiosity with deferred shading (the seed blog, "Instant Radiosity using OptiX and
+// Deferred Rendering"): photons leave the area lights from a jittered sqrt(N) x sqrt(N) grid of
+// cosine-distributed directions and bounce (with optional Russian roulette), leaving a virtual
+// point light (VPL) at each hit; the host may merge the VPLs into a voxel grid; then a G-buffer
+// pass and a shading pass that adds direct light and every VPL as a point light.
+#pragma once
+
+#include "lucent/device.h"
+
+namespace radiosity {
+
+enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kPhotonRay = 2 };
+enum : unsigned { kPhotonEntry = 0, kGBufferEntry = 1, kShadeEntry = 2, kEntryCount = 3 };
+
+struct AreaLight {
+    float3 corner, edge1, edge2;  // emits towards cross(edge1, edge2)
+    float3 emission;              // radiance
+};
+
+/// A virtual point light. Unmerged: a diffuse emitter, intensity power / pi x cos around
+/// `normal`. Merged (VplGrid): at a cell's centre with the power-weighted mean normal, or
+/// isotropic (normal zero, intensity power / 4 pi) when the cell's normals cancel out.
+struct Vpl {
+    float3 position;
+    float3 normal;
+    float3 power;  // flux leaving it
+};
+
+/// Radiant intensity of a VPL towards the unit direction w (from the VPL).
+LUCENT_HD inline float3 vpl_intensity(const Vpl& vpl, float3 w) {
+    if (dot(vpl.normal, vpl.normal) == 0.0f) return vpl.power * (0.25f / 3.14159265f);
+    return vpl.power * (lc_max(0.0f, dot(vpl.normal, w)) / 3.14159265f);
+}
+
+struct HitAttributes {
+    float3 geometric_normal;  // object space, not normalised
+    float2 uv;
+};
+
+struct SurfacePayload {  // radiance and photon rays: what was hit
+    float3 position, normal, albedo, emission;
+    float distance;  // < 0: missed
+};
+struct ShadowPayload {
+    float visible;
+};
+
+/// Uniform floats in [0, 1) from TEA (Sebald's generator) keyed by a stream and an index,
+/// so the CPU and GPU draw the same numbers.
+LUCENT_HD inline float2 random2(unsigned stream, unsigned index) {
+    const uint2 r = lucent::tea<4>(make_uint2(stream, index), lucent::zafar_tea_key());
+    return make_float2(lucent::tea_unit_float(r.x), lucent::tea_unit_float(r.y));
+}
+
+LUCENT_HD inline float3 cosine_direction(float3 n, float u1, float u2) {
+    const float r = sqrtf(u1), phi = 6.2831853f * u2;
+    const float3 t =
+        normalize(cross(n, fabsf(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
+    const float3 b = cross(n, t);
+    return normalize(t * (r * cosf(phi)) + b * (r * sinf(phi)) +
+                     n * sqrtf(lc_max(0.0f, 1.0f - u1)));
+}
+
+struct MeshRecord {
+    lucent::BufferView<float3> positions;
+    lucent::BufferView<uint3> triangles;
+    lucent::BufferView<float2> uvs;  // per vertex; empty when the mesh has none
+};
+LUCENT_RECORD(MeshRecord, positions, triangles, uvs)
+
+struct SurfaceRecord {
+    float3 Kd, Ke;
+    lucent::TextureView diffuse_map;  // multiplies Kd; a white texel when there is none
+};
+LUCENT_RECORD(SurfaceRecord, Kd, Ke, diffuse_map)
+
+struct PhotonRecord {
+    lucent::BufferView<AreaLight> area_lights;
+    lucent::BufferView<Vpl> vpls;  // photons x bounces slots; unused ones have zero power
+    unsigned bounces;
+    unsigned roulette;  // 1: Russian roulette after the first bounce
+    float vpl_offset;   // how far back along the ray a VPL sits from its hit
+    float scene_epsilon;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(PhotonRecord, area_lights, vpls, bounces, roulette, vpl_offset, scene_epsilon,
+              top_object)
+
+struct GBufferRecord {
+    float3 eye, U, V, W;
+    lucent::BufferView<float4> gbuffer_position;  // xyz, w = distance (< 0: background)
+    lucent::BufferView<float4> gbuffer_normal;
+    lucent::BufferView<float4> gbuffer_albedo;
+    lucent::BufferView<float4> gbuffer_emission;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(GBufferRecord, eye, U, V, W, gbuffer_position, gbuffer_normal, gbuffer_albedo,
+              gbuffer_emission, top_object)
+
+struct ShadeRecord {
+    float3 eye;
+    lucent::BufferView<float4> gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission;
+    lucent::BufferView<float4> output;
+    lucent::BufferView<AreaLight> area_lights;
+    unsigned area_samples;  // per light and pixel: a stratified side x side grid
+    lucent::BufferView<Vpl> vpls;
+    unsigned gi;           // 0: direct light only
+    unsigned vpl_shadows;  // 1: a shadow ray per VPL (the blog had none)
+    unsigned show_vpls;    // 1: draw each VPL as a dot
+    float clamp_distance;  // VPL distances below it count as it (bounds the 1/d^2 spike)
+    float dot_radius;      // show_vpls: angular radius of a dot, radians
+    float scene_epsilon;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(ShadeRecord, eye, gbuffer_position, gbuffer_normal, gbuffer_albedo,
+              gbuffer_emission, output, area_lights, area_samples, vpls, gi, vpl_shadows,
+              show_vpls, clamp_distance, dot_radius, scene_epsilon, top_object)
+
+LUCENT_HD inline bool visible(const ShadeRecord& rec, float3 from, float3 to) {
+    ShadowPayload s{1.0f};
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f), s);
+    return s.visible > 0.0f;
+}
+
+LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+
+/// Irradiance at x (normal n) from the area lights: side x side stratified samples each,
+/// jittered per pixel, with shadow rays.
+LUCENT_HD inline float3 direct_irradiance(const ShadeRecord& rec, float3 x, float3 n,
+                                          unsigned pixel) {
+    float3 sum = make_float3(0.0f);
+    const unsigned side = rec.area_samples > 1 ? unsigned(sqrtf(float(rec.area_samples))) : 1u;
+    for (unsigned l = 0; l < rec.area_lights.count(); ++l) {
+        const AreaLight light = rec.area_lights[l];
+        const float3 ln = cross(light.edge1, light.edge2);
+        const float area = length(ln);
+        const float3 light_normal = ln / area;
+        for (unsigned s = 0; s < side * side; ++s) {
+            const float2 r = random2(pixel, s * 64u + l);
+            const float u = (float(s % side) + r.x) / float(side);
+            const float v = (float(s / side) + r.y) / float(side);
+            const float3 q = light.corner + u * light.edge1 + v * light.edge2;
+            const float3 to = q - x;
+            const float d2 = dot(to, to), d = sqrtf(d2);
+            const float cos_x = dot(n, to) / d, cos_light = -dot(light_normal, to) / d;
+            if (cos_x > 0.0f && cos_light > 0.0f && visible(rec, x, q))
+                sum += light.emission * (cos_x * cos_light / d2 * area / float(side * side));
+        }
+    }
+    return sum;
+}
+
+/// Irradiance at x (normal n) from every VPL as a point light, 1/d^2 bounded by the clamp.
+LUCENT_HD inline float3 vpl_irradiance(const ShadeRecord& rec, float3 x, float3 n) {
+    float3 sum = make_float3(0.0f);
+    const float clamp2 = rec.clamp_distance * rec.clamp_distance;
+    for (unsigned k = 0; k < rec.vpls.count(); ++k) {
+        const Vpl vpl = rec.vpls[k];
+        if (max_component(vpl.power) <= 0.0f) continue;
+        const float3 to = vpl.position - x;
+        const float d2 = dot(to, to), d = sqrtf(d2);
+        const float cos_x = dot(n, to) / d;
+        if (cos_x <= 0.0f) continue;
+        const float3 intensity = vpl_intensity(vpl, -to / d);
+        if (max_component(intensity) <= 0.0f) continue;
+        if (rec.vpl_shadows && !visible(rec, x, vpl.position)) continue;
+        sum += intensity * (cos_x / lc_max(d2, clamp2));
+    }
+    return sum;
+}
+
+}  // namespace radiosity
+
+// ---- photons from the area lights ----------------------------------------------------------
+LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
+    const uint3 i = lucent::launch_index(), n = lucent::launch_size();
+    const unsigned photon = (i.z * n.y + i.y) * n.x + i.x;
+    for (unsigned b = 0; b < rec.bounces; ++b) rec.vpls[photon * rec.bounces + b] = radiosity::Vpl{};
+    const radiosity::AreaLight light = rec.area_lights[i.z];
+    const float3 ln = cross(light.edge1, light.edge2);
+    const float area = length(ln);
+    const float3 light_normal = ln / area;
+    // A uniform point on the light; the direction from the jittered grid cell (x, y) of the
+    // cosine-distributed hemisphere, as the blog's generateHemisphereLightPhoton.
+    const float2 at = radiosity::random2(photon, 0x51u);
+    const float2 jitter = radiosity::random2(photon, 0x52u);
+    float3 origin = light.corner + at.x * light.edge1 + at.y * light.edge2;
+    float3 direction = radiosity::cosine_direction(
+        light_normal, (float(i.x) + jitter.x) / float(n.x), (float(i.y) + jitter.y) / float(n.y));
+    // The light's flux pi L A, shared equally by its n.x * n.y photons.
+    float3 flux = light.emission * (3.14159265f * area / float(n.x * n.y));
+    for (unsigned b = 0; b < rec.bounces; ++b) {
+        radiosity::SurfacePayload hit{};
+        hit.distance = -1.0f;
+        lucent::trace(rec.top_object,
+                      lucent::make_ray(origin, direction, radiosity::kPhotonRay, rec.scene_epsilon),
+                      hit);
+        if (hit.distance < 0.0f || max_component(hit.albedo) <= 0.0f) break;
+        // The VPL: a little back along the ray, so it lies in front of its surface.
+        const float3 power = flux * hit.albedo;
+        const float back = lc_min(rec.vpl_offset, 0.5f * hit.distance);
+        rec.vpls[photon * rec.bounces + b] =
+            radiosity::Vpl{hit.position - back * direction, hit.normal, power};
+        if (b + 1 == rec.bounces) break;
+        flux = power;  // cosine sampling of the Lambertian bounce cancels cos / pi
+        const float2 r = radiosity::random2(photon, 0x100u + b);
+        if (rec.roulette && b > 0) {
+            // Survive with the albedo's largest component; the survivors carry the rest.
+            const float survive = lc_min(1.0f, max_component(hit.albedo));
+            if (radiosity::random2(photon, 0x200u + b).x >= survive) break;
+            flux = flux * (1.0f / survive);
+        }
+        origin = hit.position + rec.scene_epsilon * hit.normal;
+        direction = radiosity::cosine_direction(hit.normal, r.x, r.y);
+    }
+}
+
+// ---- the G-buffer: what each pixel sees ----------------------------------------------------
+LUCENT_RAY_GENERATION(radiosity_gbuffer, radiosity::GBufferRecord) {
+    const uint3 p = lucent::launch_index(), n = lucent::launch_size();
+    const float sx = 2.0f * (p.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (p.y + 0.5f) / n.y;
+    radiosity::SurfacePayload hit{};
+    hit.distance = -1.0f;
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
+                                   radiosity::kRadianceRay, 0.0f),
+                  hit);
+    const uint2 pixel = make_uint2(p.x, p.y);
+    rec.gbuffer_position[pixel] = make_float4(hit.position, hit.distance);
+    rec.gbuffer_normal[pixel] = make_float4(hit.normal, 0.0f);
+    rec.gbuffer_albedo[pixel] = make_float4(hit.albedo, 0.0f);
+    rec.gbuffer_emission[pixel] = make_float4(hit.emission, 0.0f);
+}
+
+// Radiance and photon rays both want the surface; the normal faces where the ray came from.
+LUCENT_CLOSEST_HIT(radiosity_surface, radiosity::SurfaceRecord, radiosity::SurfacePayload,
+                   radiosity::HitAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    prd.position = ray.origin + lucent::t_hit() * ray.direction;
+    prd.normal = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
+                             ray.direction);
+    // OBJ texture coordinates start at the bottom of the image; texel row 0 is its top.
+    const float3 texel =
+        make_float3(lucent::tex2D(rec.diffuse_map, make_float2(attr.uv.x, 1.0f - attr.uv.y)));
+    prd.albedo = rec.Kd * texel;
+    prd.emission = rec.Ke;
+    prd.distance = lucent::t_hit();
+}
+
+LUCENT_ANY_HIT(radiosity_shadow_blocked, lucent::NoRecord, radiosity::ShadowPayload,
+               radiosity::HitAttributes) {
+    prd.visible = 0.0f;
+    lucent::terminate_ray();
+}
+
+LUCENT_ATTRIBUTE(radiosity_attributes, radiosity::MeshRecord, radiosity::HitAttributes) {
+    const uint3 t = rec.triangles[prim];
+    const float3 p0 = rec.positions[t.x], p1 = rec.positions[t.y], p2 = rec.positions[t.z];
+    attr.geometric_normal = cross(p1 - p0, p2 - p0);
+    attr.uv = make_float2(0.0f, 0.0f);
+    if (rec.uvs.count() > 0) {
+        const float w = 1.0f - barycentrics.x - barycentrics.y;
+        attr.uv = w * rec.uvs[t.x] + barycentrics.x * rec.uvs[t.y] + barycentrics.y * rec.uvs[t.z];
+    }
+}
+
+// ---- deferred shading: direct light plus every VPL -----------------------------------------
+LUCENT_RAY_GENERATION(radiosity_shade, radiosity::ShadeRecord) {
+    const uint3 p = lucent::launch_index(), n = lucent::launch_size();
+    const uint2 pixel = make_uint2(p.x, p.y);
+    const float4 position = rec.gbuffer_position[pixel];
+    float3 color = make_float3(0.0f);
+    if (position.w >= 0.0f) {
+        const float3 x = radiosity::xyz(position), nx = radiosity::xyz(rec.gbuffer_normal[pixel]);
+        const float3 origin = x + rec.scene_epsilon * nx;
+        float3 irradiance = radiosity::direct_irradiance(rec, origin, nx, p.y * n.x + p.x);
+        if (rec.gi) irradiance += radiosity::vpl_irradiance(rec, origin, nx);
+        color = radiosity::xyz(rec.gbuffer_emission[pixel]) +
+                radiosity::xyz(rec.gbuffer_albedo[pixel]) * (1.0f / 3.14159265f) * irradiance;
+    }
+    if (rec.show_vpls && position.w >= 0.0f) {
+        // A VPL in front of what the pixel sees, within the dot's angular radius of its ray:
+        // drawn in its own colour at full brightness.
+        const float3 ray = radiosity::xyz(position) - rec.eye;
+        const float seen = length(ray), cos_radius = cosf(rec.dot_radius);
+        for (unsigned k = 0; k < rec.vpls.count(); ++k) {
+            const radiosity::Vpl vpl = rec.vpls[k];
+            const float peak = max_component(vpl.power);
+            if (peak <= 0.0f) continue;
+            const float3 to = vpl.position - rec.eye;
+            const float d = length(to);
+            if (d < seen && dot(to / d, ray / seen) > cos_radius) color = vpl.power / peak;
+        }
+    }
+    rec.output[pixel] = make_float4(color, 1.0f);
+}
