@@ -2,7 +2,8 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render tests sanitizer bench profile (default: all but profile).
+# with steps: render samples tests igi pathtracer tea sanitizer bench sweep profile hotspots
+# (default: render tests sanitizer bench).
 set -uo pipefail
 out=${OUT:-gpu-out}
 mkdir -p "$out"
@@ -16,6 +17,20 @@ mkdir -p /work/shared/scenes
 export LUCENT_CACHE_DIR=/tmp/lucent-kernel-cache
 nvidia-smi -L
 
+# compare A.png B.png LABEL: pixels differing by more than 10/255 (HIPRT's image test).
+compare() {
+    python3 - "$1" "$2" "$3" <<'PY'
+import sys
+import numpy as np
+from PIL import Image
+a = np.asarray(Image.open(sys.argv[1]).convert("RGB")).astype(int)
+b = np.asarray(Image.open(sys.argv[2]).convert("RGB")).astype(int)
+d = np.abs(a - b).max(axis=2)
+print(f"CPU vs GPU {sys.argv[3]}: {(d > 10).sum()} of {d.size} pixels differ by more than 10/255 "
+      f"({100.0 * (d > 10).sum() / d.size:.3f} %), max difference {d.max()}/255")
+PY
+}
+
 for step in $steps; do
 case $step in
 render)
@@ -24,20 +39,11 @@ render)
     $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose
     $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose --repeat 500
     $R $B/bin/lucent render --sample whitted --backend cpu --size 1024x1024 --out "$out/whitted_cpu.png"
-    python3 - "$out/whitted_cpu.png" "$out/whitted_cuda.png" <<'PY'
-import sys
-import numpy as np
-from PIL import Image
-a = np.asarray(Image.open(sys.argv[1]).convert("RGB")).astype(int)
-b = np.asarray(Image.open(sys.argv[2]).convert("RGB")).astype(int)
-d = np.abs(a - b).max(axis=2)
-print(f"CPU vs GPU whitted: {(d > 10).sum()} of {d.size} pixels differ by more than 10/255 "
-      f"({100.0 * (d > 10).sum() / d.size:.3f} %), max difference {d.max()}/255")
-PY
+    compare "$out/whitted_cpu.png" "$out/whitted_cuda.png" whitted
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs nodes variables exceptions validation whitted backend; do
+    for t in programs nodes variables exceptions validation whitted backend igi radiosity; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
@@ -52,14 +58,47 @@ tests)
     ;;
 sweep)
     echo "== whitted 1024x1024 frame rate against kernel variants (NVRTC defines)"
-    for v in "" "-DLUCENT_GPU_TILES=0"; do
+    for v in "" "-maxrregcount=96" "-maxrregcount=128" "-DLUCENT_GPU_MIN_BLOCKS=3" \
+             "--extra-device-vectorization" "-Xptxas=-dlcm=cg"; do
         echo "-- LUCENT_NVRTC_OPTIONS=$v"
         LUCENT_NVRTC_OPTIONS="$v" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
     done
-    for c in 100 50; do
+    for c in 50; do
         echo "-- LUCENT_GPU_CARVEOUT=$c (shared memory share, default 0: L1 first)"
         LUCENT_GPU_CARVEOUT=$c $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch"
     done
+    ;;
+samples)
+    echo "== every sample on the CPU and the GPU: images compared"
+    for args in "igi --size 512x512 --set vpls=64" \
+                "igi --size 512x512 --set downsample=4 --set interleave=3 --set imperfect_visibility=1" \
+                "radiosity --size 512x512" "direct --size 512x512" \
+                "pathtracer --size 256x256 --spp 64"; do
+        name=$(echo "$args" | tr ' =' '__' | cut -c1-60)
+        $R $B/bin/lucent render --sample $args --backend cuda --out "$out/$name.cuda.png" | tail -12
+        $R $B/bin/lucent render --sample $args --backend cpu --out "$out/$name.cpu.png" > /dev/null
+        compare "$out/$name.cpu.png" "$out/$name.cuda.png" "$args"
+    done
+    ;;
+igi)
+    echo "== bench igi: Cornell box and Sponza (3 point lights, two mirror pools), 800x600"
+    $R $B/bin/lucent bench igi --backend cuda --scene cornell --frames 50
+    LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda \
+        --scene bench/scenes/sponza-igi.json --frames 50
+    LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda \
+        --scene bench/scenes/sponza-igi.json --frames 50 --vpls 180 --json > "$out/bench_igi_sponza.json"
+    LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent render --sample igi --backend cuda \
+        --scene bench/scenes/sponza-igi.json --size 800x600 --out "$out/igi_sponza.png" --repeat 50
+    ;;
+pathtracer)
+    echo "== path tracer, Cornell box 1024x1024"
+    $R $B/bin/lucent render --sample pathtracer --scene cornell --backend cuda --size 1024x1024 --spp 256 --out "$out/pathtracer_cornell.png"
+    $R $B/bin/lucent render --sample pathtracer --scene cornell-materials --backend cuda --size 1024x1024 --spp 256 --out "$out/pathtracer_materials.png"
+    ;;
+tea)
+    echo "== bench tea on the GPU"
+    $R $B/bin/lucent bench tea --backend cuda
+    $R $B/bin/lucent bench tea --backend cuda --rounds 16
     ;;
 sanitizer)
     echo "== compute-sanitizer memcheck: whitted, bench rays"

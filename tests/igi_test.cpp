@@ -12,6 +12,7 @@
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
 #include "scene/scene.h"
+#include "tests/test_support.h"
 #include "tests/reference_tracer.h"
 
 namespace {
@@ -23,7 +24,7 @@ RenderResult render(const std::map<std::string, std::string>& sets, unsigned siz
                     const std::string& scene = "", bool layers = false) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.sets = sets;
     settings.scene = scene;
     settings.keep_layers = layers;

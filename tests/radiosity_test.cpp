@@ -9,6 +9,7 @@
 #include "samples/radiosity/radiosity.h"
 #include "samples/radiosity/vpl_grid.h"
 #include "scene/scene.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -22,7 +23,7 @@ RenderResult render(const std::map<std::string, std::string>& sets, unsigned siz
                     bool layers = false) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.sets = sets;
     settings.keep_layers = layers;
     return lucent::samples::radiosity_sample_info().render(settings);
@@ -179,7 +180,7 @@ TEST(Radiosity, ShowVplsDrawsDots) {
 TEST(Radiosity, SceneWithoutAnAreaLightIsAClearError) {
     RenderSettings settings;
     settings.width = settings.height = 8;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.scene = "cornell-point";
     try {
         lucent::samples::radiosity_sample_info().render(settings);
