@@ -146,6 +146,23 @@ TEST_F(Furnace, InsideAnEmittingLambertSphereRadianceIsEmissionOverOneMinusAlbed
     EXPECT_NEAR(mean_of(short_paths, 0, 0, 16, 16).x, 0.75f, 1e-3f);
 }
 
+TEST_F(Furnace, JsonAreaLightWithoutASurfaceIsFoundByBothStrategies) {
+    // A JSON area light has no triangles: the sample gives it some, or BSDF-sampled rays
+    // would never find it and MIS would lose its share of the light.
+    const fs::path path = dir / "lamp.json";
+    std::ofstream(path) << R"({"camera": {"eye": [0, 0.6, 2.5], "look": [0, 0.2, 0], "fov": 50},
+      "materials": [{"name": "grey", "diffuse": [0.5, 0.5, 0.5]}],
+      "meshes": [{"positions": [[-1,0,-1], [1,0,-1], [1,0,1], [-1,0,1]],
+                  "triangles": [[0,2,1], [0,3,2]], "material": "grey"}],
+      "lights": [{"type": "area", "corner": [-0.5, 1, -0.5], "edge1": [1, 0, 0],
+                  "edge2": [0, 0, 1], "emission": [2, 2, 2]}]})";
+    const RenderResult mis = render(path.string(), 16, 64, {{"nee", "1"}});
+    const RenderResult bsdf = render(path.string(), 16, 256, {{"nee", "0"}});
+    const float a = mean_of(mis, 0, 0, 16, 16).x, b = mean_of(bsdf, 0, 0, 16, 16).x;
+    EXPECT_GT(b, 0.05f) << "BSDF sampling alone finds the light";
+    EXPECT_NEAR(a / b, 1.0f, 0.03f);
+}
+
 // ---- chi-square tests of the BSDF sampling ------------------------------------------------
 /// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes §6.2): the chi-square
 /// distribution's tail, Q(dof / 2, chi2 / 2).
