@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "bench_command.h"
+#include "bench_fog_command.h"
 #include "bench_igi_command.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
     BenchBuildArgs build_args;
     BenchTeaArgs bench_tea_args;
     BenchIgiArgs bench_igi_args;
+    BenchFogArgs bench_fog_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     std::string where = "lucent";
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
         CLI::App* render = add_render_command(app, render_args);
         BenchCommands bench = add_bench_commands(app, rays_args, build_args, bench_tea_args);
         CLI::App* bench_igi = add_bench_igi_command(bench.bench, bench_igi_args);
+        CLI::App* bench_fog = add_bench_fog_command(bench.bench, bench_fog_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         try {
@@ -72,6 +75,10 @@ int main(int argc, char** argv) {
         if (bench.tea->parsed()) {
             where = "lucent bench tea";
             return run_bench_tea_command(bench_tea_args);
+        }
+        if (bench_fog->parsed()) {
+            where = "lucent bench fog";
+            return run_bench_fog_command(bench_fog_args);
         }
         if (bench_igi->parsed()) {
             where = "lucent bench igi";

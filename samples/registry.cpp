@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "samples/direct/direct.h"
+#include "samples/fog/fog.h"
 #include "samples/igi/igi.h"
 #include "samples/pathtracer/pathtracer.h"
 #include "samples/radiosity/radiosity.h"
@@ -82,7 +83,7 @@ T parse_option(const RenderSettings& s, const SampleInfo& info, const std::strin
 const std::vector<SampleInfo>& all_samples() {
     static const std::vector<SampleInfo> samples = {
         whitted_sample_info(), direct_sample_info(),     igi_sample_info(),
-        radiosity_sample_info(), pathtracer_sample_info()};
+        radiosity_sample_info(), pathtracer_sample_info(), fog_sample_info()};
     return samples;
 }
 
@@ -103,6 +104,11 @@ float get_float_option(const RenderSettings& s, const SampleInfo& info, const st
 int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name, int lo,
                    int hi) {
     return parse_option<int>(s, info, name, lo, hi);
+}
+
+std::string get_string_option(const RenderSettings& s, const SampleInfo& info,
+                              const std::string& name) {
+    return option_text(s, info, name).first;
 }
 
 void check_options(const RenderSettings& s, const SampleInfo& info) {

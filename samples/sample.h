@@ -81,6 +81,9 @@ float get_float_option(const RenderSettings& s, const SampleInfo& info, const st
                        float lo, float hi);
 int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name, int lo,
                    int hi);
+/// Reads a --set value as text (a file name, say): the option's default when not given.
+std::string get_string_option(const RenderSettings& s, const SampleInfo& info,
+                              const std::string& name);
 /// Error naming any --set that the sample does not have, with the list it does have.
 void check_options(const RenderSettings& s, const SampleInfo& info);
 

@@ -3,9 +3,11 @@
 #include <stb_image.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "lucent/error.h"
+#include "scene/exr_encoder.h"
 
 namespace lucent::scene {
 
@@ -36,6 +38,36 @@ TextureImage load_texture(const std::string& path) {
     for (size_t i = 0; i < image.texels.size(); ++i, p += 4)
         image.texels[i] =
             make_float4(to_linear[p[0]], to_linear[p[1]], to_linear[p[2]], p[3] / 255.0f);
+    return image;
+}
+
+TextureImage load_linear_image(const std::string& path) {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    TextureImage image;
+    if (ext == ".exr") {
+        const Image rgb = read_exr(path);
+        image.width = rgb.width;
+        image.height = rgb.height;
+        for (const float3& p : rgb.pixels) image.texels.push_back(make_float4(p.x, p.y, p.z, 1.0f));
+        return image;
+    }
+    if (ext != ".hdr")
+        throw Error("cannot read the environment map '" + path +
+                    "': expected a linear .hdr or .exr file");
+    int width = 0, height = 0, channels = 0;
+    std::unique_ptr<float, void (*)(void*)> data(
+        stbi_loadf(path.c_str(), &width, &height, &channels, 4), stbi_image_free);
+    if (!data) {
+        const char* reason = stbi_failure_reason();
+        throw Error("cannot read the environment map '" + path +
+                    "': " + (reason ? reason : "not a Radiance .hdr file"));
+    }
+    image.width = unsigned(width);
+    image.height = unsigned(height);
+    image.texels.resize(size_t(width) * height);
+    const float* p = data.get();
+    for (size_t i = 0; i < image.texels.size(); ++i, p += 4)
+        image.texels[i] = make_float4(p[0], p[1], p[2], 1.0f);
     return image;
 }
 

@@ -18,4 +18,9 @@ struct TextureImage {
 /// Throws lucent::Error naming the file and stb_image's reason.
 TextureImage load_texture(const std::string& path);
 
+/// A linear high-dynamic-range image, as environment maps come: Radiance .hdr (stb_image) or
+/// OpenEXR .exr; no transfer function applied. Throws lucent::Error naming the file and the
+/// reason, or the extensions it reads.
+TextureImage load_linear_image(const std::string& path);
+
 }  // namespace lucent::scene

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "lucent/device/noise.h"
 #include "lucent/device/tea.h"
 #include "lucent/error.h"
 
@@ -21,10 +22,6 @@ scene::Image gray_image(unsigned width, unsigned height) {
     image.pixels.resize(size_t(width) * height);
     return image;
 }
-
-float quintic(float t) {
-    return t * t * t * (t * (t * 6 - 15) + 10);
-}
 }  // namespace
 
 scene::Image white_noise(unsigned width, unsigned height, unsigned rounds, uint4 key) {
@@ -37,25 +34,11 @@ scene::Image white_noise(unsigned width, unsigned height, unsigned rounds, uint4
 scene::Image gradient_noise(unsigned width, unsigned height, unsigned cell, unsigned rounds,
                             uint4 key) {
     scene::Image image = gray_image(width, height);
-    auto gradient = [&](int ix, int iy) {
-        float angle =
-            6.2831853f * tea_unit_float(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds).x);
-        return make_float2(std::cos(angle), std::sin(angle));
-    };
+    GradientCell corners;
     for (unsigned y = 0; y < height; ++y)
-        for (unsigned x = 0; x < width; ++x) {
-            float fx = (x + 0.5f) / float(cell), fy = (y + 0.5f) / float(cell);
-            int ix = int(std::floor(fx)), iy = int(std::floor(fy));
-            float tx = fx - ix, ty = fy - iy;
-            // Dot products of the corner gradients with the offsets to the corners.
-            float n00 = dot(gradient(ix, iy), make_float2(tx, ty));
-            float n10 = dot(gradient(ix + 1, iy), make_float2(tx - 1, ty));
-            float n01 = dot(gradient(ix, iy + 1), make_float2(tx, ty - 1));
-            float n11 = dot(gradient(ix + 1, iy + 1), make_float2(tx - 1, ty - 1));
-            float u = quintic(tx), v = quintic(ty);
-            float n = lerpf(lerpf(n00, n10, u), lerpf(n01, n11, u), v);  // in [-0.71, 0.71]
-            image.pixels[size_t(y) * width + x] = make_float3(clampf(0.5f + n * 0.70710678f, 0, 1));
-        }
+        for (unsigned x = 0; x < width; ++x)
+            image.pixels[size_t(y) * width + x] = make_float3(tea_gradient_noise(
+                (x + 0.5f) / float(cell), (y + 0.5f) / float(cell), key, rounds, corners));
     return image;
 }
 

@@ -1,0 +1,58 @@
+// Gradient noise from TEA hashes (Perlin 1985, with the quintic fade of Perlin 2002; TEA as
+// its hash after Zafar et al. 2010 and Sebald, seed §3.2). Device code: g++, nvcc and NVRTC.
+#pragma once
+
+#include "lucent/device/tea.h"
+#include "lucent/device/vector_math.h"
+
+namespace lucent {
+
+/// The unit gradient TEA draws at lattice point (ix, iy).
+LUCENT_HD inline float2 tea_lattice_gradient(int ix, int iy, uint4 key, unsigned rounds) {
+    const float angle =
+        6.2831853f * tea_unit_float(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds).x);
+    return make_float2(cosf(angle), sinf(angle));
+}
+
+LUCENT_HD inline float quintic_fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+
+/// The four corner gradients of a lattice cell: what a march along a ray can keep while it
+/// stays in one cell (the noise of the fog sample varies in x and z only).
+struct GradientCell {
+    int ix = 0x7fffffff, iy = 0x7fffffff;  // no cell yet
+    float2 g00 = make_float2(0.0f, 0.0f), g10 = g00, g01 = g00, g11 = g00;
+
+    LUCENT_HD void fetch(int x, int y, uint4 key, unsigned rounds) {
+        if (x == ix && y == iy) return;
+        ix = x;
+        iy = y;
+        g00 = tea_lattice_gradient(x, y, key, rounds);
+        g10 = tea_lattice_gradient(x + 1, y, key, rounds);
+        g01 = tea_lattice_gradient(x, y + 1, key, rounds);
+        g11 = tea_lattice_gradient(x + 1, y + 1, key, rounds);
+    }
+};
+
+/// One octave of gradient noise at (x, y), in lattice units, mapped to [0, 1]; `cell` keeps
+/// the last cell's gradients between calls.
+LUCENT_HD inline float tea_gradient_noise(float x, float y, uint4 key, unsigned rounds,
+                                          GradientCell& cell) {
+    const float fx = floorf(x), fy = floorf(y);
+    cell.fetch(int(fx), int(fy), key, rounds);
+    const float tx = x - fx, ty = y - fy;
+    // Dot products of the corner gradients with the offsets to the corners.
+    const float n00 = dot(cell.g00, make_float2(tx, ty));
+    const float n10 = dot(cell.g10, make_float2(tx - 1.0f, ty));
+    const float n01 = dot(cell.g01, make_float2(tx, ty - 1.0f));
+    const float n11 = dot(cell.g11, make_float2(tx - 1.0f, ty - 1.0f));
+    const float u = quintic_fade(tx), v = quintic_fade(ty);
+    const float n = lerpf(lerpf(n00, n10, u), lerpf(n01, n11, u), v);  // in [-0.71, 0.71]
+    return clampf(0.5f + n * 0.70710678f, 0.0f, 1.0f);
+}
+
+LUCENT_HD inline float tea_gradient_noise(float x, float y, uint4 key, unsigned rounds) {
+    GradientCell cell;
+    return tea_gradient_noise(x, y, key, rounds, cell);
+}
+
+}  // namespace lucent

@@ -1,0 +1,370 @@
+// Volumetric fog in the OptiX SDK's tutorial scene (Sebald, seed §3.1): a tiled floor and a
+// reflective rusty box with procedural textures, a glass crystal (Fresnel, Beer absorption),
+// an environment in the miss program, point lights with shadows; and a box of fog over the
+// floor whose density is TEA gradient noise in x, z times a linear falloff in y.
+//
+// The fog box's any-hit lets shadow rays through. Its closest hit traces the same ray again
+// with the fog ignored, to find what lies beneath, then marches from where the ray enters
+// the fog (or starts, inside it) to where it leaves or meets that surface, and composites
+// the fog over it. Rays that start inside the fog (the camera, reflections off the floor)
+// are shaded too: the paper's stated limitation is lifted by reporting a hit at the ray's
+// start when its origin lies inside the box.
+#pragma once
+
+#include "lucent/device.h"
+#include "lucent/device/noise.h"
+
+namespace fog {
+
+enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
+
+struct PointLight {
+    float3 position;
+    float3 intensity;
+};
+
+/// The pinhole camera in a buffer, so that a moving camera changes data, not the scene.
+struct CameraFrame {
+    float3 eye, U, V, W;  // W: to the image centre; U, V: half the image's extent
+};
+
+struct HitAttributes {
+    float3 normal;  // object space, not normalised (triangles); unit (fog box)
+    float t_exit;   // fog box: where the ray leaves it
+};
+
+struct RadiancePayload {
+    float3 color;
+    float distance;  // to the surface shaded (1e30 for the environment)
+    int depth;
+    int skip_fog;  // 1: the fog box does not count (its own look behind itself)
+};
+struct ShadowPayload {
+    float3 attenuation;
+};
+
+LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+
+/// Unpolarised Fresnel reflectance of a dielectric for cos_i (> 0) and the index ratio
+/// eta = n_incident / n_transmitted; 1 under total internal reflection.
+LUCENT_HD inline float fresnel(float cos_i, float eta) {
+    const float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
+    if (sin2_t >= 1.0f) return 1.0f;
+    const float cos_t = sqrtf(1.0f - sin2_t);
+    const float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    const float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5f * (rs * rs + rp * rp);
+}
+
+// ---- records ---------------------------------------------------------------------------
+struct CameraRecord {
+    lucent::BufferView<CameraFrame> camera;
+    lucent::BufferView<float4> output;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(CameraRecord, camera, output, top_object)
+
+struct LightingParams {
+    lucent::BufferView<PointLight> lights;
+    float3 ambient;
+    float scene_epsilon;
+    unsigned max_depth;
+    lucent::Handle top_object;
+};
+
+/// A Phong surface with a procedural pattern: 0 floor tiles, 1 rust (gradient noise).
+struct PhongRecord {
+    float3 Kd_a, Kd_b;  // the pattern's two colours
+    float3 Ks;
+    float phong_exponent;
+    float3 Kr;  // mirror reflection
+    unsigned pattern;
+    float pattern_scale;  // tile size, or noise lattice size
+    uint4 noise_key;
+    lucent::BufferView<PointLight> lights;
+    float3 ambient;
+    float scene_epsilon;
+    unsigned max_depth;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(PhongRecord, Kd_a, Kd_b, Ks, phong_exponent, Kr, pattern, pattern_scale, noise_key,
+              lights, ambient, scene_epsilon, max_depth, top_object)
+
+struct GlassRecord {
+    float ior;
+    float3 extinction;  // Beer's law: per unit distance inside the glass
+    float3 shadow_tint;  // what a shadow ray keeps through the crystal
+    float scene_epsilon;
+    unsigned max_depth;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(GlassRecord, ior, extinction, shadow_tint, scene_epsilon, max_depth, top_object)
+
+struct FogBoxRecord {  // the fog box's bounds, for its bounding-box and intersection programs
+    float3 box_min, box_max;
+};
+LUCENT_RECORD(FogBoxRecord, box_min, box_max)
+
+struct FogRecord {
+    float3 box_min, box_max;
+    float density;        // extinction at full noise and the bottom of the box, per unit
+    float step;           // march step along the ray
+    float noise_scale;    // lattice size of the gradient noise, scene units
+    unsigned noise;       // 0: uniform density (tests)
+    unsigned falloff;     // 0: no falloff in y (tests)
+    unsigned rounds;      // TEA rounds of the noise
+    uint4 noise_key;      // generate_tea_key(device, seed): Sebald Fig. 4
+    float3 fog_color;
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(FogRecord, box_min, box_max, density, step, noise_scale, noise, falloff, rounds,
+              noise_key, fog_color, top_object)
+
+struct MeshRecord {
+    lucent::BufferView<float3> positions;
+    lucent::BufferView<uint3> triangles;
+};
+LUCENT_RECORD(MeshRecord, positions, triangles)
+
+struct MissRecord {
+    lucent::TextureView environment;  // equirectangular; used when has_environment
+    unsigned has_environment;
+};
+LUCENT_RECORD(MissRecord, environment, has_environment)
+
+LUCENT_HD inline LightingParams lighting(const PhongRecord& r) {
+    return LightingParams{r.lights, r.ambient, r.scene_epsilon, r.max_depth, r.top_object};
+}
+
+/// What reaches p from `light`: its intensity over d^2 times what shadow rays let through.
+LUCENT_HD inline float3 light_arriving(const LightingParams& p, float3 origin, float3 to_light,
+                                       const PointLight& light) {
+    ShadowPayload s{make_float3(1.0f)};
+    lucent::trace(p.top_object,
+                  lucent::make_ray(origin, to_light, kShadowRay, p.scene_epsilon, 0.999f), s);
+    return light.intensity * s.attenuation * (1.0f / dot(to_light, to_light));
+}
+
+/// The procedural pattern's colour at p.
+LUCENT_HD inline float3 pattern_colour(const PhongRecord& r, float3 p) {
+    if (r.pattern == 0) {
+        // Tiles with grout: checker of two shades, a darker line near each edge.
+        const float u = p.x / r.pattern_scale, v = p.z / r.pattern_scale;
+        const float fu = u - floorf(u), fv = v - floorf(v);
+        const bool grout = fu < 0.03f || fv < 0.03f || fu > 0.97f || fv > 0.97f;
+        const int checker = (int(floorf(u)) + int(floorf(v))) & 1;
+        if (grout) return r.Kd_b * 0.35f;
+        return checker ? r.Kd_a : lerp(r.Kd_a, r.Kd_b, 0.35f);
+    }
+    // Rust: patches of the second colour where gradient noise runs high.
+    const float n = lucent::tea_gradient_noise((p.x + 0.7f * p.y) / r.pattern_scale,
+                                               (p.z - 0.4f * p.y) / r.pattern_scale,
+                                               r.noise_key, 2u);
+    const float t = clampf((n - 0.45f) * 4.0f, 0.0f, 1.0f);
+    return lerp(r.Kd_a, r.Kd_b, t);
+}
+
+/// Where the line o + t d enters and leaves the box (t0 > t1: it misses).
+LUCENT_HD inline float2 box_span(float3 lo, float3 hi, float3 o, float3 d) {
+    const float3 inv = make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    const float3 a = (lo - o) * inv, b = (hi - o) * inv;
+    const float3 near = fminf(a, b), far = fmaxf(a, b);
+    return make_float2(lc_max(near.x, lc_max(near.y, near.z)), lc_min(far.x, lc_min(far.y, far.z)));
+}
+
+/// Fog density at p: gradient noise in x, z (TEA, Sebald §3.2) times the linear falloff from
+/// the bottom of the box (full) to its top (none).
+LUCENT_HD inline float density_at(const FogRecord& r, float3 p, lucent::GradientCell& cell) {
+    float d = r.density;
+    if (r.noise)
+        d *= lucent::tea_gradient_noise(p.x / r.noise_scale, p.z / r.noise_scale, r.noise_key,
+                                        r.rounds, cell);
+    if (r.falloff)
+        d *= clampf((r.box_max.y - p.y) / (r.box_max.y - r.box_min.y), 0.0f, 1.0f);
+    return d;
+}
+
+}  // namespace fog
+
+// ---- camera, miss ------------------------------------------------------------------------
+LUCENT_RAY_GENERATION(fog_camera, fog::CameraRecord) {
+    const uint3 i = lucent::launch_index(), n = lucent::launch_size();
+    const fog::CameraFrame c = rec.camera[0u];
+    const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
+    fog::RadiancePayload prd{make_float3(0.0f), 0.0f, 0, 0};
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(c.eye, normalize(c.W + sx * c.U + sy * c.V), fog::kRadianceRay,
+                                   0.0f),
+                  prd);
+    rec.output[make_uint2(i.x, i.y)] = make_float4(prd.color, 1.0f);
+}
+
+// The environment: an equirectangular map when given, else a procedural sky.
+LUCENT_MISS(fog_environment, fog::MissRecord, fog::RadiancePayload) {
+    const float3 d = normalize(lucent::current_ray().direction);
+    prd.distance = 1e30f;
+    if (rec.has_environment) {
+        const float u = 0.5f + atan2f(d.x, -d.z) * (0.5f / 3.14159265f);
+        const float v = acosf(clampf(d.y, -1.0f, 1.0f)) * (1.0f / 3.14159265f);
+        prd.color = make_float3(lucent::tex2D(rec.environment, make_float2(u, v)));
+        return;
+    }
+    const float up = d.y;
+    if (up < 0.0f) {  // below the horizon: a dim ground haze
+        prd.color = lerp(make_float3(0.55f, 0.55f, 0.58f), make_float3(0.2f, 0.19f, 0.18f),
+                         clampf(-up * 4.0f, 0.0f, 1.0f));
+        return;
+    }
+    const float3 horizon = make_float3(0.75f, 0.82f, 0.9f), zenith = make_float3(0.2f, 0.38f, 0.75f);
+    prd.color = lerp(horizon, zenith, sqrtf(up));
+}
+
+// ---- surfaces ------------------------------------------------------------------------------
+LUCENT_ATTRIBUTE(fog_mesh_attributes, fog::MeshRecord, fog::HitAttributes) {
+    const uint3 t = rec.triangles[prim];
+    attr.normal = cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
+    attr.t_exit = 0.0f;
+}
+
+LUCENT_CLOSEST_HIT(fog_phong, fog::PhongRecord, fog::RadiancePayload, fog::HitAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    const float3 p = ray.origin + lucent::t_hit() * ray.direction;
+    const float3 n =
+        faceforward(normalize(lucent::object_to_world_normal(attr.normal)), ray.direction);
+    const float3 origin = p + rec.scene_epsilon * n;
+    const float3 kd = fog::pattern_colour(rec, p);
+    float3 color = kd * rec.ambient;
+    const fog::LightingParams params = fog::lighting(rec);
+    for (unsigned l = 0; l < rec.lights.count(); ++l) {
+        const fog::PointLight light = rec.lights[l];
+        const float3 to = light.position - p;
+        const float3 L = normalize(to);
+        const float cos_l = dot(n, L);
+        if (cos_l <= 0.0f) continue;
+        const float3 arriving = fog::light_arriving(params, origin, to, light);
+        if (max_component(arriving) <= 0.0f) continue;
+        const float3 H = normalize(L - normalize(ray.direction));
+        const float spec = powf(lc_max(0.0f, dot(n, H)), rec.phong_exponent);
+        color += arriving * (kd * cos_l + rec.Ks * spec);
+    }
+    if (max_component(rec.Kr) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
+        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+        lucent::trace(rec.top_object,
+                      lucent::make_ray(origin, reflect(normalize(ray.direction), n),
+                                       fog::kRadianceRay, 0.0f),
+                      reflected);
+        color += rec.Kr * reflected.color;
+    }
+    prd.color = color;
+    prd.distance = lucent::t_hit();
+}
+
+// Glass: Fresnel-weighted reflection and refraction; Beer's law for the path just travelled
+// inside it (the ray leaving the crystal has been inside for t_hit).
+LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    const float3 d = normalize(ray.direction);
+    const float3 p = ray.origin + lucent::t_hit() * ray.direction;
+    const float3 outward = normalize(lucent::object_to_world_normal(attr.normal));
+    const bool entering = dot(d, outward) < 0.0f;
+    const float3 n = entering ? outward : -outward;  // faces the incoming ray
+    const float eta = entering ? 1.0f / rec.ior : rec.ior;
+    const float cos_i = -dot(d, n);
+    const float F = fog::fresnel(cos_i, eta);
+    float3 color = make_float3(0.0f);
+    if (prd.depth + 1 < int(rec.max_depth)) {
+        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+        lucent::trace(rec.top_object,
+                      lucent::make_ray(p + rec.scene_epsilon * n, reflect(d, n), fog::kRadianceRay,
+                                       0.0f),
+                      reflected);
+        color += F * reflected.color;
+        if (F < 1.0f) {
+            const float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
+            const float3 t = normalize(eta * d + (eta * cos_i - sqrtf(1.0f - sin2_t)) * n);
+            fog::RadiancePayload refracted{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+            lucent::trace(rec.top_object,
+                          lucent::make_ray(p - rec.scene_epsilon * n, t, fog::kRadianceRay, 0.0f),
+                          refracted);
+            color += (1.0f - F) * refracted.color;
+        }
+    }
+    if (!entering) {  // the ray crossed the glass: Beer's law over the distance inside
+        const float inside = lucent::t_hit() * length(ray.direction);
+        color = color * make_float3(expf(-rec.extinction.x * inside), expf(-rec.extinction.y * inside),
+                                    expf(-rec.extinction.z * inside));
+    }
+    prd.color = color;
+    prd.distance = lucent::t_hit();
+}
+
+LUCENT_ANY_HIT(fog_opaque_shadow, lucent::NoRecord, fog::ShadowPayload, fog::HitAttributes) {
+    prd.attenuation = make_float3(0.0f);
+    lucent::terminate_ray();
+}
+
+// The crystal lets a tinted part of the light through (each face it crosses).
+LUCENT_ANY_HIT(fog_glass_shadow, fog::GlassRecord, fog::ShadowPayload, fog::HitAttributes) {
+    prd.attenuation = prd.attenuation * rec.shadow_tint;
+    if (max_component(prd.attenuation) < 1e-3f) {
+        prd.attenuation = make_float3(0.0f);
+        lucent::terminate_ray();
+        return;
+    }
+    lucent::ignore_intersection();
+}
+
+// ---- the fog box ---------------------------------------------------------------------------
+LUCENT_BOUNDING_BOX(fog_box_bounds, fog::FogBoxRecord) {
+    box.lo = rec.box_min;
+    box.hi = rec.box_max;
+}
+
+LUCENT_INTERSECTION(fog_box_intersect, fog::FogBoxRecord, fog::HitAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    const float2 span = fog::box_span(rec.box_min, rec.box_max, ray.origin, ray.direction);
+    if (span.x > span.y || span.y <= ray.tmin) return;
+    // From outside: the entry point. From inside (the origin is in the fog): the ray's start.
+    const float t = span.x > ray.tmin ? span.x : ray.tmin + 1e-6f * (1.0f + fabsf(ray.tmin));
+    if (lucent::potential_intersection(t)) {
+        attr.normal = make_float3(0.0f, 1.0f, 0.0f);
+        attr.t_exit = span.y;
+        lucent::report_intersection(0);
+    }
+}
+
+// Shadows pass through fog (Sebald: "simply ignores the intersection"); a radiance ray
+// looking behind the fog ignores it too.
+LUCENT_ANY_HIT(fog_volume_shadow, lucent::NoRecord, fog::ShadowPayload, fog::HitAttributes) {
+    lucent::ignore_intersection();
+}
+LUCENT_ANY_HIT(fog_volume_radiance, lucent::NoRecord, fog::RadiancePayload, fog::HitAttributes) {
+    if (prd.skip_fog) lucent::ignore_intersection();
+}
+
+LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAttributes) {
+    const lucent::Ray& ray = lucent::current_ray();
+    // What lies beneath: the same ray again, the fog ignored (its hits are exactly those of
+    // a scene without fog, so zero density reproduces it).
+    fog::RadiancePayload behind{make_float3(0.0f), 0.0f, prd.depth, 1};
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(ray.origin, ray.direction, fog::kRadianceRay, ray.tmin, ray.tmax),
+                  behind);
+    const float t_start = lucent::t_hit(), t_end = lc_min(attr.t_exit, behind.distance);
+    const float speed = length(ray.direction);  // t to distance
+    const float distance = lc_max(0.0f, t_end - t_start) * speed;
+    // March in equal steps of at most `step`, sampling each at its middle: transmittance
+    // falls by exp(-density dt) per step and the fog colour fills what it takes away.
+    const unsigned steps = distance > 0.0f ? unsigned(ceilf(distance / rec.step)) : 0u;
+    const float dt = steps ? distance / float(steps) : 0.0f;
+    const float3 d = ray.direction * (1.0f / speed);
+    const float3 start = ray.origin + t_start * ray.direction;
+    float transmittance = 1.0f;
+    lucent::GradientCell cell;
+    for (unsigned s = 0; s < steps && transmittance > 1e-4f; ++s) {
+        const float3 p = start + ((float(s) + 0.5f) * dt) * d;
+        transmittance *= expf(-fog::density_at(rec, p, cell) * dt);
+    }
+    prd.color = rec.fog_color * (1.0f - transmittance) + behind.color * transmittance;
+    prd.distance = behind.distance;
+}

@@ -1,0 +1,260 @@
+// The fog sample's scene: geometry and materials of the OptiX SDK tutorial (a tiled floor, a
+// rusty reflective box, a glass crystal), two point lights, the environment and the fog box.
+#include "samples/fog/fog_scene.h"
+
+#include <cmath>
+#include <vector>
+
+#include "lucent/device/tea.h"
+#include "samples/fog/fog_programs.h"
+#include "samples/scene_setup.h"
+#include "samples/settings_error.h"
+#include "scene/texture_image.h"
+
+namespace lucent::samples {
+
+namespace {
+
+constexpr float kFloorHalf = 12.0f;  // the floor (and the fog box) span [-12, 12] in x and z
+constexpr float kOrbitStartDegrees = 37.0f;  // where orbit 0 puts the camera
+const float3 kLookAt = make_float3(0.0f, 2.0f, 0.0f);
+
+struct Mesh {
+    std::vector<float3> positions;
+    std::vector<uint3> triangles;
+};
+
+Mesh floor_mesh() {
+    const float h = kFloorHalf;
+    return {{{-h, 0, -h}, {h, 0, -h}, {h, 0, h}, {-h, 0, h}}, {{0, 2, 1}, {0, 3, 2}}};
+}
+
+Mesh box_mesh(float3 lo, float3 hi) {
+    Mesh m;
+    for (int i = 0; i < 8; ++i)
+        m.positions.push_back(make_float3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+    const unsigned quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                  {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) {
+        m.triangles.push_back(make_uint3(q[0], q[1], q[2]));
+        m.triangles.push_back(make_uint3(q[0], q[2], q[3]));
+    }
+    return m;
+}
+
+/// A hexagonal bipyramid standing on its tip: the "translucent crystalline object".
+Mesh crystal_mesh(float3 base, float radius) {
+    Mesh m;
+    const float ring_y[2] = {1.3f, 3.1f};
+    for (float y : ring_y)
+        for (int k = 0; k < 6; ++k) {
+            const float a = 1.0471976f * float(k) + 0.3f;
+            m.positions.push_back(base + make_float3(radius * std::cos(a), y, radius * std::sin(a)));
+        }
+    m.positions.push_back(base + make_float3(0.0f, 0.05f, 0.0f));  // 12: bottom tip
+    m.positions.push_back(base + make_float3(0.0f, 4.6f, 0.0f));   // 13: top tip
+    for (unsigned k = 0; k < 6; ++k) {
+        const unsigned k1 = (k + 1) % 6;
+        m.triangles.push_back(make_uint3(k, k1, 6 + k1));
+        m.triangles.push_back(make_uint3(k, 6 + k1, 6 + k));
+        m.triangles.push_back(make_uint3(12, k1, k));
+        m.triangles.push_back(make_uint3(13, 6 + k, 6 + k1));
+    }
+    // Wind every face outwards: the glass program tells entering from leaving by the normal.
+    float3 centre = make_float3(0.0f);
+    for (const float3& p : m.positions) centre += p;
+    centre = centre * (1.0f / float(m.positions.size()));
+    for (uint3& t : m.triangles) {
+        const float3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+        if (dot(cross(b - a, c - a), (a + b + c) * (1.0f / 3.0f) - centre) < 0) std::swap(t.y, t.z);
+    }
+    return m;
+}
+
+}  // namespace
+
+FogOptions read_fog_options(const RenderSettings& s, const SampleInfo& info) {
+    FogOptions o;
+    o.fog = get_int_option(s, info, "fog", 0, 1) == 1;
+    o.step = get_float_option(s, info, "step", 1e-3f, 10.0f);
+    o.height = get_float_option(s, info, "height", 0.01f, 100.0f);
+    o.density = get_float_option(s, info, "density", 0.0f, 100.0f);
+    o.noise_scale = get_float_option(s, info, "noise_scale", 0.01f, 1000.0f);
+    o.noise = get_int_option(s, info, "noise", 0, 1) == 1;
+    o.falloff = get_int_option(s, info, "falloff", 0, 1) == 1;
+    o.rounds = unsigned(get_int_option(s, info, "rounds", 1, 64));
+    o.device = unsigned(get_int_option(s, info, "device", 0, 1 << 30));
+    o.seed = unsigned(get_int_option(s, info, "seed", 0, 1 << 30));
+    o.max_depth = unsigned(get_int_option(s, info, "max_depth", 1, 16));
+    o.environment = get_string_option(s, info, "environment");
+    o.orbit_degrees = get_float_option(s, info, "orbit", -3600.0f, 3600.0f);
+    o.eye_height = get_float_option(s, info, "eye_height", -100.0f, 100.0f);
+    o.eye_distance = get_float_option(s, info, "eye_distance", 0.1f, 1000.0f);
+    return o;
+}
+
+struct FogScene::Impl {
+    Context ctx;
+    FogOptions options;
+    unsigned width, height;
+    std::shared_ptr<Buffer> camera, output;
+
+    Impl(const FogOptions& o, unsigned w, unsigned h, const ContextOptions& c)
+        : ctx(c), options(o), width(w), height(h) {}
+};
+
+FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
+                   const ContextOptions& context_options)
+    : m(std::make_unique<Impl>(options, width, height, context_options)) {
+    Context& ctx = m->ctx;
+    ctx.set_ray_type<fog::RadiancePayload>(fog::kRadianceRay, "radiance");
+    ctx.set_ray_type<fog::ShadowPayload>(fog::kShadowRay, "shadow", /*expects_closest_hit=*/false);
+    // Each level of the reflection and refraction tree may cross the fog, whose look behind
+    // itself is one more trace at the same depth: two frames per level, and the camera's.
+    ctx.set_max_recursion_depth(2 * options.max_depth + 2);
+
+    const std::vector<fog::PointLight> lights = {
+        {make_float3(-8.0f, 20.0f, -10.0f), make_float3(420.0f, 410.0f, 390.0f)},
+        {make_float3(10.0f, 14.0f, 9.0f), make_float3(110.0f, 95.0f, 75.0f)}};
+    auto light_buffer = ctx.create_buffer<fog::PointLight>(BufferType::kInput, unsigned(lights.size()));
+    light_buffer->upload(lights);
+    ctx["lights"] = light_buffer;
+    ctx["ambient"] = make_float3(0.12f, 0.13f, 0.15f);
+    ctx["scene_epsilon"] = 1e-3f;
+    ctx["max_depth"] = options.max_depth;
+    // Sebald Fig. 4: this device's key from its identifier and the seed.
+    ctx["noise_key"] = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
+
+    auto phong = ctx.create_program(LUCENT_PROGRAM(fog_phong));
+    auto opaque = ctx.create_program(LUCENT_PROGRAM(fog_opaque_shadow));
+    auto floor_material = ctx.create_material();
+    floor_material->set_name("floor tiles");
+    floor_material->set_closest_hit(fog::kRadianceRay, phong);
+    floor_material->set_any_hit(fog::kShadowRay, opaque);
+    (*floor_material)["Kd_a"] = make_float3(0.75f, 0.72f, 0.66f);
+    (*floor_material)["Kd_b"] = make_float3(0.45f, 0.42f, 0.38f);
+    (*floor_material)["Ks"] = make_float3(0.1f);
+    (*floor_material)["phong_exponent"] = 40.0f;
+    (*floor_material)["Kr"] = make_float3(0.1f);
+    (*floor_material)["pattern"] = 0u;
+    (*floor_material)["pattern_scale"] = 2.0f;
+    auto box_material = ctx.create_material();
+    box_material->set_name("rusty box");
+    box_material->set_closest_hit(fog::kRadianceRay, phong);
+    box_material->set_any_hit(fog::kShadowRay, opaque);
+    (*box_material)["Kd_a"] = make_float3(0.55f, 0.56f, 0.6f);
+    (*box_material)["Kd_b"] = make_float3(0.42f, 0.2f, 0.07f);
+    (*box_material)["Ks"] = make_float3(0.5f);
+    (*box_material)["phong_exponent"] = 60.0f;
+    (*box_material)["Kr"] = make_float3(0.35f);
+    (*box_material)["pattern"] = 1u;
+    (*box_material)["pattern_scale"] = 1.2f;
+    auto glass_material = ctx.create_material();
+    glass_material->set_name("crystal");
+    glass_material->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog_glass)));
+    glass_material->set_any_hit(fog::kShadowRay, ctx.create_program(LUCENT_PROGRAM(fog_glass_shadow)));
+    (*glass_material)["ior"] = 1.5f;
+    (*glass_material)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
+    (*glass_material)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
+
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(fog_mesh_attributes));
+    auto top = ctx.create_geometry_group();
+    auto add_mesh = [&](const Mesh& mesh, const std::shared_ptr<Material>& material,
+                        const char* name) {
+        auto positions = ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
+        positions->upload(mesh.positions);
+        auto triangles = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.triangles.size()));
+        triangles->upload(mesh.triangles);
+        auto geometry = ctx.create_geometry_triangles();
+        geometry->set_name(name);
+        geometry->set_vertices(positions);
+        geometry->set_indices(triangles);
+        geometry->set_attribute_program(attributes);
+        (*geometry)["positions"] = positions;
+        (*geometry)["triangles"] = triangles;
+        auto instance = ctx.create_geometry_instance();
+        instance->set_geometry(geometry);
+        instance->add_material(material);
+        top->add_child(instance);
+    };
+    add_mesh(floor_mesh(), floor_material, "floor");
+    add_mesh(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)), box_material,
+             "box");
+    add_mesh(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), glass_material, "crystal");
+
+    if (options.fog) {
+        // Sebald §3.1: a box with the floor's x, z extent and the fog's height.
+        auto fog_material = ctx.create_material();
+        fog_material->set_name("fog");
+        fog_material->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog_volume)));
+        fog_material->set_any_hit(fog::kRadianceRay,
+                                  ctx.create_program(LUCENT_PROGRAM(fog_volume_radiance)));
+        fog_material->set_any_hit(fog::kShadowRay, ctx.create_program(LUCENT_PROGRAM(fog_volume_shadow)));
+        (*fog_material)["density"] = options.density;
+        (*fog_material)["step"] = options.step;
+        (*fog_material)["noise_scale"] = options.noise_scale;
+        (*fog_material)["noise"] = unsigned(options.noise);
+        (*fog_material)["falloff"] = unsigned(options.falloff);
+        (*fog_material)["rounds"] = options.rounds;
+        (*fog_material)["fog_color"] = make_float3(0.62f, 0.66f, 0.72f);
+        auto fog_box = ctx.create_geometry();
+        fog_box->set_name("fog box");
+        fog_box->set_primitive_count(1);
+        fog_box->set_bounding_box_program(ctx.create_program(LUCENT_PROGRAM(fog_box_bounds)));
+        fog_box->set_intersection_program(ctx.create_program(LUCENT_PROGRAM(fog_box_intersect)));
+        auto instance = ctx.create_geometry_instance();
+        instance->set_geometry(fog_box);
+        // On the instance: its intersection and its closest hit both read them.
+        (*instance)["box_min"] = make_float3(-kFloorHalf, 0.0f, -kFloorHalf);
+        (*instance)["box_max"] = make_float3(kFloorHalf, options.height, kFloorHalf);
+        instance->add_material(fog_material);
+        top->add_child(instance);
+    }
+    ctx["top_object"] = top;
+
+    auto miss = ctx.create_program(LUCENT_PROGRAM(fog_environment));
+    DiffuseTextures textures(ctx);  // a white texel stands in when there is no map
+    if (options.environment.empty()) {
+        (*miss)["environment"] = textures("");
+        (*miss)["has_environment"] = 0u;
+    } else {
+        const scene::TextureImage map = scene::load_linear_image(options.environment);
+        auto texels = ctx.create_buffer<float4>(BufferType::kInput, map.width, map.height);
+        texels->upload(map.texels);
+        auto sampler = ctx.create_texture_sampler();
+        sampler->set_buffer(texels);
+        sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kClampToEdge);
+        sampler->set_filter(FilterMode::kLinear);
+        (*miss)["environment"] = sampler;
+        (*miss)["has_environment"] = 1u;
+    }
+    ctx.set_miss_program(fog::kRadianceRay, miss);
+
+    m->camera = ctx.create_buffer<fog::CameraFrame>(BufferType::kInput, 1);
+    m->output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
+    auto camera = ctx.create_program(LUCENT_PROGRAM(fog_camera));
+    (*camera)["camera"] = m->camera;
+    (*camera)["output"] = m->output;
+    ctx.set_ray_generation_program(0, camera);
+}
+
+FogScene::~FogScene() = default;
+
+const LaunchReport& FogScene::render(float orbit_degrees) {
+    const float a = (orbit_degrees + kOrbitStartDegrees) * 3.14159265f / 180.0f;
+    scene::Camera camera;
+    const float r = m->options.eye_distance;
+    camera.eye = make_float3(r * std::sin(a), m->options.eye_height, -r * std::cos(a));
+    camera.look = kLookAt;
+    camera.fov_degrees = 45.0f;
+    const PinholeFrame frame = pinhole_frame(camera, float(m->width) / float(m->height));
+    // The camera is data in a buffer: moving it re-uploads 48 bytes, it recompiles nothing.
+    m->camera->upload(std::vector<fog::CameraFrame>{{camera.eye, frame.U, frame.V, frame.W}});
+    m->ctx.launch(0, m->width, m->height);
+    return m->ctx.last_launch();
+}
+
+Context& FogScene::context() { return m->ctx; }
+const Buffer& FogScene::output() const { return *m->output; }
+
+}  // namespace lucent::samples

@@ -1,0 +1,49 @@
+// The fog sample's scene, built once and rendered for any camera on its orbit: the OptiX SDK
+// tutorial's floor, box and crystal, point lights, the environment, and the fog box
+// (Sebald, seed §3.1). The sample renders one frame; `lucent bench fog` renders a path.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "lucent/context.h"
+#include "samples/sample.h"
+
+namespace lucent::samples {
+
+struct FogOptions {
+    bool fog = true;
+    float step = 0.05f;         // march step
+    float height = 2.0f;        // of the fog box over the floor
+    float density = 1.5f;       // extinction per unit at full noise, bottom of the box
+    float noise_scale = 3.0f;   // gradient noise lattice, scene units
+    bool noise = true;          // false: uniform density (tests)
+    bool falloff = true;        // false: no linear falloff in y (tests)
+    unsigned rounds = 2;        // TEA rounds of the noise (the paper: 2)
+    unsigned device = 0, seed = 0;  // the TEA key's inputs (Sebald Fig. 4)
+    unsigned max_depth = 5;
+    std::string environment;  // .hdr or .exr; empty: the procedural sky
+    float orbit_degrees = 0;  // the camera's place on its orbit around the scene
+    float eye_height = 9.0f;
+    float eye_distance = 20.0f;  // the orbit's radius, in x and z
+};
+
+/// Reads FogOptions from a sample's --set values (the fog SampleInfo's options).
+FogOptions read_fog_options(const RenderSettings& settings, const SampleInfo& info);
+
+class FogScene {
+  public:
+    FogScene(const FogOptions& options, unsigned width, unsigned height, const ContextOptions& ctx);
+    ~FogScene();
+
+    /// Places the camera at `orbit_degrees` around the scene and launches; returns the report.
+    const LaunchReport& render(float orbit_degrees);
+    Context& context();
+    const Buffer& output() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> m;
+};
+
+}  // namespace lucent::samples
