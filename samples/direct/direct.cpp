@@ -55,13 +55,11 @@ RenderResult render_direct(const RenderSettings& settings) {
 
     DiffuseTextures texture_for(ctx);
     auto lambert = ctx.create_program(LUCENT_PROGRAM(direct_lambert));
-    auto blocked = ctx.create_program(LUCENT_PROGRAM(direct_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(direct::kRadianceRay, lambert);
-        material->set_any_hit(direct::kShadowRay, blocked);
         (*material)["Kd"] = m.diffuse + make_float3(ambient);
         (*material)["Ke"] = m.emission;
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);

@@ -10,7 +10,7 @@ namespace direct {
 struct RadiancePayload {
     float3 color;
 };
-struct ShadowPayload {
+struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occluded() uses none
     float visible;
 };
 
@@ -63,13 +63,14 @@ struct MissRecord {
 };
 LUCENT_RECORD(MissRecord, background)
 
-/// Fraction of light from `p` that reaches `target` (0 or 1: opaque any-hit).
+/// Fraction of light from `p` that reaches `target`: 0 or 1, an occlusion query (every
+/// surface is opaque). The ray stops just short of the target, so an emitter's own surface
+/// does not shadow it.
 LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 p, float3 target) {
-    float3 d = target - p;
-    ShadowPayload s{1.0f};
-    // The ray stops just short of the target, so an emitter's own surface does not shadow it.
-    lucent::trace(rec.top_object, lucent::make_ray(p, d, kShadowRay, rec.scene_epsilon, 0.999f), s);
-    return s.visible;
+    return lucent::occluded(rec.top_object,
+                            lucent::make_ray(p, target - p, kShadowRay, rec.scene_epsilon, 0.999f))
+               ? 0.0f
+               : 1.0f;
 }
 
 }  // namespace direct
@@ -148,8 +149,4 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
     prd.color = color;
 }
 
-LUCENT_ANY_HIT(direct_shadow_blocked, lucent::NoRecord, direct::ShadowPayload,
-               direct::HitAttributes) {
-    prd.visible = 0.0f;
-    lucent::terminate_ray();
-}
+

@@ -108,14 +108,12 @@ RenderResult render_igi(const RenderSettings& settings) {
 
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi_particle_hit));
-    auto blocked = ctx.create_program(LUCENT_PROGRAM(igi_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(igi::kRadianceRay, surface);
         material->set_closest_hit(igi::kParticleRay, particle);
-        material->set_any_hit(igi::kShadowRay, blocked);
         (*material)["Kd"] = m.diffuse;
         (*material)["Ks"] = m.specular;
         (*material)["Ke"] = m.emission;
@@ -128,9 +126,8 @@ RenderResult render_igi(const RenderSettings& settings) {
     auto boxes = ctx.create_geometry_group();
     auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_bounds));
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_intersect));
-    auto box_material = ctx.create_material();
+    auto box_material = ctx.create_material();  // occlusion queries run no hit programs
     box_material->set_name("box");
-    box_material->set_any_hit(igi::kVplShadowRay, blocked);
     for (const auto& mesh : input.meshes) {
         const MeshBuffers buffers = upload_mesh(ctx, mesh);
         auto triangles = ctx.create_geometry_triangles();

@@ -67,6 +67,8 @@ struct RadiancePayload {
     float3 position, normal, albedo;
     float distance;  // along the primary ray; < 0: it missed
 };
+/// The shadow ray types' declared payload: their rays go through lucent::occluded(), which
+/// runs no program and carries none.
 struct ShadowPayload {
     float visible;
 };
@@ -214,11 +216,10 @@ LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
                           rec.imperfect_visibility, rec.vpl_shadow_object};
 }
 
+/// Nothing opaque between `from` and just short of `to`: an occlusion query, no programs.
 LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float epsilon, float3 from,
                               float3 to) {
-    ShadowPayload s{1.0f};
-    lucent::trace(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f), s);
-    return s.visible > 0.0f;
+    return !lucent::occluded(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f));
 }
 
 /// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (seed §4.1), against
@@ -373,11 +374,6 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
 
 LUCENT_MISS(igi_miss, lucent::NoRecord, igi::RadiancePayload) {
     prd.color = make_float3(0.0f);
-}
-
-LUCENT_ANY_HIT(igi_shadow_blocked, lucent::NoRecord, igi::ShadowPayload, igi::HitAttributes) {
-    prd.visible = 0.0f;
-    lucent::terminate_ray();
 }
 
 LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {

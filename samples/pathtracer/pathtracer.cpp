@@ -107,13 +107,11 @@ RenderResult render_pathtracer(const RenderSettings& settings) {
         ctx.create_program(LUCENT_PROGRAM(pt_dielectric)),
         ctx.create_program(LUCENT_PROGRAM(pt_coated)),
     };
-    auto blocked = ctx.create_program(LUCENT_PROGRAM(pt_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(pathtracer::kRadianceRay, closest_hits[int(m.kind)]);
-        material->set_any_hit(pathtracer::kShadowRay, blocked);
         (*material)["Kd"] = m.diffuse;
         (*material)["Ks"] = m.specular;
         (*material)["Ke"] = m.emission;

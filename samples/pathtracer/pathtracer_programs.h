@@ -37,7 +37,7 @@ struct PathPayload {
     float pdf;        // out: solid-angle pdf of the next direction
     float3 origin, direction;  // out: the next ray
 };
-struct ShadowPayload {
+struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occluded() uses none
     float visible;
 };
 
@@ -127,14 +127,13 @@ struct MeshRecord {
 };
 LUCENT_RECORD(MeshRecord, positions, triangles)
 
+/// Nothing between `from` and `distance` along `direction`: an occlusion query (every
+/// surface opaque, no programs run).
 LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 direction,
                                  float distance) {
-    ShadowPayload s{1.0f};
-    lucent::trace(
+    return !lucent::occluded(
         rec.top_object,
-        lucent::make_ray(from, direction, kShadowRay, 0.0f, distance - 2.0f * rec.scene_epsilon),
-        s);
-    return s.visible > 0.0f;
+        lucent::make_ray(from, direction, kShadowRay, 0.0f, distance - 2.0f * rec.scene_epsilon));
 }
 
 /// Next-event estimation at p: one point on one area light chosen uniformly, weighted by the
@@ -294,12 +293,6 @@ LUCENT_CLOSEST_HIT(pt_dielectric, pathtracer::SurfaceRecord, pathtracer::PathPay
 LUCENT_CLOSEST_HIT(pt_coated, pathtracer::SurfaceRecord, pathtracer::PathPayload,
                    pathtracer::HitAttributes) {
     pathtracer::shade<pathtracer::kCoated>(rec, prd, attr);
-}
-
-LUCENT_ANY_HIT(pt_shadow_blocked, lucent::NoRecord, pathtracer::ShadowPayload,
-               pathtracer::HitAttributes) {
-    prd.visible = 0.0f;
-    lucent::terminate_ray();
 }
 
 LUCENT_ATTRIBUTE(pt_attributes, pathtracer::MeshRecord, pathtracer::HitAttributes) {

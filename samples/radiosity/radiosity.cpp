@@ -102,14 +102,12 @@ RenderResult render_radiosity(const RenderSettings& settings) {
 
     DiffuseTextures texture_for(ctx);
     auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity_surface));
-    auto blocked = ctx.create_program(LUCENT_PROGRAM(radiosity_shadow_blocked));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(radiosity::kRadianceRay, surface);
         material->set_closest_hit(radiosity::kPhotonRay, surface);
-        material->set_any_hit(radiosity::kShadowRay, blocked);
         (*material)["Kd"] = m.diffuse;
         (*material)["Ke"] = m.emission;
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);

@@ -41,7 +41,7 @@ struct SurfacePayload {  // radiance and photon rays: what was hit
     float3 position, normal, albedo, emission;
     float distance;  // < 0: missed
 };
-struct ShadowPayload {
+struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occluded() uses none
     float visible;
 };
 
@@ -116,11 +116,10 @@ LUCENT_RECORD(ShadeRecord, eye, gbuffer_position, gbuffer_normal, gbuffer_albedo
               gbuffer_emission, output, area_lights, area_samples, vpls, gi, vpl_shadows,
               show_vpls, clamp_distance, dot_radius, scene_epsilon, top_object)
 
+/// Nothing between `from` and just short of `to`: an occlusion query, no programs.
 LUCENT_HD inline bool visible(const ShadeRecord& rec, float3 from, float3 to) {
-    ShadowPayload s{1.0f};
-    lucent::trace(rec.top_object,
-                  lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f), s);
-    return s.visible > 0.0f;
+    return !lucent::occluded(rec.top_object,
+                             lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f));
 }
 
 LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
@@ -246,12 +245,6 @@ LUCENT_CLOSEST_HIT(radiosity_surface, radiosity::SurfaceRecord, radiosity::Surfa
     prd.albedo = rec.Kd * texel;
     prd.emission = rec.Ke;
     prd.distance = lucent::t_hit();
-}
-
-LUCENT_ANY_HIT(radiosity_shadow_blocked, lucent::NoRecord, radiosity::ShadowPayload,
-               radiosity::HitAttributes) {
-    prd.visible = 0.0f;
-    lucent::terminate_ray();
 }
 
 LUCENT_ATTRIBUTE(radiosity_attributes, radiosity::MeshRecord, radiosity::HitAttributes) {

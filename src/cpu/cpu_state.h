@@ -51,6 +51,7 @@ struct TraceFrame {
     float closest = 0;  // upper end of the ray interval: shrinks with each committed hit
     bool has_hit = false;
     bool terminated = false;
+    bool occlusion = false;  // occluded(): the first intersection ends it, no programs run
     HitState hit;
     // Traversal position, for intersection and any-hit programs.
     const core::CompiledInstance* instance = nullptr;
@@ -85,5 +86,7 @@ void set_thread_state(ThreadState* state);
 
 /// Runs one trace (the device API's trace()).
 void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const void* payload_tag);
+/// occluded() of the device API.
+bool occluded(ThreadState& ts, Handle root, const Ray& ray);
 
 }  // namespace lucent::cpu

@@ -107,6 +107,10 @@ unsigned primitive_index() {
     return f->context == ProgramContext::kClosestHit ? f->hit.prim : f->prim;
 }
 
+bool occluded(Handle root, const Ray& ray) {
+    return cpu::occluded(cpu::thread_state(), root, ray);
+}
+
 bool potential_intersection(float t) {
     TraceFrame* f = cpu::thread_state().current();
     if (!f || f->context != ProgramContext::kIntersection) return false;

@@ -101,6 +101,11 @@ class Traverser {
         const float tmin = m_frame.world_ray.tmin;
         if (ga.triangles_only) {
             accel::TriangleHit hit;
+            if (m_frame.occlusion) {
+                if (ga.triangles.occluded(origin, direction, tmin, m_frame.closest))
+                    m_frame.has_hit = m_frame.terminated = true;
+                return;
+            }
             if (!n.any_hit_for_ray_type[m_frame.ray_type]) {
                 if (ga.triangles.intersect(origin, direction, tmin, m_frame.closest, hit))
                     commit_triangle(n, hit.prim, hit.t, make_float2(hit.u, hit.v));
@@ -181,6 +186,10 @@ class Traverser {
 
     bool triangle_candidate(const CompiledNode& n, unsigned, size_t k, unsigned local, float t,
                             float2 bary) {
+        if (m_frame.occlusion) {  // any intersection answers the query
+            m_frame.has_hit = m_frame.terminated = true;
+            return true;
+        }
         unsigned instance_index = n.instances[k];
         const CompiledInstance& inst = m_scene.instances[instance_index];
         unsigned material = inst.material_indices ? inst.material_indices[local] : 0u;
@@ -296,6 +305,10 @@ bool report_candidate(ThreadState& ts, unsigned material) {
     const CompiledInstance& inst = *f->instance;
     if (material >= inst.materials.size())
         throw ProgramException{kExceptionMaterialIndexOutOfRange, material};
+    if (f->occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
+        f->has_hit = f->terminated = true;
+        return true;
+    }
     const core::CompiledProgram& any_hit = inst.materials[material].any_hit[f->ray_type];
     if (any_hit && !Traverser::run_any_hit(*f, any_hit)) return false;
     Traverser::commit(*f, f->instance_index, f->prim, f->candidate_t, material);
@@ -321,6 +334,7 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
     frame.closest = ray.tmax;
     frame.has_hit = false;
     frame.terminated = false;
+    frame.occlusion = false;
     frame.transformed = false;
     frame.candidate_open = false;
     frame.to_world = frame.to_object = kIdentity;
@@ -359,6 +373,39 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
         miss.entry<MissFn>()(miss.rec(), payload);
     }
     --ts.depth;
+}
+
+bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
+    const CompiledScene& scene = *ts.scene;
+    if (ray.ray_type >= scene.ray_types.size())
+        throw ProgramException{kExceptionInvalidRayType, ray.ray_type};
+    if (root.index >= scene.nodes.size())
+        throw ProgramException{kExceptionInvalidHandle, root.index};
+    // A GeometryGroup of triangles (the common shadow root): the BVH's any-hit traversal.
+    const CompiledNode& root_node = scene.nodes[root.index];
+    if (root_node.kind == NodeKind::kGeometryGroup && root_node.geometry &&
+        root_node.geometry->triangles_only)
+        return root_node.geometry->triangles.occluded(ray.origin, ray.direction, ray.tmin,
+                                                       ray.tmax);
+    // Anything else needs a frame: intersection programs and selectors run in it.
+    if (ts.depth >= scene.max_depth) throw ProgramException{kExceptionStackOverflow, ts.depth + 1};
+    TraceFrame& frame = ts.frames[ts.depth++];
+    frame.world_ray = ray;
+    frame.object_ray = ray;
+    frame.payload = nullptr;
+    frame.ray_type = ray.ray_type;
+    frame.closest = ray.tmax;
+    frame.has_hit = false;
+    frame.terminated = false;
+    frame.occlusion = true;
+    frame.transformed = false;
+    frame.candidate_open = false;
+    frame.to_world = frame.to_object = kIdentity;
+    frame.context = ProgramContext::kIntersection;
+    Traverser(ts, frame).node(root.index, ray.origin, ray.direction);
+    frame.occlusion = false;
+    --ts.depth;
+    return frame.has_hit;
 }
 
 }  // namespace lucent::cpu

@@ -53,6 +53,16 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 #endif
 }
 
+/// A shadow query: true when anything in the graph below `root` intersects `ray` within
+/// (tmin, tmax). No program runs but intersection programs: every primitive counts as
+/// opaque (any-hit programs are skipped), there is no closest hit and no miss, and traversal
+/// stops at the first intersection found (OptiX's terminate-on-first-hit with any-hit
+/// disabled). `ray.ray_type` must be a valid ray type; selectors' visit programs see it.
+/// Use it where a shadow any-hit would only say "blocked"; shadows that attenuate (glass)
+/// need trace() with an any-hit program. Much cheaper than trace(): on a GeometryGroup of
+/// triangles it is the bare any-hit traversal of the BVH.
+LUCENT_HD bool occluded(Handle root, const Ray& ray);
+
 /// In an intersection program: is t inside the ray's current interval?
 LUCENT_HD bool potential_intersection(float t);
 /// In an intersection program, after potential_intersection(t) returned true and the

@@ -82,6 +82,7 @@ struct Frame {
     float closest;
     unsigned context;
     bool has_hit, terminated, candidate_open, ignore_requested, terminate_requested;
+    bool occlusion;  // occluded(): the first intersection ends it, no programs run
     // committed hit
     float hit_t;
     unsigned hit_instance, hit_prim, hit_material;

@@ -84,6 +84,10 @@ __device__ inline bool run_any_hit(Frame& f, ProgramRef any) {
 /// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
 __device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, unsigned prim, float t,
                                           float2 bary) {
+    if (f.occlusion) {  // occluded(): any intersection answers the query
+        f.has_hit = f.terminated = true;
+        return true;
+    }
     const GpuInstance& inst = params.instances[instance_index];
     unsigned material = inst.material_indices ? inst.material_indices[prim] : 0u;
     ProgramRef any = material_slot(inst, material, f.ray_type).any;
@@ -144,6 +148,11 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
     if (ga.triangles_only) {
+        if (f.occlusion) {
+            if (gpu_bvh_occluded(ga.triangles, origin, direction, tmin, f.closest))
+                f.has_hit = f.terminated = true;
+            return;
+        }
         GpuHit hit;
         if (!((ga.any_hit_mask >> f.ray_type) & 1u)) {
             if (gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit)) {
@@ -324,6 +333,7 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
     f.closest = ray.tmax;
     f.has_hit = false;
     f.terminated = false;
+    f.occlusion = false;
     f.candidate_open = false;
     f.context = kCtxIntersection;
 #if LUCENT_GPU_TRANSFORMS
@@ -380,6 +390,57 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
     s.frame = outer;
 }
 
+/// occluded() of the device API. A GeometryGroup of triangles needs no frame at all: the
+/// BVH's any-hit traversal answers; other roots are traversed in an occlusion frame.
+__device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
+    ThreadState& s = self();
+    if (s.exception_code) return false;
+    if (ray.ray_type >= params.ray_type_count) {
+        detail::raise_exception(kExceptionInvalidRayType, ray.ray_type);
+        return false;
+    }
+    if (root.index >= params.node_count) {
+        detail::raise_exception(kExceptionInvalidHandle, root.index);
+        return false;
+    }
+    const GpuNode& root_node = params.nodes[root.index];
+#if LUCENT_GPU_TRIANGLE_GROUPS
+    if (root_node.kind == kGpuGeometryGroup && params.accels[root_node.accel].triangles_only)
+        return gpu_bvh_occluded(params.accels[root_node.accel].triangles, ray.origin,
+                                ray.direction, ray.tmin, ray.tmax);
+#endif
+    if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
+        detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
+        return false;
+    }
+    Frame f;
+    f.world_ray = ray;
+#if LUCENT_GPU_TRANSFORMS
+    f.object_ray = ray;
+    f.transformed = false;
+#endif
+    f.payload = nullptr;
+    f.ray_type = ray.ray_type;
+    f.closest = ray.tmax;
+    f.has_hit = false;
+    f.terminated = false;
+    f.occlusion = true;
+    f.candidate_open = false;
+    f.context = kCtxIntersection;
+    Frame* outer = s.frame;
+    s.frame = &f;
+    ++s.depth;
+#if LUCENT_GPU_NESTED
+    if (root_node.kind != kGpuGeometryGroup)
+        traverse_node(f, root.index, ray.origin, ray.direction);
+    else
+#endif
+        geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
+    --s.depth;
+    s.frame = outer;
+    return f.has_hit && !s.exception_code;
+}
+
 /// Records an exception in the slot of its code (slots are claimed with atomicCAS).
 __device__ inline void count_exception(int code, unsigned long long linear) {
     for (unsigned i = 0; i < kGpuExceptionSlots; ++i) {
@@ -402,6 +463,10 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 }
 }  // namespace detail
 
+LUCENT_HD bool occluded(Handle root, const Ray& ray) {
+    return gpu::occluded_ray(root, ray);
+}
+
 LUCENT_HD bool report_intersection(unsigned material) {
     gpu::Frame& f = *gpu::self().frame;
     if (f.context != gpu::kCtxIntersection || !f.candidate_open) return false;
@@ -410,6 +475,10 @@ LUCENT_HD bool report_intersection(unsigned material) {
     if (material >= inst.material_count) {
         detail::raise_exception(kExceptionMaterialIndexOutOfRange, material);
         return false;
+    }
+    if (f.occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
+        f.has_hit = f.terminated = true;
+        return true;
     }
     gpu::ProgramRef any = gpu::material_slot(inst, material, f.ray_type).any;
     if (any.id >= 0 && !gpu::run_any_hit(f, any)) return false;

@@ -1,0 +1,81 @@
+// lucent::occluded(): a shadow query that runs no hit programs. It must see triangles and
+// custom primitives under any graph (GeometryGroup, Group, Transform), respect the ray's
+// interval, and treat every primitive as opaque: any-hit programs are not run.
+#include "tests/test_support.h"
+#include "tests/programs/occlusion_programs.h"
+
+namespace {
+
+using namespace lucent;
+using namespace lucent_tests;
+
+class OcclusionTest : public testing::Test {
+  protected:
+    OcclusionTest() : ctx(test_context_options()) {
+        ctx.set_entry_point_count(1);
+        ctx.set_ray_type<TestPayload>(0, "radiance");
+        ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(common_miss)));
+        ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(occlusion_cast)));
+    }
+
+    /// occluded() for each query against `top`; `traced` gets trace()'s payloads.
+    std::vector<unsigned> query(std::shared_ptr<Node> top, const std::vector<OcclusionQuery>& q,
+                                std::vector<TestPayload>* traced = nullptr) {
+        auto results = ctx.create_buffer<unsigned>(BufferType::kOutput, unsigned(q.size()));
+        auto payloads = ctx.create_buffer<TestPayload>(BufferType::kOutput, unsigned(q.size()));
+        auto gen = ctx.ray_generation_program(0);
+        (*gen)["top"] = top;
+        (*gen)["queries"] = input_buffer(ctx, q);
+        (*gen)["occluded"] = results;
+        (*gen)["traced"] = payloads;
+        ctx.launch(0, unsigned(q.size()));
+        EXPECT_EQ(ctx.last_launch().exception_count(), 0u) << ctx.last_launch().summary();
+        if (traced) *traced = read_buffer<TestPayload>(*payloads);
+        return read_buffer<unsigned>(*results);
+    }
+
+    Context ctx;
+};
+
+const float3 kOrigin = make_float3(0, 0, 0), kForward = make_float3(0, 0, 1);
+
+TEST_F(OcclusionTest, TrianglesWithinTheIntervalOcclude) {
+    auto square = make_instance(ctx, make_triangles(ctx, square_at(5.0f)),
+                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
+    auto top = make_geometry_group(ctx, {square});
+    const auto r = query(top, {{kOrigin, kForward, 10.0f},     // through the square
+                               {kOrigin, kForward, 4.0f},      // stops short of it
+                               {kOrigin, -kForward, 10.0f},    // away from it
+                               {make_float3(20, 0, 0), kForward, 10.0f}});  // beside it
+    EXPECT_EQ(r, (std::vector<unsigned>{1, 0, 0, 0}));
+}
+
+TEST_F(OcclusionTest, CustomPrimitivesUnderGroupsAndTransformsOcclude) {
+    auto sphere = make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
+                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 2));
+    auto moved = ctx.create_transform();
+    moved->set_matrix(translation(3, 0, 0));
+    moved->set_child(make_geometry_group(ctx, {sphere}));
+    auto top = ctx.create_group();
+    top->add_child(moved);
+    const auto r = query(top, {{kOrigin, normalize(make_float3(3, 0, 5)), 10.0f},  // the sphere
+                               {kOrigin, kForward, 10.0f},  // where it was before the move
+                               {kOrigin, normalize(make_float3(3, 0, 5)), 3.0f}});  // short
+    EXPECT_EQ(r, (std::vector<unsigned>{1, 0, 0}));
+}
+
+TEST_F(OcclusionTest, AnyHitProgramsAreNotRun) {
+    // An any-hit that ignores everything: trace() passes through to the miss program, the
+    // occlusion query still sees the square (every primitive counts as opaque).
+    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 3);
+    material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
+    auto top = make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5.0f)), material)});
+    std::vector<TestPayload> traced;
+    const auto r = query(top, {{kOrigin, kForward, 10.0f}}, &traced);
+    EXPECT_EQ(r, (std::vector<unsigned>{1}));
+    EXPECT_EQ(traced[0].hit, 0) << "trace() ran the any-hit, which ignored the square";
+    EXPECT_GE(traced[0].anyhit_count, 1u);
+}
+
+}  // namespace

@@ -1,0 +1,38 @@
+// Programs of the occlusion-query tests: a ray generation that asks lucent::occluded() for
+// each listed ray segment, and an any-hit that ignores every intersection (which occluded()
+// must never run).
+#pragma once
+
+#include "tests/programs/common.h"
+
+namespace lucent_tests {
+
+struct OcclusionQuery {
+    float3 origin, direction;
+    float tmax;
+};
+
+struct OcclusionRecord {
+    Handle top;
+    BufferView<OcclusionQuery> queries;
+    BufferView<unsigned> occluded;  // 1: something in (tmin, tmax); 0: nothing
+    BufferView<TestPayload> traced;  // the same segment through trace(), for comparison
+};
+LUCENT_RECORD(OcclusionRecord, top, queries, occluded, traced)
+
+LUCENT_RAY_GENERATION(occlusion_cast, OcclusionRecord) {
+    const unsigned i = launch_index().x;
+    const OcclusionQuery q = rec.queries[i];
+    const Ray ray = make_ray(q.origin, q.direction, 0, 1e-4f, q.tmax);
+    rec.occluded[i] = occluded(rec.top, ray) ? 1u : 0u;
+    TestPayload p = make_test_payload();
+    trace(rec.top, ray, p);
+    rec.traced[i] = p;
+}
+
+LUCENT_ANY_HIT(occlusion_ignore_all, NoRecord, TestPayload, TriangleAttributes) {
+    ++prd.anyhit_count;
+    ignore_intersection();
+}
+
+}  // namespace lucent_tests
