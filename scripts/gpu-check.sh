@@ -2,7 +2,7 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render samples tests igi pathtracer tea sanitizer bench sweep profile hotspots
+# with steps: render samples tests igi pathtracer fog tea sanitizer bench sweep profile hotspots
 # (default: render tests sanitizer bench).
 set -uo pipefail
 out=${OUT:-gpu-out}
@@ -73,7 +73,8 @@ samples)
     for args in "igi --size 512x512 --set vpls=64" \
                 "igi --size 512x512 --set downsample=4 --set interleave=3 --set imperfect_visibility=1" \
                 "radiosity --size 512x512" "direct --size 512x512" \
-                "pathtracer --size 256x256 --spp 64"; do
+                "pathtracer --size 256x256 --spp 64" "fog --size 512x384" \
+                "fog --size 512x384 --set eye_height=1.2 --set eye_distance=9"; do
         name=$(echo "$args" | tr ' =' '__' | cut -c1-60)
         $R $B/bin/lucent render --sample $args --backend cuda --out "$out/$name.cuda.png" | tail -12
         $R $B/bin/lucent render --sample $args --backend cpu --out "$out/$name.cpu.png" > /dev/null
@@ -95,6 +96,11 @@ pathtracer)
     $R $B/bin/lucent render --sample pathtracer --scene cornell --backend cuda --size 1024x1024 --spp 256 --out "$out/pathtracer_cornell.png"
     $R $B/bin/lucent render --sample pathtracer --scene cornell-materials --backend cuda --size 1024x1024 --spp 256 --out "$out/pathtracer_materials.png"
     ;;
+fog)
+    echo "== bench fog: the tutorial scene at 1024x768, moving camera (Sebald Table 1)"
+    $R $B/bin/lucent bench fog --backend cuda --frames 100
+    $R $B/bin/lucent bench fog --backend cuda --frames 100 --json > "$out/bench_fog.json"
+    ;;
 tea)
     echo "== bench tea on the GPU"
     $R $B/bin/lucent bench tea --backend cuda
@@ -110,6 +116,16 @@ profile)
     ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
         $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
+    ;;
+profile_igi)
+    echo "== ncu: the IGI indirect pass (canonical, 180 VPLs) on Sponza at 800x600"
+    # Launches per frame: VPL generation, direct, indirect, composition; skip frame 1 and
+    # the first two launches of frame 2.
+    LUCENT_SCENE_PATH=/work/shared/scenes ncu --kernel-name lucent_megakernel --launch-skip 6 \
+        --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
+        --section WarpStateStats --section MemoryWorkloadAnalysis \
+        $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
+        --size 800x600 --repeat 3 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -90
     ;;
 hotspots)
     echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"

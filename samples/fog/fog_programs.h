@@ -172,18 +172,6 @@ LUCENT_HD inline float2 box_span(float3 lo, float3 hi, float3 o, float3 d) {
     return make_float2(lc_max(near.x, lc_max(near.y, near.z)), lc_min(far.x, lc_min(far.y, far.z)));
 }
 
-/// Fog density at p: gradient noise in x, z (TEA, Sebald §3.2) times the linear falloff from
-/// the bottom of the box (full) to its top (none).
-LUCENT_HD inline float density_at(const FogRecord& r, float3 p, lucent::GradientCell& cell) {
-    float d = r.density;
-    if (r.noise)
-        d *= lucent::tea_gradient_noise(p.x / r.noise_scale, p.z / r.noise_scale, r.noise_key,
-                                        r.rounds, cell);
-    if (r.falloff)
-        d *= clampf((r.box_max.y - p.y) / (r.box_max.y - r.box_min.y), 0.0f, 1.0f);
-    return d;
-}
-
 }  // namespace fog
 
 // ---- camera, miss ------------------------------------------------------------------------
@@ -359,14 +347,33 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
     const unsigned steps = distance > 0.0f ? unsigned(ceilf(distance / rec.step)) : 0u;
     const float dt = steps ? distance / float(steps) : 0.0f;
     const float3 d = ray.direction * (1.0f / speed);
-    const float3 start = ray.origin + t_start * ray.direction;
-    float optical_depth = 0.0f;
-    lucent::GradientCell cell;
+    const float3 start = ray.origin + t_start * ray.direction + (0.5f * dt) * d;
+    // Density = density x noise(x / scale, z / scale) x falloff(y), with falloff falling
+    // linearly from 1 at the bottom of the box to 0 at its top. Every term is linear in the
+    // step index, so the march only adds increments.
+    const float inv_scale = 1.0f / rec.noise_scale;
+    float nx = start.x * inv_scale, nz = start.z * inv_scale;
+    const float dnx = dt * d.x * inv_scale, dnz = dt * d.z * inv_scale;
+    const float inv_height = 1.0f / (rec.box_max.y - rec.box_min.y);
+    float fall = (rec.box_max.y - start.y) * inv_height;
+    const float dfall = -dt * d.y * inv_height;
+    const uint4 key = rec.noise_key;
+    const unsigned rounds = rec.rounds;
+    const bool noise = rec.noise != 0u, falloff = rec.falloff != 0u;
     // Past an optical depth of 9.2 less than 1e-4 of what lies behind shows through.
-    for (unsigned s = 0; s < steps && optical_depth < 9.2f; ++s) {
-        const float3 p = start + ((float(s) + 0.5f) * dt) * d;
-        optical_depth += fog::density_at(rec, p, cell) * dt;
+    const float limit = rec.density * dt > 0.0f ? 9.2f / (rec.density * dt) : 3.4e38f;
+    float weight_sum = 0.0f;  // optical depth / (density dt)
+    lucent::GradientCell cell;
+    for (unsigned s = 0; s < steps && weight_sum < limit; ++s) {
+        float w = 1.0f;
+        if (noise) w = lucent::tea_gradient_noise(nx, nz, key, rounds, cell);
+        if (falloff) w *= clampf(fall, 0.0f, 1.0f);
+        weight_sum += w;
+        nx += dnx;
+        nz += dnz;
+        fall += dfall;
     }
+    const float optical_depth = weight_sum * rec.density * dt;
     const float transmittance = expf(-optical_depth);
     prd.color = rec.fog_color * (1.0f - transmittance) + behind.color * transmittance;
     prd.distance = behind.distance;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <set>
+#include <string_view>
 #include <sstream>
 
 #include "cuda/embedded_sources.h"
@@ -151,22 +152,9 @@ void generate_callables(std::ostringstream& out, const std::vector<const Program
 }  // namespace
 
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape) {
-    std::ostringstream out;
-    out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
-        << "#define LUCENT_GPU_GROUPS " << shape.groups << "\n"
-        << "#define LUCENT_GPU_TRANSFORMS " << shape.transforms << "\n"
-        << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
-        << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
-        << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
-        << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
-        << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
-        << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
-        << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
-        << "#include \"lucent_gpu/runtime.cuh\"\n"
-        << "#include \"lucent_gpu/invoke.cuh\"\n";
-
     // The program modules actually bound, each once.
     std::set<std::string> modules;
+    bool occlusion = false;  // some bound module asks occluded(): keep its traversal checks
     for (size_t k = 0; k <= size_t(ProgramKind::kCallable); ++k)
         for (const ProgramDesc* desc : table.programs(ProgramKind(k))) {
             const EmbeddedSource* module = find_embedded_source(desc->file);
@@ -177,7 +165,24 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
                             "modules in samples/<name>/<name>_programs.h (embedded at build "
                             "time) or use --backend cpu");
             modules.insert(std::string(module->name));
+            occlusion = occlusion || std::string_view(module->text).find("occluded(") !=
+                                         std::string_view::npos;
         }
+
+    std::ostringstream out;
+    out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
+        << "#define LUCENT_GPU_GROUPS " << shape.groups << "\n"
+        << "#define LUCENT_GPU_TRANSFORMS " << shape.transforms << "\n"
+        << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
+        << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
+        << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
+        << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
+        << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
+        << "#define LUCENT_GPU_OCCLUSION " << occlusion << "\n"
+        << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
+        << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
+        << "#include \"lucent_gpu/runtime.cuh\"\n"
+        << "#include \"lucent_gpu/invoke.cuh\"\n";
     for (const std::string& m : modules) out << "#include \"" << m << "\"\n";
 
     out << "\nnamespace lucent::gpu {\n";

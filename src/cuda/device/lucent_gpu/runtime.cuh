@@ -23,6 +23,9 @@
 #ifndef LUCENT_GPU_TILES
 #define LUCENT_GPU_TILES 1  // warps take 8x4 tiles of 2D launches
 #endif
+#ifndef LUCENT_GPU_OCCLUSION
+#define LUCENT_GPU_OCCLUSION 1  // some program calls occluded(): traversal checks for it
+#endif
 #ifndef LUCENT_GPU_MIN_BLOCKS
 #define LUCENT_GPU_MIN_BLOCKS 1  // __launch_bounds__ hint: blocks per SM to fit in registers
 #endif

@@ -84,10 +84,12 @@ __device__ inline bool run_any_hit(Frame& f, ProgramRef any) {
 /// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
 __device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, unsigned prim, float t,
                                           float2 bary) {
+#if LUCENT_GPU_OCCLUSION
     if (f.occlusion) {  // occluded(): any intersection answers the query
         f.has_hit = f.terminated = true;
         return true;
     }
+#endif
     const GpuInstance& inst = params.instances[instance_index];
     unsigned material = inst.material_indices ? inst.material_indices[prim] : 0u;
     ProgramRef any = material_slot(inst, material, f.ray_type).any;
@@ -148,11 +150,13 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
     if (ga.triangles_only) {
+#if LUCENT_GPU_OCCLUSION
         if (f.occlusion) {
             if (gpu_bvh_occluded(ga.triangles, origin, direction, tmin, f.closest))
                 f.has_hit = f.terminated = true;
             return;
         }
+#endif
         GpuHit hit;
         if (!((ga.any_hit_mask >> f.ray_type) & 1u)) {
             if (gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit)) {
@@ -390,6 +394,7 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
     s.frame = outer;
 }
 
+#if LUCENT_GPU_OCCLUSION
 /// occluded() of the device API. A GeometryGroup of triangles needs no frame at all: the
 /// BVH's any-hit traversal answers; other roots are traversed in an occlusion frame.
 __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
@@ -440,6 +445,7 @@ __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
     s.frame = outer;
     return f.has_hit && !s.exception_code;
 }
+#endif  // LUCENT_GPU_OCCLUSION
 
 /// Records an exception in the slot of its code (slots are claimed with atomicCAS).
 __device__ inline void count_exception(int code, unsigned long long linear) {
@@ -463,9 +469,11 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 }
 }  // namespace detail
 
+#if LUCENT_GPU_OCCLUSION
 LUCENT_HD bool occluded(Handle root, const Ray& ray) {
     return gpu::occluded_ray(root, ray);
 }
+#endif
 
 LUCENT_HD bool report_intersection(unsigned material) {
     gpu::Frame& f = *gpu::self().frame;
@@ -476,10 +484,12 @@ LUCENT_HD bool report_intersection(unsigned material) {
         detail::raise_exception(kExceptionMaterialIndexOutOfRange, material);
         return false;
     }
+#if LUCENT_GPU_OCCLUSION
     if (f.occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
         f.has_hit = f.terminated = true;
         return true;
     }
+#endif
     gpu::ProgramRef any = gpu::material_slot(inst, material, f.ray_type).any;
     if (any.id >= 0 && !gpu::run_any_hit(f, any)) return false;
     gpu::commit(f, f.instance, f.prim, f.candidate_t, material);
