@@ -1,10 +1,13 @@
 // The CUDA backend (ARCHITECTURE §4): at launch, if the compiled scene changed shape,
 // generate the megakernel, compile it with NVRTC (or load it from the disk cache), load it
 // with the driver API and run it with persistent threads.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <memory>
+#include <utility>
 
 #include "core/backend.h"
 #include "cuda/cuda_backend.h"
@@ -18,6 +21,40 @@ namespace lucent::cuda {
 namespace {
 
 constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
+
+/// How the megakernel is launched: the share of the SM's on-chip memory given to shared
+/// memory (the rest is L1) and the persistent grid that share lets run at once.
+struct LaunchShape {
+    int carveout = 0;  // percent of the largest shared-memory configuration
+    int grid = 1;      // blocks: resident blocks per SM x SMs
+};
+
+/// The two shapes the backend chooses between for each entry point and launch size.
+/// Measured on the H100 (docs/performance.md): IGI, the path tracer and the fog run 2 to 2.7
+/// times faster with every block the registers allow resident; the Whitted sample, whose
+/// deep recursion keeps large trace frames in local memory, runs 1.2 times faster with one
+/// block per SM and all of L1 for them. Neither is right for every program, so the first
+/// launches try both.
+enum : int { kOccupancyFirst = 0, kL1First = 1 };
+
+/// Per entry point and launch size: launch 1 runs the occupancy-first shape (and warms up),
+/// launch 2 the L1-first, launch 3 the occupancy-first again; from then on, the faster of
+/// launches 2 and 3.
+struct ShapeTuning {
+    unsigned launches = 0;
+    double ms[2] = {0, 0};
+    int choice = -1;
+
+    int next_shape() const {
+        if (choice >= 0) return choice;
+        return launches == 1 ? kL1First : kOccupancyFirst;
+    }
+    void record(int shape, double kernel_ms) {
+        if (choice >= 0) return;
+        if (launches >= 1) ms[shape] = kernel_ms;
+        if (++launches == 3) choice = ms[kL1First] < ms[kOccupancyFirst] ? kL1First : kOccupancyFirst;
+    }
+};
 
 class CudaBackend final : public core::Backend {
   public:
@@ -70,7 +107,12 @@ class CudaBackend final : public core::Backend {
         m_exceptions.fill(0);
         p.work_counter = const_cast<unsigned long long*>(m_counter.as<unsigned long long>());
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
-        const unsigned threads = unsigned(m_grid) * kBlock;
+        // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
+        ShapeTuning& tuning = m_tuning[{entry, p.launch_count}];
+        const int shape = m_fixed_shape ? kOccupancyFirst : tuning.next_shape();
+        apply_shape(m_shapes[shape]);
+        const unsigned threads =
+            unsigned(std::max(m_shapes[0].grid, m_shapes[1].grid)) * kBlock;
         if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
             m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
@@ -81,7 +123,7 @@ class CudaBackend final : public core::Backend {
             check(m_driver.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
         }
         check(m_driver.cuEventRecord(m_start, nullptr), "cuEventRecord");
-        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_grid), 1, 1, kBlock, 1, 1, 0, nullptr,
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0, nullptr,
                                       nullptr, nullptr),
               "launch the megakernel");
         check(m_driver.cuEventRecord(m_stop, nullptr), "cuEventRecord");
@@ -89,6 +131,7 @@ class CudaBackend final : public core::Backend {
         float kernel_ms = 0;
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
+        if (!m_fixed_shape) tuning.record(shape, kernel_ms);
 
         std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
         m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
@@ -126,19 +169,29 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
                                          "_ZN6lucent3gpu6paramsE"),
               "find the launch parameters");
-        // The megakernel needs little shared memory but its trace frames and the call ABI's
-        // saved registers live in local memory: give L1 the largest share (ncu: most stalls
-        // were L1TEX waits). LUCENT_GPU_CARVEOUT=<percent of shared memory> overrides.
-        const char* carveout = std::getenv("LUCENT_GPU_CARVEOUT");
-        check(m_driver.cuFuncSetAttribute(m_kernel,
-                                          CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
-                                          carveout ? std::atoi(carveout) : 0),
-              "prefer L1 for the megakernel");
-        int blocks_per_sm = 0;
-        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks_per_sm, m_kernel, kBlock,
-                                                                   0),
-              "occupancy");
-        m_grid = std::max(1, blocks_per_sm) * m_sm_count;
+        // Two launch shapes (see LaunchShape and ShapeTuning). Occupancy first: as many
+        // blocks per SM as the registers allow, with just the shared memory they need (the
+        // runtime's per-thread state, 5 KB a block) and the rest as L1. L1 first: shared
+        // memory for one block, everything else L1 for the trace frames in local memory.
+        const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
+        m_fixed_shape = fixed != nullptr;
+        int static_shared = 0, reserved = 0, shared_per_sm = 0;
+        m_driver.cuFuncGetAttribute(&static_shared, CU_FUNC_ATTRIBUTE_SHARED_SIZE_BYTES, m_kernel);
+        m_driver.cuDeviceGetAttribute(&reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK,
+                                      m_device);
+        m_driver.cuDeviceGetAttribute(&shared_per_sm,
+                                      CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR,
+                                      m_device);
+        const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
+        const int needed = by_registers * (static_shared + reserved);
+        const int fit = shared_per_sm > 0
+                            ? std::min(100, (100 * needed + shared_per_sm - 1) / shared_per_sm + 1)
+                            : 100;
+        m_shapes[kOccupancyFirst] = {fixed ? std::atoi(fixed) : fit, 0};
+        m_shapes[kL1First] = {0, 0};
+        for (LaunchShape& shape : m_shapes) shape.grid = resident_blocks(shape.carveout) * m_sm_count;
+        m_applied = {-1, 0};
+        m_tuning.clear();
         // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
         size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
         check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
@@ -146,6 +199,26 @@ class CudaBackend final : public core::Backend {
     }
 
   private:
+    /// Blocks of the megakernel resident per SM with this carveout.
+    int resident_blocks(int carveout) {
+        check(m_driver.cuFuncSetAttribute(m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
+                                          carveout),
+              "set the shared memory carveout");
+        m_applied = {-1, 0};
+        int blocks = 0;
+        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, m_kernel, kBlock, 0),
+              "occupancy");
+        return std::max(1, blocks);
+    }
+
+    void apply_shape(const LaunchShape& shape) {
+        if (shape.carveout == m_applied.carveout) return;
+        check(m_driver.cuFuncSetAttribute(m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
+                                          shape.carveout),
+              "set the shared memory carveout");
+        m_applied = shape;
+    }
+
     const DriverApi& m_driver;
     CUdevice m_device = 0;
     CUcontext m_context = nullptr;
@@ -153,8 +226,11 @@ class CudaBackend final : public core::Backend {
     CUfunction m_kernel = nullptr;
     CUdeviceptr m_params_global = 0;
     std::string m_device_name, m_source;
-    int m_sm = 0, m_sm_count = 0, m_grid = 0;
+    int m_sm = 0, m_sm_count = 0;
     std::unique_ptr<GpuScene> m_scene;
+    LaunchShape m_shapes[2], m_applied{-1, 0};
+    bool m_fixed_shape = false;
+    std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
     const core::CompiledScene* m_last_scene = nullptr;
     uint64_t m_last_generation = 0;
     DeviceBuffer m_counter, m_exceptions, m_scratch;
