@@ -61,7 +61,13 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 /// Use it where a shadow any-hit would only say "blocked"; shadows that attenuate (glass)
 /// need trace() with an any-hit program. Much cheaper than trace(): on a GeometryGroup of
 /// triangles it is the bare any-hit traversal of the BVH.
+#if defined(__CUDACC_RTC__)
+// In the megakernel the runtime defines it, inlined into each caller: its fast path is the
+// bare BVH traversal, and a call would cost the ABI's register saves on every shadow ray.
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray);
+#else
 LUCENT_HD bool occluded(Handle root, const Ray& ray);
+#endif
 
 /// In an intersection program: is t inside the ray's current interval?
 LUCENT_HD bool potential_intersection(float t);

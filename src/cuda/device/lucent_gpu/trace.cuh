@@ -395,8 +395,8 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
 }
 
 #if LUCENT_GPU_OCCLUSION
-/// occluded() of the device API. A GeometryGroup of triangles needs no frame at all: the
-/// BVH's any-hit traversal answers; other roots are traversed in an occlusion frame.
+/// occluded() of the device API for the roots its inline fast path leaves (see occluded()
+/// below): any graph, traversed in an occlusion frame; and the checks that raise exceptions.
 __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
     ThreadState& s = self();
     if (s.exception_code) return false;
@@ -409,11 +409,6 @@ __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
         return false;
     }
     const GpuNode& root_node = params.nodes[root.index];
-#if LUCENT_GPU_TRIANGLE_GROUPS
-    if (root_node.kind == kGpuGeometryGroup && params.accels[root_node.accel].triangles_only)
-        return gpu_bvh_occluded(params.accels[root_node.accel].triangles, ray.origin,
-                                ray.direction, ray.tmin, ray.tmax);
-#endif
     if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
         detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
         return false;
@@ -470,7 +465,18 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 }  // namespace detail
 
 #if LUCENT_GPU_OCCLUSION
-LUCENT_HD bool occluded(Handle root, const Ray& ray) {
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray) {
+#if LUCENT_GPU_TRIANGLE_GROUPS
+    // The common shadow root, a GeometryGroup of triangles: the BVH's any-hit traversal right
+    // here (occluded_ray checks the same and raises the exceptions for bad input).
+    if (root.index < gpu::params.node_count && ray.ray_type < gpu::params.ray_type_count &&
+        !gpu::self().exception_code) {
+        const gpu::GpuNode& node = gpu::params.nodes[root.index];
+        if (node.kind == gpu::kGpuGeometryGroup && gpu::params.accels[node.accel].triangles_only)
+            return gpu::gpu_bvh_occluded(gpu::params.accels[node.accel].triangles, ray.origin,
+                                         ray.direction, ray.tmin, ray.tmax);
+    }
+#endif
     return gpu::occluded_ray(root, ray);
 }
 #endif
