@@ -28,6 +28,31 @@ MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh) {
     return b;
 }
 
+std::shared_ptr<GeometryGroup> mesh_group(
+    Context& ctx, const scene::Scene& scene, const std::shared_ptr<Program>& attributes,
+    const std::vector<std::shared_ptr<Material>>& materials,
+    const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each) {
+    auto group = ctx.create_geometry_group();
+    for (const auto& mesh : scene.meshes) {
+        const MeshBuffers buffers = upload_mesh(ctx, mesh);
+        auto triangles = ctx.create_geometry_triangles();
+        triangles->set_name(mesh.name);
+        triangles->set_vertices(buffers.positions);
+        triangles->set_indices(buffers.triangles);
+        triangles->set_material_indices(buffers.materials);
+        triangles->set_attribute_program(attributes);
+        (*triangles)["positions"] = buffers.positions;
+        (*triangles)["triangles"] = buffers.triangles;
+        (*triangles)["uvs"] = buffers.uvs;
+        auto instance = ctx.create_geometry_instance();
+        instance->set_geometry(triangles);
+        for (const auto& material : materials) instance->add_material(material);
+        group->add_child(instance);
+        if (each) each(mesh, buffers);
+    }
+    return group;
+}
+
 PinholeFrame pinhole_frame(const scene::Camera& c, float aspect) {
     const float3 W = normalize(c.look - c.eye), U = normalize(cross(W, c.up)), V = cross(U, W);
     const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);

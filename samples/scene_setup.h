@@ -2,9 +2,11 @@
 // buffers, the pinhole camera frame, and the output buffer as an image.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "lucent/context.h"
 #include "scene/image_io.h"
@@ -21,6 +23,16 @@ struct MeshBuffers {
     std::shared_ptr<Buffer> positions, triangles, materials, uvs;
 };
 MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh);
+
+/// One GeometryTriangles per mesh of `scene`, each in an instance with all of `materials` (a
+/// triangle's material index picks one), under a new GeometryGroup. Each geometry gets the
+/// attribute program and the variables attribute programs read: "positions", "triangles"
+/// and "uvs" (empty when the mesh has none). `each`, when given, sees every mesh with its
+/// buffers, for graphs built beside this one (IGI's boxes).
+std::shared_ptr<GeometryGroup> mesh_group(
+    Context& ctx, const scene::Scene& scene, const std::shared_ptr<Program>& attributes,
+    const std::vector<std::shared_ptr<Material>>& materials,
+    const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each = {});
 
 /// Pinhole camera: W to the image centre, U and V half the image's width and height.
 struct PinholeFrame {

@@ -66,23 +66,7 @@ RenderResult render_direct(const RenderSettings& settings) {
         materials.push_back(material);
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(direct_attributes));
-    auto top = ctx.create_geometry_group();
-    for (const auto& mesh : input.meshes) {
-        const MeshBuffers buffers = upload_mesh(ctx, mesh);
-        auto triangles = ctx.create_geometry_triangles();
-        triangles->set_name(mesh.name);
-        triangles->set_vertices(buffers.positions);
-        triangles->set_indices(buffers.triangles);
-        triangles->set_material_indices(buffers.materials);
-        triangles->set_attribute_program(attributes);
-        (*triangles)["positions"] = buffers.positions;
-        (*triangles)["triangles"] = buffers.triangles;
-        (*triangles)["uvs"] = buffers.uvs;
-        auto instance = ctx.create_geometry_instance();
-        instance->set_geometry(triangles);
-        for (const auto& material : materials) instance->add_material(material);
-        top->add_child(instance);
-    }
+    auto top = mesh_group(ctx, input, attributes, materials);
     ctx["top_object"] = top;
 
     const PinholeFrame frame =

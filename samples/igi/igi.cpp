@@ -120,7 +120,6 @@ RenderResult render_igi(const RenderSettings& settings) {
         materials.push_back(material);
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(igi_attributes));
-    auto top = ctx.create_geometry_group();
     // Imperfect visibility (seed §4.1): a second graph, one box per triangle as custom
     // primitives, traced only by VPL shadow rays.
     auto boxes = ctx.create_geometry_group();
@@ -128,20 +127,7 @@ RenderResult render_igi(const RenderSettings& settings) {
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_intersect));
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
     box_material->set_name("box");
-    for (const auto& mesh : input.meshes) {
-        const MeshBuffers buffers = upload_mesh(ctx, mesh);
-        auto triangles = ctx.create_geometry_triangles();
-        triangles->set_vertices(buffers.positions);
-        triangles->set_indices(buffers.triangles);
-        triangles->set_material_indices(buffers.materials);
-        triangles->set_attribute_program(attributes);
-        (*triangles)["positions"] = buffers.positions;
-        (*triangles)["triangles"] = buffers.triangles;
-        auto instance = ctx.create_geometry_instance();
-        instance->set_geometry(triangles);
-        for (const auto& material : materials) instance->add_material(material);
-        top->add_child(instance);
-
+    auto add_boxes = [&](const scene::Mesh& mesh, const MeshBuffers& buffers) {
         auto box_geometry = ctx.create_geometry();
         box_geometry->set_primitive_count(unsigned(mesh.indices.size()));
         box_geometry->set_bounding_box_program(box_bounds);
@@ -152,7 +138,8 @@ RenderResult render_igi(const RenderSettings& settings) {
         box_instance->set_geometry(box_geometry);
         box_instance->add_material(box_material);
         boxes->add_child(box_instance);
-    }
+    };
+    auto top = mesh_group(ctx, input, attributes, materials, add_boxes);
     ctx["top_object"] = top;
     ctx["vpl_shadow_object"] = boxes;
     ctx["imperfect_visibility"] = unsigned(imperfect);
