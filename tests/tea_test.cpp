@@ -2,6 +2,8 @@
 // per-device keys of Figure 4, and the statistical quality of the output against rounds.
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include <cstdio>
 #include <set>
 #include <string>
@@ -96,24 +98,42 @@ TEST(TeaPrograms, LaunchFillsTheBufferWithTheStreamOfEachKey) {
     options.jit_check_sm = 90;
 #endif
     lucent::Context ctx(options);
-    ctx.set_entry_point_count(2);
+    ctx.set_entry_point_count(3);
     ctx.set_ray_generation_program(0, ctx.create_program(LUCENT_PROGRAM(tea_fixed_key)));
     ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(tea_device_key)));
+    ctx.set_ray_generation_program(2, ctx.create_program(LUCENT_PROGRAM(tea_copy)));
     auto out = ctx.create_buffer<uint2>(lucent::BufferType::kOutput, 1000);
+    auto first_block = ctx.create_buffer<unsigned>(lucent::BufferType::kInput, 1);
+    auto source = ctx.create_buffer<uint2>(lucent::BufferType::kInput, 1000);
+    std::vector<uint2> source_words(1000);
+    for (unsigned i = 0; i < 1000; ++i) source_words[i] = make_uint2(i * 7u, ~i);
+    source->upload(source_words);
     const uint4 device_key = lucent::generate_tea_key(lucent::zafar_tea_key(), make_uint2(3, 7));
     ctx["out"] = out;
+    ctx["source"] = source;
     ctx["rounds"] = 4u;
-    ctx["first_block"] = 500u;
+    ctx["first_block"] = first_block;
     ctx["key"] = device_key;
-    for (unsigned entry : {0u, 1u}) {
-        ctx.launch(entry, 1000);
-        const uint4 key = entry == 0 ? lucent::zafar_tea_key() : device_key;
-        const uint2* words = out->data<uint2>();
-        for (unsigned i = 0; i < 1000; ++i) {
-            uint2 expected = tea(make_uint2(500 + i, 0), key, 4);
-            ASSERT_EQ(words[i].x, expected.x) << "entry " << entry << ", block " << i;
-            ASSERT_EQ(words[i].y, expected.y);
+    // The first block is data (a buffer), so the next launch's counter costs no recompile.
+    for (unsigned first : {500u, 9000u})
+        for (unsigned entry : {0u, 1u}) {
+            first_block->upload(std::vector<unsigned>{first});
+            ctx.launch(entry, 1000);
+            EXPECT_TRUE(ctx.last_launch().recompiled == (first == 500u && entry == 0u));
+            const uint4 key = entry == 0 ? lucent::zafar_tea_key() : device_key;
+            const uint2* words = out->data<uint2>();
+            for (unsigned i = 0; i < 1000; ++i) {
+                uint2 expected = tea(make_uint2(first + i, 0), key, 4);
+                ASSERT_EQ(words[i].x, expected.x) << "entry " << entry << ", block " << i;
+                ASSERT_EQ(words[i].y, expected.y);
+            }
         }
+    // The bench's copy baseline copies.
+    ctx.launch(2, 1000);
+    const uint2* copied = out->data<uint2>();
+    for (unsigned i = 0; i < 1000; ++i) {
+        ASSERT_EQ(copied[i].x, source_words[i].x);
+        ASSERT_EQ(copied[i].y, source_words[i].y);
     }
 }
 

@@ -12,11 +12,15 @@ namespace lucent {
 class Buffer;
 
 namespace detail {
-/// State every object of one context shares: a generation bumped on every change, and the
+/// State every object of one context shares: a generation bumped on every change of the
+/// scene's shape, a data generation bumped when a buffer's contents change, and the
 /// backend's hook that copies a buffer the GPU wrote back to the host when it is read.
 /// Objects hold it by shared_ptr, so they may outlive their Context safely.
 struct ContextShared {
     uint64_t generation = 1;
+    /// New buffer contents need no recompile, only an upload; unless an acceleration
+    /// structure or a texture is built from that buffer (CompiledScene::rebuild_inputs).
+    uint64_t data_generation = 1;
     std::function<void(const Buffer&)> fetch_from_device;
 };
 using OwnerRef = std::shared_ptr<ContextShared>;

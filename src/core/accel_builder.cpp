@@ -86,10 +86,15 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
             structure.add(tris->indices().get())
                 .add(tris->indices() ? tris->indices()->version() : 0);
             content.add(tris->vertices().get()).add(tris->vertices()->version());
+            m_rebuild_inputs.push_back(tris->vertices().get());
+            if (tris->indices()) m_rebuild_inputs.push_back(tris->indices().get());
         } else {
             triangles_only = false;
             content.add_bytes(inst.bounding_box.rec(), inst.bounding_box.desc->record->size);
-            for (const auto& b : inst.bounding_box.buffers) content.add(b.get()).add(b->version());
+            for (const auto& b : inst.bounding_box.buffers) {
+                content.add(b.get()).add(b->version());
+                m_rebuild_inputs.push_back(b.get());
+            }
         }
     }
     structure.add(accel.builder());

@@ -70,7 +70,7 @@ void Buffer::sync_from_device() const {
 void Buffer::unmap() {
     m_mapped = false;
     ++m_version;
-    changed();
+    ++m_owner->data_generation;  // new contents: uploaded at the next launch, not recompiled
 }
 
 std::string TextureSampler::describe() const {

@@ -108,6 +108,11 @@ inline bool exception_code_enabled(const std::vector<int>& enabled, int code) {
 
 struct CompiledScene {
     uint64_t generation = 0;
+    uint64_t data_generation = 0;  // of the buffer contents this scene was checked against
+    /// Buffers whose contents the compile built something from (acceleration structures'
+    /// vertices, indices and bounding-box records; textures' texels), with their versions
+    /// then: new contents in one of them need a recompile, in any other only an upload.
+    std::vector<std::pair<const Buffer*, uint64_t>> rebuild_inputs;
     std::vector<CompiledEntry> entries;
     std::vector<RayTypeDesc> ray_types;
     std::vector<CompiledProgram> miss;  // per ray type

@@ -305,11 +305,19 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
                     " is empty; every dimension must be at least 1");
     LaunchReport report;
     auto t0 = Clock::now();
-    if (!m_impl->compiled || m_impl->compiled->generation != m_impl->shared->generation) {
+    bool stale = !m_impl->compiled || m_impl->compiled->generation != m_impl->shared->generation;
+    if (!stale && m_impl->compiled->data_generation != m_impl->shared->data_generation) {
+        // New buffer contents: a recompile only if something was built from them.
+        for (const auto& [buffer, version] : m_impl->compiled->rebuild_inputs)
+            stale = stale || buffer->version() != version;
+        if (!stale) m_impl->compiled->data_generation = m_impl->shared->data_generation;
+    }
+    if (stale) {
         m_impl->compiled.reset();  // a failed compile must not leave a stale scene behind
         core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache);
         m_impl->compiled = compiler.compile();
         m_impl->compiled->generation = m_impl->shared->generation;
+        m_impl->compiled->data_generation = m_impl->shared->data_generation;
         report.accel_ms = compiler.accel_ms();
         report.compile_ms = ms_since(t0) - report.accel_ms;
         report.recompiled = true;

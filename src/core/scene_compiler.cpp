@@ -38,6 +38,7 @@ bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
 std::unique_ptr<CompiledScene> SceneCompiler::compile() {
     compile_graph();
     build_accelerations();
+    for (const Buffer* b : m_rebuild_inputs) m_scene->rebuild_inputs.emplace_back(b, b->version());
     return std::move(m_scene);
 }
 

@@ -59,6 +59,7 @@ class SceneCompiler {
 
     const ContextState& m_state;
     AccelCache& m_cache;
+    std::vector<const Buffer*> m_rebuild_inputs;  // see CompiledScene::rebuild_inputs
     std::unique_ptr<CompiledScene> m_scene;
     std::map<const Node*, unsigned> m_node_ids;
     std::map<const GeometryInstance*, unsigned> m_instance_ids;
