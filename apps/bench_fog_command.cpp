@@ -9,8 +9,9 @@ namespace lucent::cli {
 
 CLI::App* add_bench_fog_command(CLI::App* bench, BenchFogArgs& args) {
     CLI::App* c = bench->add_subcommand(
-        "fog", "Volumetric fog: no fog, then steps 0.1, 0.05, 0.01, frames/s over a moving "
-               "camera (Sebald, Table 1)");
+        "fog",
+        "Volumetric fog: no fog, then steps 0.1, 0.05, 0.01, frames/s over a moving "
+        "camera (Sebald, Table 1)");
     c->add_option("--backend", args.backend, "cpu, cuda or auto")
         ->type_name("KIND")
         ->capture_default_str();

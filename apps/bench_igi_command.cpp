@@ -9,8 +9,9 @@ namespace lucent::cli {
 
 CLI::App* add_bench_igi_command(CLI::App* bench, BenchIgiArgs& args) {
     CLI::App* c = bench->add_subcommand(
-        "igi", "Instant Global Illumination: canonical, then +imperfect visibility, "
-               "+downsampling, +interleaving, x VPL counts (Marques and Santos, Fig. 4 and 5)");
+        "igi",
+        "Instant Global Illumination: canonical, then +imperfect visibility, "
+        "+downsampling, +interleaving, x VPL counts (Marques and Santos, Fig. 4 and 5)");
     c->add_option("--scene", args.scene, "Built-in scene name or a .obj/.json/.ply file")
         ->type_name("NAME|FILE")
         ->capture_default_str();

@@ -72,8 +72,9 @@ scene::Image image_from_output(const Buffer& output) {
 std::shared_ptr<TextureSampler> DiffuseTextures::operator()(const std::string& file) {
     auto& sampler = m_samplers[file];
     if (sampler) return sampler;
-    const scene::TextureImage image =
-        file.empty() ? scene::TextureImage{1, 1, {make_float4(1, 1, 1, 1)}} : scene::load_texture(file);
+    const scene::TextureImage image = file.empty()
+                                          ? scene::TextureImage{1, 1, {make_float4(1, 1, 1, 1)}}
+                                          : scene::load_texture(file);
     auto texels = m_ctx.create_buffer<float4>(BufferType::kInput, image.width, image.height);
     texels->upload(image.texels);
     sampler = m_ctx.create_texture_sampler();

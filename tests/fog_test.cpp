@@ -126,7 +126,8 @@ TEST(Fog, EnvironmentMapFromAnHdrFile) {
         render({{"environment", "/nonexistent/sky.hdr"}});
         ADD_FAILURE() << "no error";
     } catch (const std::exception& e) {
-        EXPECT_NE(std::string(e.what()).find("/nonexistent/sky.hdr"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("/nonexistent/sky.hdr"), std::string::npos)
+            << e.what();
     }
 }
 

@@ -12,8 +12,8 @@
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
 #include "scene/scene.h"
-#include "tests/test_support.h"
 #include "tests/reference_tracer.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -178,7 +178,8 @@ TEST(Igi, AllThreeAcceleratorsTogether) {
 
 TEST(Igi, SceneWithoutLightsIsAClearError) {
     namespace fs = std::filesystem;
-    const fs::path path = fs::temp_directory_path() / ("igi-dark-" + std::to_string(::getpid()) + ".json");
+    const fs::path path =
+        fs::temp_directory_path() / ("igi-dark-" + std::to_string(::getpid()) + ".json");
     std::ofstream(path) << R"({"camera": {"eye": [0,0,3], "look": [0,0,0]},
         "meshes": [{"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]]}]})";
     try {

@@ -1,8 +1,8 @@
 // lucent::occluded(): a shadow query that runs no hit programs. It must see triangles and
 // custom primitives under any graph (GeometryGroup, Group, Transform), respect the ray's
 // interval, and treat every primitive as opaque: any-hit programs are not run.
-#include "tests/test_support.h"
 #include "tests/programs/occlusion_programs.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -40,19 +40,21 @@ class OcclusionTest : public testing::Test {
 const float3 kOrigin = make_float3(0, 0, 0), kForward = make_float3(0, 0, 1);
 
 TEST_F(OcclusionTest, TrianglesWithinTheIntervalOcclude) {
-    auto square = make_instance(ctx, make_triangles(ctx, square_at(5.0f)),
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
+    auto square =
+        make_instance(ctx, make_triangles(ctx, square_at(5.0f)),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
     auto top = make_geometry_group(ctx, {square});
-    const auto r = query(top, {{kOrigin, kForward, 10.0f},     // through the square
-                               {kOrigin, kForward, 4.0f},      // stops short of it
-                               {kOrigin, -kForward, 10.0f},    // away from it
+    const auto r = query(top, {{kOrigin, kForward, 10.0f},                  // through the square
+                               {kOrigin, kForward, 4.0f},                   // stops short of it
+                               {kOrigin, -kForward, 10.0f},                 // away from it
                                {make_float3(20, 0, 0), kForward, 10.0f}});  // beside it
     EXPECT_EQ(r, (std::vector<unsigned>{1, 0, 0, 0}));
 }
 
 TEST_F(OcclusionTest, CustomPrimitivesUnderGroupsAndTransformsOcclude) {
-    auto sphere = make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 2));
+    auto sphere =
+        make_instance(ctx, make_spheres(ctx, {make_float4(0, 0, 5, 1)}),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 2));
     auto moved = ctx.create_transform();
     moved->set_matrix(translation(3, 0, 0));
     moved->set_child(make_geometry_group(ctx, {sphere}));

@@ -63,7 +63,8 @@ TEST(VplGrid, MergingConservesPowerAndUsesVoxelCentres) {
                         make_float3(u(rng), u(rng), u(rng))});
     }
     vpls.push_back({make_float3(5, 5, 5), make_float3(0, 1, 0), make_float3(0.0f)});  // empty slot
-    vpls.push_back({make_float3(-4, 50, 5), make_float3(0, 1, 0), make_float3(1, 2, 3)});  // outside
+    vpls.push_back(
+        {make_float3(-4, 50, 5), make_float3(0, 1, 0), make_float3(1, 2, 3)});  // outside
     const Bounds3 bounds{make_float3(0, 0, 0), make_float3(10, 20, 30)};
     const std::vector<Vpl> merged = merge_vpls(vpls, bounds, 4);
     EXPECT_LE(merged.size(), 64u);
@@ -116,8 +117,7 @@ TEST(Radiosity, PhotonsCarryTheLightsFluxTimesTheAlbedoTheyMeet) {
     // nothing; the walls still catch most of them.
     const lucent::scene::Scene scene = lucent::scene::load_scene("cornell");
     const auto& light = scene.area_lights.at(0);
-    const float3 flux =
-        light.emission * (float(M_PI) * length(cross(light.edge1, light.edge2)));
+    const float3 flux = light.emission * (float(M_PI) * length(cross(light.edge1, light.edge2)));
     float3 hi = make_float3(0.0f);
     for (const auto& m : scene.materials)
         if (max_component(m.emission) == 0) hi = fmaxf(hi, m.diffuse);

@@ -29,7 +29,8 @@ class ReferenceTracer {
         for (const auto& mesh : m_scene.meshes)
             for (size_t i = 0; i < mesh.indices.size(); ++i) {
                 const uint3 t = mesh.indices[i];
-                const float3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+                const float3 a = mesh.positions[t.x], b = mesh.positions[t.y],
+                             c = mesh.positions[t.z];
                 const double hit_t = intersect(origin, dir, a, b, c);
                 if (hit_t > tmin && hit_t < tmax && (!best || hit_t < best->t)) {
                     float3 n = normalize(cross(b - a, c - a));
@@ -63,8 +64,8 @@ class ReferenceTracer {
     float3 one_bounce_irradiance(float3 x, float3 n, int samples, float epsilon,
                                  std::mt19937& rng) const {
         std::uniform_real_distribution<float> u(0.0f, 1.0f);
-        const float3 t = normalize(cross(n, std::fabs(n.x) > 0.5f ? make_float3(0, 1, 0)
-                                                                   : make_float3(1, 0, 0)));
+        const float3 t = normalize(
+            cross(n, std::fabs(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
         const float3 b = cross(n, t);
         float3 sum = make_float3(0.0f);
         for (int s = 0; s < samples; ++s) {

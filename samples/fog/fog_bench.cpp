@@ -57,14 +57,16 @@ int run_fog_bench(const FogBenchOptions& options) {
                         ms.back(), scene.context().backend_name()});
     }
     if (options.json) {
-        std::printf("{\"benchmark\": \"fog\", \"backend\": \"%s\", \"width\": %u, \"height\": %u, "
-                    "\"frames\": %u, \"rows\": [",
-                    rows[0].backend.c_str(), options.width, options.height, options.frames);
+        std::printf(
+            "{\"benchmark\": \"fog\", \"backend\": \"%s\", \"width\": %u, \"height\": %u, "
+            "\"frames\": %u, \"rows\": [",
+            rows[0].backend.c_str(), options.width, options.height, options.frames);
         for (size_t i = 0; i < rows.size(); ++i)
-            std::printf("%s\n  {\"configuration\": \"%s\", \"fps\": %.3f, \"median_ms\": %.4f, "
-                        "\"min_ms\": %.4f, \"max_ms\": %.4f}",
-                        i ? "," : "", rows[i].name.c_str(), rows[i].fps, rows[i].median_ms,
-                        rows[i].min_ms, rows[i].max_ms);
+            std::printf(
+                "%s\n  {\"configuration\": \"%s\", \"fps\": %.3f, \"median_ms\": %.4f, "
+                "\"min_ms\": %.4f, \"max_ms\": %.4f}",
+                i ? "," : "", rows[i].name.c_str(), rows[i].fps, rows[i].median_ms, rows[i].min_ms,
+                rows[i].max_ms);
         std::printf("\n]}\n");
         return 0;
     }

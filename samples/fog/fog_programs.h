@@ -43,7 +43,9 @@ struct ShadowPayload {
     float3 attenuation;
 };
 
-LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+LUCENT_HD inline float3 xyz(float4 v) {
+    return make_float3(v.x, v.y, v.z);
+}
 
 /// Unpolarised Fresnel reflectance of a dielectric for cos_i (> 0) and the index ratio
 /// eta = n_incident / n_transmitted; 1 under total internal reflection.
@@ -92,7 +94,7 @@ LUCENT_RECORD(PhongRecord, Kd_a, Kd_b, Ks, phong_exponent, Kr, pattern, pattern_
 
 struct GlassRecord {
     float ior;
-    float3 extinction;  // Beer's law: per unit distance inside the glass
+    float3 extinction;   // Beer's law: per unit distance inside the glass
     float3 shadow_tint;  // what a shadow ray keeps through the crystal
     float scene_epsilon;
     unsigned max_depth;
@@ -107,13 +109,13 @@ LUCENT_RECORD(FogBoxRecord, box_min, box_max)
 
 struct FogRecord {
     float3 box_min, box_max;
-    float density;        // extinction at full noise and the bottom of the box, per unit
-    float step;           // march step along the ray
-    float noise_scale;    // lattice size of the gradient noise, scene units
-    unsigned noise;       // 0: uniform density (tests)
-    unsigned falloff;     // 0: no falloff in y (tests)
-    unsigned rounds;      // TEA rounds of the noise
-    uint4 noise_key;      // generate_tea_key(device, seed): Sebald Fig. 4
+    float density;      // extinction at full noise and the bottom of the box, per unit
+    float step;         // march step along the ray
+    float noise_scale;  // lattice size of the gradient noise, scene units
+    unsigned noise;     // 0: uniform density (tests)
+    unsigned falloff;   // 0: no falloff in y (tests)
+    unsigned rounds;    // TEA rounds of the noise
+    uint4 noise_key;    // generate_tea_key(device, seed): Sebald Fig. 4
     float3 fog_color;
     lucent::Handle top_object;
 };
@@ -157,9 +159,9 @@ LUCENT_HD inline float3 pattern_colour(const PhongRecord& r, float3 p) {
         return checker ? r.Kd_a : lerp(r.Kd_a, r.Kd_b, 0.35f);
     }
     // Rust: patches of the second colour where gradient noise runs high.
-    const float n = lucent::tea_gradient_noise((p.x + 0.7f * p.y) / r.pattern_scale,
-                                               (p.z - 0.4f * p.y) / r.pattern_scale,
-                                               r.noise_key, 2u);
+    const float n =
+        lucent::tea_gradient_noise((p.x + 0.7f * p.y) / r.pattern_scale,
+                                   (p.z - 0.4f * p.y) / r.pattern_scale, r.noise_key, 2u);
     const float t = clampf((n - 0.45f) * 4.0f, 0.0f, 1.0f);
     return lerp(r.Kd_a, r.Kd_b, t);
 }
@@ -180,10 +182,10 @@ LUCENT_RAY_GENERATION(fog_camera, fog::CameraRecord) {
     const fog::CameraFrame c = rec.camera[0u];
     const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
     fog::RadiancePayload prd{make_float3(0.0f), 0.0f, 0, 0};
-    lucent::trace(rec.top_object,
-                  lucent::make_ray(c.eye, normalize(c.W + sx * c.U + sy * c.V), fog::kRadianceRay,
-                                   0.0f),
-                  prd);
+    lucent::trace(
+        rec.top_object,
+        lucent::make_ray(c.eye, normalize(c.W + sx * c.U + sy * c.V), fog::kRadianceRay, 0.0f),
+        prd);
     rec.output[make_uint2(i.x, i.y)] = make_float4(prd.color, 1.0f);
 }
 
@@ -203,14 +205,16 @@ LUCENT_MISS(fog_environment, fog::MissRecord, fog::RadiancePayload) {
                          clampf(-up * 4.0f, 0.0f, 1.0f));
         return;
     }
-    const float3 horizon = make_float3(0.75f, 0.82f, 0.9f), zenith = make_float3(0.2f, 0.38f, 0.75f);
+    const float3 horizon = make_float3(0.75f, 0.82f, 0.9f),
+                 zenith = make_float3(0.2f, 0.38f, 0.75f);
     prd.color = lerp(horizon, zenith, sqrtf(up));
 }
 
 // ---- surfaces ------------------------------------------------------------------------------
 LUCENT_ATTRIBUTE(fog_mesh_attributes, fog::MeshRecord, fog::HitAttributes) {
     const uint3 t = rec.triangles[prim];
-    attr.normal = cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
+    attr.normal =
+        cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
     attr.t_exit = 0.0f;
 }
 
@@ -237,10 +241,10 @@ LUCENT_CLOSEST_HIT(fog_phong, fog::PhongRecord, fog::RadiancePayload, fog::HitAt
     }
     if (max_component(rec.Kr) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
         fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
-        lucent::trace(rec.top_object,
-                      lucent::make_ray(origin, reflect(normalize(ray.direction), n),
-                                       fog::kRadianceRay, 0.0f),
-                      reflected);
+        lucent::trace(
+            rec.top_object,
+            lucent::make_ray(origin, reflect(normalize(ray.direction), n), fog::kRadianceRay, 0.0f),
+            reflected);
         color += rec.Kr * reflected.color;
     }
     prd.color = color;
@@ -262,10 +266,10 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
     float3 color = make_float3(0.0f);
     if (prd.depth + 1 < int(rec.max_depth)) {
         fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
-        lucent::trace(rec.top_object,
-                      lucent::make_ray(p + rec.scene_epsilon * n, reflect(d, n), fog::kRadianceRay,
-                                       0.0f),
-                      reflected);
+        lucent::trace(
+            rec.top_object,
+            lucent::make_ray(p + rec.scene_epsilon * n, reflect(d, n), fog::kRadianceRay, 0.0f),
+            reflected);
         color += F * reflected.color;
         if (F < 1.0f) {
             const float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
@@ -279,8 +283,9 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
     }
     if (!entering) {  // the ray crossed the glass: Beer's law over the distance inside
         const float inside = lucent::t_hit() * length(ray.direction);
-        color = color * make_float3(expf(-rec.extinction.x * inside), expf(-rec.extinction.y * inside),
-                                    expf(-rec.extinction.z * inside));
+        color =
+            color * make_float3(expf(-rec.extinction.x * inside), expf(-rec.extinction.y * inside),
+                                expf(-rec.extinction.z * inside));
     }
     prd.color = color;
     prd.distance = lucent::t_hit();
@@ -335,9 +340,9 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
     // What lies beneath: the same ray again, the fog ignored (its hits are exactly those of
     // a scene without fog, so zero density reproduces it).
     fog::RadiancePayload behind{make_float3(0.0f), 0.0f, prd.depth, 1};
-    lucent::trace(rec.top_object,
-                  lucent::make_ray(ray.origin, ray.direction, fog::kRadianceRay, ray.tmin, ray.tmax),
-                  behind);
+    lucent::trace(
+        rec.top_object,
+        lucent::make_ray(ray.origin, ray.direction, fog::kRadianceRay, ray.tmin, ray.tmax), behind);
     const float t_start = lucent::t_hit(), t_end = lc_min(attr.t_exit, behind.distance);
     const float speed = length(ray.direction);  // t to distance
     const float distance = lc_max(0.0f, t_end - t_start) * speed;

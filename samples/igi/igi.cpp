@@ -37,9 +37,10 @@ std::vector<igi::PointLight> point_emitters(const scene::Scene& input, int side)
         const float cells = float(side * side);
         for (int j = 0; j < side; ++j)
             for (int i = 0; i < side; ++i) {
-                const float u = (float(i) + 0.5f) / float(side), v = (float(j) + 0.5f) / float(side);
-                lights.push_back({a.corner + u * a.edge1 + v * a.edge2,
-                                  a.emission * (area / cells), normal});
+                const float u = (float(i) + 0.5f) / float(side),
+                            v = (float(j) + 0.5f) / float(side);
+                lights.push_back(
+                    {a.corner + u * a.edge1 + v * a.edge2, a.emission * (area / cells), normal});
             }
     }
     return lights;
@@ -64,7 +65,8 @@ RenderResult render_igi(const RenderSettings& settings) {
     const int max_depth = get_int_option(settings, info, "max_depth", 1, 16);
     const int imperfect = get_int_option(settings, info, "imperfect_visibility", 0, 1);
     const float depth_threshold = get_float_option(settings, info, "depth_threshold", 0.0f, 10.0f);
-    const float normal_threshold = get_float_option(settings, info, "normal_threshold", -1.0f, 1.0f);
+    const float normal_threshold =
+        get_float_option(settings, info, "normal_threshold", -1.0f, 1.0f);
     const float sigma = get_float_option(settings, info, "sigma", 0.1f, 16.0f);
     const int area_side = get_int_option(settings, info, "area_samples", 1, 64);
     const Clock::time_point setup_start = Clock::now();
@@ -102,8 +104,8 @@ RenderResult render_igi(const RenderSettings& settings) {
         ctx.create_buffer<igi::PointLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
-    auto vpls = ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput,
-                                            config.paths * config.bounces);
+    auto vpls =
+        ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
     ctx["vpls"] = vpls;
 
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi_surface));
@@ -177,10 +179,9 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_generation_program(igi::kUpsampleEntry, upsample);
     ctx.set_ray_generation_program(igi::kComposeEntry, compose);
     ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi_miss)));
-    out.stages.push_back(
-        {"scene setup", ms_since(setup_start),
-         input.name + ", " + std::to_string(input.triangle_count()) + " triangles, " +
-             std::to_string(lights.size()) + " point emitters"});
+    out.stages.push_back({"scene setup", ms_since(setup_start),
+                          input.name + ", " + std::to_string(input.triangle_count()) +
+                              " triangles, " + std::to_string(lights.size()) + " point emitters"});
 
     render_igi_frames(ctx, config, settings, out);
     out.image = image_from_output(*images.output);

@@ -59,15 +59,17 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
 }
 
 void print_json(const IgiBenchOptions& options, const std::vector<Row>& rows) {
-    std::printf("{\"benchmark\": \"igi\", \"scene\": \"%s\", \"backend\": \"%s\", \"width\": %u, "
-                "\"height\": %u, \"frames\": %u, \"rows\": [",
-                options.scene.c_str(), rows.empty() ? "" : rows[0].backend.c_str(), options.width,
-                options.height, options.frames);
+    std::printf(
+        "{\"benchmark\": \"igi\", \"scene\": \"%s\", \"backend\": \"%s\", \"width\": %u, "
+        "\"height\": %u, \"frames\": %u, \"rows\": [",
+        options.scene.c_str(), rows.empty() ? "" : rows[0].backend.c_str(), options.width,
+        options.height, options.frames);
     for (size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
-        std::printf("%s\n  {\"configuration\": \"%s\", \"vpls\": %u, \"frame_ms\": %.4f, "
-                    "\"fps\": %.2f, \"stage_ms\": {",
-                    i ? "," : "", r.configuration.c_str(), r.vpls, r.frame_ms, 1000.0 / r.frame_ms);
+        std::printf(
+            "%s\n  {\"configuration\": \"%s\", \"vpls\": %u, \"frame_ms\": %.4f, "
+            "\"fps\": %.2f, \"stage_ms\": {",
+            i ? "," : "", r.configuration.c_str(), r.vpls, r.frame_ms, 1000.0 / r.frame_ms);
         bool first = true;
         for (const char* name : kIgiStageNames) {
             auto it = r.stage_ms.find(name);
@@ -84,9 +86,8 @@ void print_table(const IgiBenchOptions& options, const std::vector<Row>& rows) {
     std::printf("igi: %s, %ux%u on %s, median of %u frames; stage shares in %% of the frame\n",
                 options.scene.c_str(), options.width, options.height,
                 rows.empty() ? "?" : rows[0].backend.c_str(), options.frames);
-    std::printf("%-22s %5s %9s %9s %7s %7s %8s %7s %7s %7s\n", "configuration", "VPLs",
-                "frames/s", "frame ms", "VPLgen", "direct", "indirect", "discont", "upsamp",
-                "compose");
+    std::printf("%-22s %5s %9s %9s %7s %7s %8s %7s %7s %7s\n", "configuration", "VPLs", "frames/s",
+                "frame ms", "VPLgen", "direct", "indirect", "discont", "upsamp", "compose");
     for (const Row& r : rows) {
         std::printf("%-22s %5u %9.2f %9.3f", r.configuration.c_str(), r.vpls, 1000.0 / r.frame_ms,
                     r.frame_ms);

@@ -17,7 +17,8 @@ std::shared_ptr<Buffer> IgiImages::irradiance_at_full_resolution(const IgiConfig
 IgiImages create_igi_images(Context& ctx, const IgiConfig& config) {
     const unsigned w = config.width, h = config.height;
     const unsigned lw = config.low_width(), lh = config.low_height();
-    auto image = [&ctx](unsigned width, unsigned height, BufferType type = BufferType::kInputOutput) {
+    auto image = [&ctx](unsigned width, unsigned height,
+                        BufferType type = BufferType::kInputOutput) {
         return ctx.create_buffer<float4>(type, width, height);
     };
     IgiImages images;

@@ -36,8 +36,8 @@ IgiImages create_igi_images(Context& ctx, const IgiConfig& config);
 
 /// The stages of a frame in launch order; the names RenderResult::stages uses.
 inline constexpr std::array<const char*, 6> kIgiStageNames = {
-    "VPL generation", "direct + specular", "indirect",
-    "discontinuity filter", "upsampling", "composition"};
+    "VPL generation",       "direct + specular", "indirect",
+    "discontinuity filter", "upsampling",        "composition"};
 
 /// Renders settings.repeat frames (at least one), each: VPL generation, direct + specular,
 /// indirect, the discontinuity filter (interleave > 1), upsampling (downsample > 1),

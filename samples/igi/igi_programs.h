@@ -33,7 +33,9 @@ struct PointLight {
     float3 normal;
 };
 
-LUCENT_HD inline bool is_oriented(const PointLight& light) { return dot(light.normal, light.normal) > 0.0f; }
+LUCENT_HD inline bool is_oriented(const PointLight& light) {
+    return dot(light.normal, light.normal) > 0.0f;
+}
 
 /// Radiant intensity of `light` towards the unit direction `w` (from the light).
 LUCENT_HD inline float3 intensity_towards(const PointLight& light, float3 w) {
@@ -106,7 +108,9 @@ LUCENT_HD inline float3 cosine_direction(float3 n, float u1, float u2) {
 }
 
 /// Fractional part, for Cranley-Patterson rotations of a Halton point.
-LUCENT_HD inline float wrap01(float x) { return x - floorf(x); }
+LUCENT_HD inline float wrap01(float x) {
+    return x - floorf(x);
+}
 
 // ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
@@ -131,8 +135,8 @@ struct CameraRecord {
     lucent::BufferView<float4> gbuffer_position, gbuffer_normal, gbuffer_albedo;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, direct, gbuffer_position, gbuffer_normal,
-              gbuffer_albedo, top_object)
+LUCENT_RECORD(CameraRecord, eye, U, V, W, direct, gbuffer_position, gbuffer_normal, gbuffer_albedo,
+              top_object)
 
 /// What Eq. (1) needs wherever it is evaluated: the VPLs and how to test their visibility.
 struct IndirectParams {
@@ -170,8 +174,7 @@ struct IndirectRecord {
     lucent::Handle vpl_shadow_object;
 };
 LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, downsample,
-              interleave, min_d, scene_epsilon, top_object, imperfect_visibility,
-              vpl_shadow_object)
+              interleave, min_d, scene_epsilon, top_object, imperfect_visibility, vpl_shadow_object)
 
 struct DiscontinuityRecord {
     lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
@@ -211,9 +214,12 @@ LUCENT_RECORD(MeshRecord, positions, triangles)
 
 template <class Record>
 LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
-    return IndirectParams{rec.vpls,       rec.min_d,
-                          rec.scene_epsilon, rec.top_object,
-                          rec.imperfect_visibility, rec.vpl_shadow_object};
+    return IndirectParams{rec.vpls,
+                          rec.min_d,
+                          rec.scene_epsilon,
+                          rec.top_object,
+                          rec.imperfect_visibility,
+                          rec.vpl_shadow_object};
 }
 
 /// Nothing opaque between `from` and just short of `to`: an occlusion query, no programs.
@@ -256,7 +262,9 @@ LUCENT_HD inline uint2 representative_pixel(uint2 q, unsigned downsample, uint2 
                       lc_min(q.y * downsample + downsample / 2, full_size.y - 1));
 }
 
-LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+LUCENT_HD inline float3 xyz(float4 v) {
+    return make_float3(v.x, v.y, v.z);
+}
 
 template <class T>
 LUCENT_HD inline uint2 size2(const lucent::BufferView<T>& b) {
@@ -386,7 +394,8 @@ LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {
 LUCENT_RAY_GENERATION(igi_indirect, igi::IndirectRecord) {
     const uint3 q = lucent::launch_index();
     const uint2 low = make_uint2(q.x, q.y);
-    const uint2 full = igi::representative_pixel(low, rec.downsample, igi::size2(rec.gbuffer_position));
+    const uint2 full =
+        igi::representative_pixel(low, rec.downsample, igi::size2(rec.gbuffer_position));
     const float4 position = rec.gbuffer_position[full];
     if (position.w < 0.0f) {
         rec.indirect[low] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
@@ -426,8 +435,7 @@ LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
             const bool is_centre = dx == 0 && dy == 0;  // always counts, whatever the thresholds
             if (!is_centre) {
                 if (position.w < 0.0f) continue;
-                if (fabsf(position.w - c_position.w) > rec.depth_threshold * c_position.w)
-                    continue;
+                if (fabsf(position.w - c_position.w) > rec.depth_threshold * c_position.w) continue;
                 if (dot(igi::xyz(rec.gbuffer_normal[nb_full]), c_normal) < rec.normal_threshold)
                     continue;
             }
@@ -468,8 +476,8 @@ LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
                 nearest_d2 = d2;
                 nearest = value;
             }
-            const float w =
-                expf(-d2 * inv_two_sigma2) * lc_max(0.0f, dot(n, igi::xyz(rec.gbuffer_normal[q_full])));
+            const float w = expf(-d2 * inv_two_sigma2) *
+                            lc_max(0.0f, dot(n, igi::xyz(rec.gbuffer_normal[q_full])));
             sum += value * w;
             k += w;
         }

@@ -35,8 +35,7 @@ Bounds3 scene_bounds(const scene::Scene& scene) {
 }
 
 struct Options {
-    unsigned photon_side, bounces, roulette, grid, merge, gi, show_vpls, vpl_shadows,
-        area_samples;
+    unsigned photon_side, bounces, roulette, grid, merge, gi, show_vpls, vpl_shadows, area_samples;
     float clamp;
 };
 
@@ -91,7 +90,8 @@ RenderResult render_radiosity(const RenderSettings& settings) {
     ctx["dot_radius"] = 0.006f;
 
     std::vector<radiosity::AreaLight> lights;
-    for (const auto& l : input.area_lights) lights.push_back({l.corner, l.edge1, l.edge2, l.emission});
+    for (const auto& l : input.area_lights)
+        lights.push_back({l.corner, l.edge1, l.edge2, l.emission});
     auto light_buffer =
         ctx.create_buffer<radiosity::AreaLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
@@ -153,9 +153,9 @@ RenderResult render_radiosity(const RenderSettings& settings) {
     const LaunchReport first = ctx.last_launch();
     out.stages.push_back({"compile + accel", first.compile_ms + first.accel_ms, ""});
     if (first.jit_ms > 0)
-        out.stages.push_back({"megakernel JIT", first.jit_ms,
-                              first.jit_cached ? "loaded from the kernel cache"
-                                               : "cold NVRTC compile"});
+        out.stages.push_back(
+            {"megakernel JIT", first.jit_ms,
+             first.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
     out.stages.push_back({"photons", first.launch_ms,
                           std::to_string(photons) + " photons, up to " +
                               std::to_string(options.bounces) + " bounces"});
@@ -173,9 +173,8 @@ RenderResult render_radiosity(const RenderSettings& settings) {
         merged->resize(unsigned(cells.size()));
         merged->upload(cells);
         out.stages.push_back({"VPL merge", ms_since(merge_start),
-                              std::to_string(live) + " VPLs into " +
-                                  std::to_string(cells.size()) + " cells of a " +
-                                  std::to_string(options.grid) + "^3 grid"});
+                              std::to_string(live) + " VPLs into " + std::to_string(cells.size()) +
+                                  " cells of a " + std::to_string(options.grid) + "^3 grid"});
     }
 
     ctx.launch(radiosity::kGBufferEntry, w, h);

@@ -112,17 +112,19 @@ struct ShadeRecord {
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(ShadeRecord, eye, gbuffer_position, gbuffer_normal, gbuffer_albedo,
-              gbuffer_emission, output, area_lights, area_samples, vpls, gi, vpl_shadows,
-              show_vpls, clamp_distance, dot_radius, scene_epsilon, top_object)
+LUCENT_RECORD(ShadeRecord, eye, gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission,
+              output, area_lights, area_samples, vpls, gi, vpl_shadows, show_vpls, clamp_distance,
+              dot_radius, scene_epsilon, top_object)
 
 /// Nothing between `from` and just short of `to`: an occlusion query, no programs.
 LUCENT_HD inline bool visible(const ShadeRecord& rec, float3 from, float3 to) {
-    return !lucent::occluded(rec.top_object,
-                             lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f));
+    return !lucent::occluded(
+        rec.top_object, lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f));
 }
 
-LUCENT_HD inline float3 xyz(float4 v) { return make_float3(v.x, v.y, v.z); }
+LUCENT_HD inline float3 xyz(float4 v) {
+    return make_float3(v.x, v.y, v.z);
+}
 
 /// Irradiance at x (normal n) from the area lights: side x side stratified samples each,
 /// jittered per pixel, with shadow rays.
@@ -175,7 +177,8 @@ LUCENT_HD inline float3 vpl_irradiance(const ShadeRecord& rec, float3 x, float3 
 LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
     const unsigned photon = (i.z * n.y + i.y) * n.x + i.x;
-    for (unsigned b = 0; b < rec.bounces; ++b) rec.vpls[photon * rec.bounces + b] = radiosity::Vpl{};
+    for (unsigned b = 0; b < rec.bounces; ++b)
+        rec.vpls[photon * rec.bounces + b] = radiosity::Vpl{};
     const radiosity::AreaLight light = rec.area_lights[i.z];
     const float3 ln = cross(light.edge1, light.edge2);
     const float area = length(ln);

@@ -14,7 +14,9 @@ unsigned cell_of(float x, float lo, float hi, unsigned resolution) {
     return unsigned(std::clamp(cell, 0, int(resolution) - 1));
 }
 
-float luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(float3 c) {
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 }  // namespace
 

@@ -68,8 +68,8 @@ int run_tea_bench(const TeaBenchOptions& options) {
     };
     const VariantResult fixed =
         run_variant(ctx, out, first_block, options.megabytes, 0, report_from(0));
-    const VariantResult device = run_variant(ctx, out, first_block, options.megabytes, 1,
-                                             report_from(options.megabytes));
+    const VariantResult device =
+        run_variant(ctx, out, first_block, options.megabytes, 1, report_from(options.megabytes));
     const VariantResult copy = run_variant(ctx, out, first_block, options.megabytes, 2,
                                            report_from(2 * options.megabytes));
     const double mb = options.megabytes;
@@ -89,10 +89,11 @@ int run_tea_bench(const TeaBenchOptions& options) {
     std::printf("fixed key      %9.1f MB/s  %5.1f%% of copy  (%.3f s, checksum %08x)\n",
                 mb / fixed.seconds, 100.0 * copy.seconds / fixed.seconds, fixed.seconds,
                 fixed.checksum);
-    std::printf("generated key  %9.1f MB/s  %5.1f%% of copy  (%.3f s, checksum %08x; device %u, "
-                "seed %u)\n",
-                mb / device.seconds, 100.0 * copy.seconds / device.seconds, device.seconds,
-                device.checksum, options.device, options.seed);
+    std::printf(
+        "generated key  %9.1f MB/s  %5.1f%% of copy  (%.3f s, checksum %08x; device %u, "
+        "seed %u)\n",
+        mb / device.seconds, 100.0 * copy.seconds / device.seconds, device.seconds, device.checksum,
+        options.device, options.seed);
     std::printf("copy           %9.1f MB/s  the same launches copying a 1 MB device buffer\n",
                 mb / copy.seconds);
     return 0;

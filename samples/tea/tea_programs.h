@@ -33,8 +33,8 @@ LUCENT_RECORD(CopyRecord, out, source)
 
 LUCENT_RAY_GENERATION(tea_fixed_key, tea_sample::FixedKeyRecord) {
     const unsigned i = lucent::launch_index().x;
-    rec.out[i] = lucent::tea(make_uint2(rec.first_block[0u] + i, 0u), lucent::zafar_tea_key(),
-                             rec.rounds);
+    rec.out[i] =
+        lucent::tea(make_uint2(rec.first_block[0u] + i, 0u), lucent::zafar_tea_key(), rec.rounds);
 }
 
 LUCENT_RAY_GENERATION(tea_device_key, tea_sample::DeviceKeyRecord) {

@@ -386,7 +386,7 @@ bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
     if (root_node.kind == NodeKind::kGeometryGroup && root_node.geometry &&
         root_node.geometry->triangles_only)
         return root_node.geometry->triangles.occluded(ray.origin, ray.direction, ray.tmin,
-                                                       ray.tmax);
+                                                      ray.tmax);
     // Anything else needs a frame: intersection programs and selectors run in it.
     if (ts.depth >= scene.max_depth) throw ProgramException{kExceptionStackOverflow, ts.depth + 1};
     TraceFrame& frame = ts.frames[ts.depth++];

@@ -52,7 +52,8 @@ struct ShapeTuning {
     void record(int shape, double kernel_ms) {
         if (choice >= 0) return;
         if (launches >= 1) ms[shape] = kernel_ms;
-        if (++launches == 3) choice = ms[kL1First] < ms[kOccupancyFirst] ? kL1First : kOccupancyFirst;
+        if (++launches == 3)
+            choice = ms[kL1First] < ms[kOccupancyFirst] ? kL1First : kOccupancyFirst;
     }
 };
 
@@ -111,8 +112,7 @@ class CudaBackend final : public core::Backend {
         ShapeTuning& tuning = m_tuning[{entry, p.launch_count}];
         const int shape = m_fixed_shape ? kOccupancyFirst : tuning.next_shape();
         apply_shape(m_shapes[shape]);
-        const unsigned threads =
-            unsigned(std::max(m_shapes[0].grid, m_shapes[1].grid)) * kBlock;
+        const unsigned threads = unsigned(std::max(m_shapes[0].grid, m_shapes[1].grid)) * kBlock;
         if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
             m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
@@ -123,8 +123,8 @@ class CudaBackend final : public core::Backend {
             check(m_driver.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
         }
         check(m_driver.cuEventRecord(m_start, nullptr), "cuEventRecord");
-        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0, nullptr,
-                                      nullptr, nullptr),
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+                                      nullptr, nullptr, nullptr),
               "launch the megakernel");
         check(m_driver.cuEventRecord(m_stop, nullptr), "cuEventRecord");
         check(m_driver.cuCtxSynchronize(), "run the megakernel");
@@ -177,11 +177,10 @@ class CudaBackend final : public core::Backend {
         m_fixed_shape = fixed != nullptr;
         int static_shared = 0, reserved = 0, shared_per_sm = 0;
         m_driver.cuFuncGetAttribute(&static_shared, CU_FUNC_ATTRIBUTE_SHARED_SIZE_BYTES, m_kernel);
-        m_driver.cuDeviceGetAttribute(&reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK,
-                                      m_device);
-        m_driver.cuDeviceGetAttribute(&shared_per_sm,
-                                      CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR,
-                                      m_device);
+        m_driver.cuDeviceGetAttribute(
+            &reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK, m_device);
+        m_driver.cuDeviceGetAttribute(
+            &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
         const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
         const int needed = by_registers * (static_shared + reserved);
         const int fit = shared_per_sm > 0
@@ -189,7 +188,8 @@ class CudaBackend final : public core::Backend {
                             : 100;
         m_shapes[kOccupancyFirst] = {fixed ? std::atoi(fixed) : fit, 0};
         m_shapes[kL1First] = {0, 0};
-        for (LaunchShape& shape : m_shapes) shape.grid = resident_blocks(shape.carveout) * m_sm_count;
+        for (LaunchShape& shape : m_shapes)
+            shape.grid = resident_blocks(shape.carveout) * m_sm_count;
         m_applied = {-1, 0};
         m_tuning.clear();
         // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
@@ -201,8 +201,8 @@ class CudaBackend final : public core::Backend {
   private:
     /// Blocks of the megakernel resident per SM with this carveout.
     int resident_blocks(int carveout) {
-        check(m_driver.cuFuncSetAttribute(m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
-                                          carveout),
+        check(m_driver.cuFuncSetAttribute(
+                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, carveout),
               "set the shared memory carveout");
         m_applied = {-1, 0};
         int blocks = 0;
@@ -213,8 +213,8 @@ class CudaBackend final : public core::Backend {
 
     void apply_shape(const LaunchShape& shape) {
         if (shape.carveout == m_applied.carveout) return;
-        check(m_driver.cuFuncSetAttribute(m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
-                                          shape.carveout),
+        check(m_driver.cuFuncSetAttribute(
+                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, shape.carveout),
               "set the shared memory carveout");
         m_applied = shape;
     }

@@ -15,7 +15,7 @@ struct OcclusionQuery {
 struct OcclusionRecord {
     Handle top;
     BufferView<OcclusionQuery> queries;
-    BufferView<unsigned> occluded;  // 1: something in (tmin, tmax); 0: nothing
+    BufferView<unsigned> occluded;   // 1: something in (tmin, tmax); 0: nothing
     BufferView<TestPayload> traced;  // the same segment through trace(), for comparison
 };
 LUCENT_RECORD(OcclusionRecord, top, queries, occluded, traced)

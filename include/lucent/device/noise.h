@@ -14,7 +14,9 @@ LUCENT_HD inline float2 tea_lattice_gradient(int ix, int iy, uint4 key, unsigned
     return make_float2(cosf(angle), sinf(angle));
 }
 
-LUCENT_HD inline float quintic_fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+LUCENT_HD inline float quintic_fade(float t) {
+    return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
+}
 
 /// The four corner gradients of a lattice cell: what a march along a ray can keep while it
 /// stays in one cell (the noise of the fog sample varies in x and z only).
