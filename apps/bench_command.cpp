@@ -14,7 +14,16 @@ namespace lucent::cli {
 namespace {
 
 /// A missing scene is a runtime error (exit 1) like an unreadable one, caught before timing.
+/// Checked here rather than by CLI11's required(): CLI11 reports a missing required flag
+/// before an unknown one, so `bench rays --sceen x.obj` would not name the typo.
+void require_scene(const std::string& path) {
+    if (path.empty())
+        throw UsageError(
+            "--scene is required: give an .obj file, e.g. ../shared/scenes/sponza.obj");
+}
+
 void check_scene_file(const std::string& path) {
+    require_scene(path);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
         throw Error("--scene " + path + ": no such file (give an .obj file, e.g. " +
@@ -41,7 +50,7 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
 
     CLI::App* r = cmds.bench->add_subcommand(
         "rays", "Trace the primary, shadow and diffuse ray sets of shared/BENCH.md");
-    r->add_option("--scene", rays.scene, "OBJ file")->type_name("FILE")->required();
+    r->add_option("--scene", rays.scene, "OBJ file (required)")->type_name("FILE");
     r->add_option("--eye", rays.eye, "Camera position x,y,z")->type_name("X,Y,Z");
     r->add_option("--look", rays.look, "Point looked at x,y,z")->type_name("X,Y,Z");
     r->add_option("--up", rays.up, "Up vector x,y,z")->type_name("X,Y,Z");
@@ -95,7 +104,7 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     cmds.tea = t;
 
     CLI::App* b = cmds.bench->add_subcommand("build", "Time the BVH build of a scene");
-    b->add_option("--scene", build.scene, "OBJ file")->type_name("FILE")->required();
+    b->add_option("--scene", build.scene, "OBJ file (required)")->type_name("FILE");
     b->add_option("--repeat", build.repeat, "Timed repeats (median reported)")
         ->type_name("N")
         ->check(CLI::Range(1, 1000).description(""))
@@ -119,6 +128,7 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
 }
 
 int run_bench_rays_command(const BenchRaysArgs& args) {
+    require_scene(args.scene);
     bench::RaysOptions options;
     options.scene = args.scene;
     options.backend = bench_backend(args.backend);

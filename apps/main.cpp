@@ -1,4 +1,4 @@
-// The `lucent` command line: render a sample, or run the benchmarks.
+// The `lucent` command line: render or view a sample, or run the benchmarks.
 // Exit codes: 0 success, 1 runtime error (engine, files), 2 bad command-line input.
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -13,6 +13,7 @@
 #include "render_command.h"
 #include "samples/settings_error.h"
 #include "tea_command.h"
+#include "view_command.h"
 
 namespace {
 
@@ -34,11 +35,13 @@ int main(int argc, char** argv) {
     app.footer(
         "Examples:\n"
         "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"
+        "  lucent view --sample pathtracer --scene cornell-materials\n"
         "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
         "  lucent tea --block 0,0 --key 0,0,0,0 --rounds 32\n"
         "Run `lucent render --help` for the samples and their options.\n");
 
     RenderArgs render_args;
+    ViewArgs view_args;
     BenchRaysArgs rays_args;
     BenchBuildArgs build_args;
     BenchTeaArgs bench_tea_args;
@@ -49,6 +52,7 @@ int main(int argc, char** argv) {
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
+        CLI::App* view = add_view_command(app, view_args);
         BenchCommands bench = add_bench_commands(app, rays_args, build_args, bench_tea_args);
         CLI::App* bench_igi = add_bench_igi_command(bench.bench, bench_igi_args);
         CLI::App* bench_fog = add_bench_fog_command(bench.bench, bench_fog_args);
@@ -63,6 +67,10 @@ int main(int argc, char** argv) {
         if (render->parsed()) {
             where = "lucent render";
             return run_render(render_args);
+        }
+        if (view->parsed()) {
+            where = "lucent view";
+            return run_view(view_args);
         }
         if (bench.rays->parsed()) {
             where = "lucent bench rays";

@@ -4,11 +4,13 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "lucent/context.h"
 #include "scene/image_io.h"
+#include "scene/scene.h"
 
 namespace lucent::samples {
 
@@ -57,11 +59,47 @@ struct RenderResult {
     std::map<std::string, scene::Image> layers;
 };
 
+/// One frame of an interactive session.
+struct FrameResult {
+    scene::Image image;               // linear RGB
+    std::vector<StageTiming> stages;  // of this frame only (a recompile shows here)
+    unsigned samples = 1;             // frames accumulated into the image (progressive samples)
+    LaunchReport report;              // exceptions of this frame's last launch
+};
+
+/// A sample's scene built once and rendered many times from a moving camera (`lucent view`).
+/// Not thread-safe: one thread opens it and calls everything.
+class InteractiveSession {
+  public:
+    virtual ~InteractiveSession() = default;
+    /// The backend that runs it (Context::backend_name()) and why auto chose it.
+    virtual std::string backend() const = 0;
+    virtual std::string backend_notice() const = 0;
+    /// Where the sample's own render puts the camera: the viewer starts there.
+    virtual scene::Camera initial_camera() const = 0;
+    /// Moves the camera; a progressive session restarts its accumulation.
+    virtual void set_camera(const scene::Camera& camera) = 0;
+    /// Changes a --set option in place and returns true; false when the option needs the
+    /// scene rebuilt (the caller opens a new session). A bad value throws SettingsError.
+    virtual bool set_option(const std::string& name, const std::string& value) = 0;
+    /// Progressive sessions: drop the accumulated frames.
+    virtual void reset() {}
+    /// True when frame() refines the image further while nothing changes.
+    virtual bool progressive() const { return false; }
+    /// True when set_camera is ignored: the session renders from the sample's own camera.
+    virtual bool fixed_camera() const { return false; }
+    /// Renders one frame (a progressive session: one more sample per pixel).
+    virtual FrameResult frame() = 0;
+};
+
 struct SampleInfo {
     std::string name;
     std::string description;
     std::vector<SampleOption> options;
     RenderResult (*render)(const RenderSettings& settings);
+    /// Opens an interactive session (size, backend and --set from the settings); null for
+    /// samples that have none (`lucent view` then shows their own camera's render).
+    std::unique_ptr<InteractiveSession> (*open)(const RenderSettings& settings) = nullptr;
 };
 
 /// Launches `entry` over width x height, then `settings.repeat - 1` more times when asked,
@@ -69,6 +107,20 @@ struct SampleInfo {
 /// JIT" (when it ran) and "launch" (the first, or the median of the repeats with spread).
 void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
                   RenderResult& result);
+
+/// The sample's own session (SampleInfo::open) or, for samples without one, a session that
+/// re-renders through SampleInfo::render when an option changes, from the sample's own
+/// camera (fixed_camera() is true).
+std::unique_ptr<InteractiveSession> open_session(const SampleInfo& info,
+                                                 const RenderSettings& settings);
+
+/// The [lo, hi] range an option's help text names, "(1..256)" or "(0..2^30)"; false when it
+/// names none. For the viewer's sliders.
+bool option_range(const SampleOption& option, double& lo, double& hi);
+
+/// A viewer frame's stages from its launch report: "compile + accel" and "megakernel JIT"
+/// when that launch recompiled, then "launch".
+void add_launch_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
 
 /// Every sample, in the order `--help` lists them.
 const std::vector<SampleInfo>& all_samples();

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "samples/fog/fog_scene.h"
+#include "samples/fog/fog_session.h"
 #include "samples/scene_setup.h"
 #include "samples/settings_error.h"
 
@@ -80,6 +81,7 @@ const SampleInfo& fog_sample_info() {
              "the camera's distance from the scene's axis (below 12: over the floor)"},
         },
         render_fog,
+        open_fog_session,
     };
     return info;
 }

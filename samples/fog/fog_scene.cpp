@@ -240,13 +240,21 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
 
 FogScene::~FogScene() = default;
 
-const LaunchReport& FogScene::render(float orbit_degrees) {
+scene::Camera FogScene::orbit_camera(float orbit_degrees) const {
     const float a = (orbit_degrees + kOrbitStartDegrees) * 3.14159265f / 180.0f;
     scene::Camera camera;
     const float r = m->options.eye_distance;
     camera.eye = make_float3(r * std::sin(a), m->options.eye_height, -r * std::cos(a));
     camera.look = kLookAt;
     camera.fov_degrees = 45.0f;
+    return camera;
+}
+
+const LaunchReport& FogScene::render(float orbit_degrees) {
+    return render(orbit_camera(orbit_degrees));
+}
+
+const LaunchReport& FogScene::render(const scene::Camera& camera) {
     const PinholeFrame frame = pinhole_frame(camera, float(m->width) / float(m->height));
     // The camera is data in a buffer: moving it re-uploads 48 bytes, it recompiles nothing.
     m->camera->upload(std::vector<fog::CameraFrame>{{camera.eye, frame.U, frame.V, frame.W}});

@@ -8,6 +8,7 @@
 
 #include "lucent/context.h"
 #include "samples/sample.h"
+#include "scene/scene.h"
 
 namespace lucent::samples {
 
@@ -38,6 +39,10 @@ class FogScene {
 
     /// Places the camera at `orbit_degrees` around the scene and launches; returns the report.
     const LaunchReport& render(float orbit_degrees);
+    /// Launches with any camera (the viewer's); returns the report.
+    const LaunchReport& render(const scene::Camera& camera);
+    /// The camera at `orbit_degrees` on the orbit of the options' height and distance.
+    scene::Camera orbit_camera(float orbit_degrees) const;
     Context& context();
     const Buffer& output() const;
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "samples/pathtracer/pathtracer_programs.h"
+#include "samples/pathtracer/pathtracer_scene.h"
 #include "samples/scene_setup.h"
 #include "scene/scene.h"
 
@@ -60,27 +61,38 @@ void add_light_geometry(scene::Scene& s, float tolerance) {
     }
 }
 
-RenderResult render_pathtracer(const RenderSettings& settings) {
+}  // namespace
+
+PathOptions read_path_options(const RenderSettings& settings) {
     const SampleInfo& info = pathtracer_sample_info();
     check_options(settings, info);
-    const int max_depth = get_int_option(settings, info, "max_depth", 1, 256);
-    const int rr_depth = get_int_option(settings, info, "rr_depth", 1, 256);
-    const int nee = get_int_option(settings, info, "nee", 0, 1);
-    const float environment = get_float_option(settings, info, "environment", 0.0f, 1e6f);
-    const float exposure = get_float_option(settings, info, "exposure", 0.0f, 1e6f);
-    const int reinhard = get_int_option(settings, info, "reinhard", 0, 1);
-    const int seed = get_int_option(settings, info, "seed", 0, 1 << 30);
-    const unsigned spp = settings.spp ? settings.spp : 64;
-    const Clock::time_point setup_start = Clock::now();
+    PathOptions o;
+    o.max_depth = get_int_option(settings, info, "max_depth", 1, 256);
+    o.rr_depth = get_int_option(settings, info, "rr_depth", 1, 256);
+    o.nee = get_int_option(settings, info, "nee", 0, 1);
+    o.environment = get_float_option(settings, info, "environment", 0.0f, 1e6f);
+    o.exposure = get_float_option(settings, info, "exposure", 0.0f, 1e6f);
+    o.reinhard = get_int_option(settings, info, "reinhard", 0, 1);
+    o.seed = get_int_option(settings, info, "seed", 0, 1 << 30);
+    return o;
+}
+
+void set_path_camera_options(Program& camera, const PathOptions& o) {
+    camera["max_depth"] = unsigned(o.max_depth);
+    camera["rr_depth"] = unsigned(o.rr_depth);
+    camera["nee"] = unsigned(o.nee);
+    camera["seed"] = unsigned(o.seed);
+    camera["exposure"] = o.exposure;
+    camera["reinhard"] = unsigned(o.reinhard);
+}
+
+PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
+                           const PathOptions& options) {
     scene::Scene input = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
     const float extent = scene_extent(input);
     const float epsilon = std::max(1e-4f, 1e-4f * extent);
     add_light_geometry(input, 10 * epsilon);
 
-    RenderResult out;
-    Context ctx(settings.context_options());
-    out.backend = ctx.backend_name();
-    out.backend_notice = ctx.backend_notice();
     ctx.set_ray_type<pathtracer::PathPayload>(pathtracer::kRadianceRay, "radiance");
     ctx.set_ray_type<pathtracer::ShadowPayload>(pathtracer::kShadowRay, "shadow",
                                                 /*expects_closest_hit=*/false);
@@ -139,31 +151,43 @@ RenderResult render_pathtracer(const RenderSettings& settings) {
     }
     ctx["top_object"] = top;
 
-    const PinholeFrame frame =
-        pinhole_frame(input.camera, float(settings.width) / float(settings.height));
-    auto accum =
+    PathScene out;
+    out.camera = input.camera;
+    out.accum =
         ctx.create_buffer<float4>(BufferType::kInputOutput, settings.width, settings.height);
-    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    out.output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    out.miss = ctx.create_program(LUCENT_PROGRAM(pt_miss));
+    (*out.miss)["environment"] = make_float3(options.environment);
+    ctx.set_miss_program(pathtracer::kRadianceRay, out.miss);
+    out.note = input.name + ", " + std::to_string(input.triangle_count()) + " triangles";
+    return out;
+}
+
+namespace {
+
+RenderResult render_pathtracer(const RenderSettings& settings) {
+    const PathOptions options = read_path_options(settings);
+    const unsigned spp = settings.spp ? settings.spp : 64;
+    const Clock::time_point setup_start = Clock::now();
+    RenderResult out;
+    Context ctx(settings.context_options());
+    out.backend = ctx.backend_name();
+    out.backend_notice = ctx.backend_notice();
+    const PathScene scene = build_path_scene(ctx, settings, options);
+
+    const PinholeFrame frame =
+        pinhole_frame(scene.camera, float(settings.width) / float(settings.height));
     auto camera = ctx.create_program(LUCENT_PROGRAM(pt_camera));
-    (*camera)["eye"] = input.camera.eye;
+    (*camera)["eye"] = scene.camera.eye;
     (*camera)["W"] = frame.W;
     (*camera)["U"] = frame.U;
     (*camera)["V"] = frame.V;
-    (*camera)["accum"] = accum;
-    (*camera)["output"] = output;
-    (*camera)["max_depth"] = unsigned(max_depth);
-    (*camera)["rr_depth"] = unsigned(rr_depth);
-    (*camera)["nee"] = unsigned(nee);
-    (*camera)["seed"] = unsigned(seed);
-    (*camera)["exposure"] = exposure;
-    (*camera)["reinhard"] = unsigned(reinhard);
+    (*camera)["accum"] = scene.accum;
+    (*camera)["output"] = scene.output;
+    set_path_camera_options(*camera, options);
     ctx.set_ray_generation_program(0, camera);
-    auto miss = ctx.create_program(LUCENT_PROGRAM(pt_miss));
-    (*miss)["environment"] = make_float3(environment);
-    ctx.set_miss_program(pathtracer::kRadianceRay, miss);
-    out.stages.push_back(
-        {"scene setup", ms_since(setup_start),
-         input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
+    out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
+    auto& output = scene.output;
 
     // Progressive accumulation: the frame number lives in the accumulation buffer (its w),
     // so launches change nothing on the host and the compiled scene (and on the GPU the
@@ -221,6 +245,7 @@ const SampleInfo& pathtracer_sample_info() {
             {"seed", "0", "selects an independent set of random streams (0..2^30)"},
         },
         render_pathtracer,
+        open_pathtracer_session,
     };
     return info;
 }

@@ -214,11 +214,11 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
     prd.origin = s.wi.z > 0.0f ? above : x - rec.scene_epsilon * n;
 }
 
-}  // namespace pathtracer
-
 // ---- the path loop (CACM Figure 8) -----------------------------------------------------------
-LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
-    using namespace pathtracer;
+/// One more sample of the pixel at the launch index into rec.accum, and the mean into
+/// rec.output. Shared by the sample's camera and the viewer's, which differ only in where the
+/// frame is.
+LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
     const uint2 pixel = make_uint2(i.x, i.y);
     float4 accum = rec.accum[pixel];
@@ -270,6 +270,50 @@ LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
         mean = make_float3(mean.x / (1.0f + mean.x), mean.y / (1.0f + mean.y),
                            mean.z / (1.0f + mean.z));
     rec.output[pixel] = make_float4(mean, 1.0f);
+}
+
+/// The viewer's camera frame: data in a 1-element buffer, so moving the camera re-uploads
+/// 48 bytes instead of changing variables (which recompiles the scene).
+struct ViewFrame {
+    float3 eye, U, V, W;
+};
+
+struct ViewCameraRecord {
+    lucent::BufferView<ViewFrame> camera;
+    lucent::BufferView<float4> accum;
+    lucent::BufferView<float4> output;
+    lucent::Handle top_object;
+    unsigned max_depth, rr_depth, nee, seed;
+    float exposure;
+    unsigned reinhard;
+};
+LUCENT_RECORD(ViewCameraRecord, camera, accum, output, top_object, max_depth, rr_depth, nee, seed,
+              exposure, reinhard)
+
+}  // namespace pathtracer
+
+LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
+    pathtracer::trace_pixel(rec);
+}
+
+/// `lucent view`'s camera: pt_camera with the frame read from a buffer.
+LUCENT_RAY_GENERATION(pt_view_camera, pathtracer::ViewCameraRecord) {
+    const pathtracer::ViewFrame c = rec.camera[0u];
+    pathtracer::CameraRecord frame;
+    frame.eye = c.eye;
+    frame.U = c.U;
+    frame.V = c.V;
+    frame.W = c.W;
+    frame.accum = rec.accum;
+    frame.output = rec.output;
+    frame.top_object = rec.top_object;
+    frame.max_depth = rec.max_depth;
+    frame.rr_depth = rec.rr_depth;
+    frame.nee = rec.nee;
+    frame.seed = rec.seed;
+    frame.exposure = rec.exposure;
+    frame.reinhard = rec.reinhard;
+    pathtracer::trace_pixel(frame);
 }
 
 LUCENT_MISS(pt_miss, pathtracer::MissRecord, pathtracer::PathPayload) {

@@ -13,6 +13,7 @@
 #include "lucent.h"
 #include "samples/settings_error.h"
 #include "samples/whitted/whitted_programs.h"
+#include "samples/whitted/whitted_scene.h"
 
 namespace lucent::samples {
 namespace {
@@ -58,28 +59,58 @@ std::vector<whitted::BasicLight> make_lights(const WhittedLayout& layout, int co
 }
 
 RenderResult render_whitted(const RenderSettings& settings) {
-    const SampleInfo& info = whitted_sample_info();
-    check_options(settings, info);
-    if (!settings.scene.empty() && settings.scene != kSceneName)
-        throw SettingsError("--scene " + settings.scene +
-                            ": the whitted sample has one built-in scene; accepted names are "
-                            "'whitted' (or no --scene)");
-    const int antialiasing = get_int_option(settings, info, "aa", 0, 1);
-    const float aa_threshold = get_float_option(settings, info, "aa_threshold", 0.0f, 1.0f);
-    const int max_depth = get_int_option(settings, info, "max_depth", 1, 31);
-    const int shadows = get_int_option(settings, info, "shadows", 0, 1);
-    const int light_count = get_int_option(settings, info, "lights", 1, 3);
-    if (settings.width == 0 || settings.height == 0)
-        throw SettingsError("whitted: image size " + std::to_string(settings.width) + "x" +
-                            std::to_string(settings.height) + " is empty; give --size WxH");
-
-    const WhittedLayout& layout = whitted_layout();
+    const WhittedOptions options = read_whitted_options(settings);
     RenderResult out;
     const Clock::time_point setup_start = Clock::now();
 
     Context ctx(settings.context_options());
     out.backend = ctx.backend_name();
     out.backend_notice = ctx.backend_notice();
+    auto output = build_whitted_scene(ctx, options, settings.width, settings.height);
+
+    const WhittedLayout& layout = whitted_layout();
+    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted_camera));
+    const CameraFrame frame = camera_frame(layout, float(settings.width) / float(settings.height));
+    (*camera)["eye"] = layout.eye;
+    (*camera)["U"] = frame.U;
+    (*camera)["V"] = frame.V;
+    (*camera)["W"] = frame.W;
+    (*camera)["antialiasing"] = options.antialiasing;
+    (*camera)["aa_threshold"] = options.aa_threshold;
+    ctx.set_ray_generation_program(0, camera);
+    out.stages.push_back({"scene setup", ms_since(setup_start)});
+
+    timed_launch(ctx, 0, settings, out);
+
+    out.image = image_from_output(*output);
+    return out;
+}
+
+}  // namespace
+
+WhittedOptions read_whitted_options(const RenderSettings& settings) {
+    const SampleInfo& info = whitted_sample_info();
+    check_options(settings, info);
+    if (!settings.scene.empty() && settings.scene != kSceneName)
+        throw SettingsError("--scene " + settings.scene +
+                            ": the whitted sample has one built-in scene; accepted names are "
+                            "'whitted' (or no --scene)");
+    if (settings.width == 0 || settings.height == 0)
+        throw SettingsError("whitted: image size " + std::to_string(settings.width) + "x" +
+                            std::to_string(settings.height) + " is empty; give --size WxH");
+    WhittedOptions o;
+    o.antialiasing = get_int_option(settings, info, "aa", 0, 1);
+    o.aa_threshold = get_float_option(settings, info, "aa_threshold", 0.0f, 1.0f);
+    o.max_depth = get_int_option(settings, info, "max_depth", 1, 31);
+    o.shadows = get_int_option(settings, info, "shadows", 0, 1);
+    o.lights = get_int_option(settings, info, "lights", 1, 3);
+    return o;
+}
+
+std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& options,
+                                            unsigned width, unsigned height) {
+    const WhittedLayout& layout = whitted_layout();
+    const int max_depth = options.max_depth;
     ctx.set_ray_type<whitted::RadiancePayload>(whitted::kRadianceRay, "radiance");
     // Shadow rays need only any-hit (attenuate or stop) and no miss program: a ray that
     // reaches the light returns the attenuation the glass left it.
@@ -90,22 +121,12 @@ RenderResult render_whitted(const RenderSettings& settings) {
     ctx.set_exception_enabled(kExceptionStackOverflow, true);
     ctx.set_exception_enabled(kExceptionBufferIndexOutOfBounds, true);
 
-    // ---- camera, exception and miss programs ----------------------------------------
-    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    // ---- output, exception and miss programs (the caller adds the camera) --------------
+    auto output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
     output->set_name("output_buffer");
     ctx["output_buffer"] = output;
 
     ctx.set_entry_point_count(1);
-    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted_camera));
-    const CameraFrame frame = camera_frame(layout, float(settings.width) / float(settings.height));
-    (*camera)["eye"] = layout.eye;
-    (*camera)["U"] = frame.U;
-    (*camera)["V"] = frame.V;
-    (*camera)["W"] = frame.W;
-    (*camera)["antialiasing"] = antialiasing;
-    (*camera)["aa_threshold"] = aa_threshold;
-    ctx.set_ray_generation_program(0, camera);
-
     auto exception = ctx.create_program(LUCENT_PROGRAM(whitted_exception));
     (*exception)["bad_color"] = make_float3(1.0f, 0.0f, 1.0f);
     ctx.set_exception_program(0, exception);
@@ -238,7 +259,7 @@ RenderResult render_whitted(const RenderSettings& settings) {
     group->add_child(glass_instance);
 
     // ---- context-wide variables ---------------------------------------------------------
-    const std::vector<whitted::BasicLight> lights = make_lights(layout, light_count);
+    const std::vector<whitted::BasicLight> lights = make_lights(layout, options.lights);
     auto light_buffer =
         ctx.create_buffer<whitted::BasicLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->set_name("lights");
@@ -249,17 +270,9 @@ RenderResult render_whitted(const RenderSettings& settings) {
     ctx["ambient_light_color"] = make_float3(layout.ambient);
     ctx["scene_epsilon"] = 1e-3f;
     ctx["max_depth"] = max_depth;
-    ctx["shadows"] = shadows;
-
-    out.stages.push_back({"scene setup", ms_since(setup_start)});
-
-    timed_launch(ctx, 0, settings, out);
-
-    out.image = image_from_output(*output);
-    return out;
+    ctx["shadows"] = options.shadows;
+    return output;
 }
-
-}  // namespace
 
 const WhittedLayout& whitted_layout() {
     static const WhittedLayout layout = [] {
@@ -313,6 +326,7 @@ const SampleInfo& whitted_sample_info() {
             {"lights", "1", "number of point lights, sharing one intensity (1..3)"},
         },
         &render_whitted,
+        &open_whitted_session,
     };
     return info;
 }

@@ -274,15 +274,14 @@ LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, float sx, float s
     return prd.result;
 }
 
-}  // namespace whitted
-
 // ---- camera ----------------------------------------------------------------------
 
 /// Pinhole camera (paper §6.1). With antialiasing on, four rays on a rotated grid decide
 /// whether the pixel is smooth; if any differs from their mean by more than aa_threshold, the
 /// other twelve cells of a 4x4 grid are traced too and all sixteen averaged (adaptive
 /// supersampling: only edges, shadow borders and checker borders pay for it).
-LUCENT_RAY_GENERATION(whitted_camera, whitted::CameraRecord) {
+/// Shared by the sample's camera and the viewer's, which differ only in where the frame is.
+LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
     uint3 index = lucent::launch_index();
     uint3 size = lucent::launch_size();
     float inv_w = 1.0f / float(size.x), inv_h = 1.0f / float(size.y);
@@ -322,6 +321,42 @@ LUCENT_RAY_GENERATION(whitted_camera, whitted::CameraRecord) {
         }
     }
     rec.output_buffer[make_uint2(index.x, index.y)] = make_float4(color, 1.0f);
+}
+
+/// The viewer's camera frame: data in a 1-element buffer, so moving the camera re-uploads
+/// 48 bytes instead of changing variables (which recompiles the scene).
+struct ViewFrame {
+    float3 eye, U, V, W;
+};
+
+struct ViewCameraRecord {
+    BufferView<ViewFrame> camera;
+    BufferView<float4> output_buffer;
+    Handle top_object;
+    int antialiasing;
+    float aa_threshold;
+};
+LUCENT_RECORD(ViewCameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold)
+
+}  // namespace whitted
+
+LUCENT_RAY_GENERATION(whitted_camera, whitted::CameraRecord) {
+    whitted::render_pixel(rec);
+}
+
+/// `lucent view`'s camera: the same pixels as whitted_camera, the frame read from a buffer.
+LUCENT_RAY_GENERATION(whitted_view_camera, whitted::ViewCameraRecord) {
+    const whitted::ViewFrame c = rec.camera[0u];
+    whitted::CameraRecord frame;
+    frame.eye = c.eye;
+    frame.U = c.U;
+    frame.V = c.V;
+    frame.W = c.W;
+    frame.output_buffer = rec.output_buffer;
+    frame.top_object = rec.top_object;
+    frame.antialiasing = rec.antialiasing;
+    frame.aa_threshold = rec.aa_threshold;
+    whitted::render_pixel(frame);
 }
 
 /// Marks a pixel whose launch raised an exception with an unmistakable colour.

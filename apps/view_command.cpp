@@ -1,0 +1,115 @@
+// `lucent view`: checks the input like `render` does, then hands over to the viewer, which
+// this build has only when GLFW, Dear ImGui and OpenGL were found at configure time.
+#include "view_command.h"
+
+#include <thread>
+
+#include "cli_parse.h"
+#include "lucent/error.h"
+#include "samples/sample.h"
+#ifdef LUCENT_HAVE_VIEWER
+#include "viewer/viewer.h"
+#endif
+
+namespace lucent::cli {
+
+CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
+    CLI::App* cmd =
+        app.add_subcommand("view", "Show a sample in a window, rendered as the camera moves");
+    cmd->add_option("--sample", args.sample, "Sample to show (see `lucent render --help`)")
+        ->type_name("NAME")
+        ->capture_default_str();
+    cmd->add_option("--size", args.size, "Rendered image size, each side 1..16384")
+        ->type_name("WxH")
+        ->capture_default_str();
+    cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
+        ->type_name("KIND")
+        ->capture_default_str();
+    cmd->add_option("--scene", args.scene,
+                    "Built-in scene or scene file (default: the sample's own)")
+        ->type_name("NAME|FILE");
+    cmd->add_option("--set", args.sets, "Sample option (repeatable)")->type_name("NAME=VALUE");
+    cmd->add_option("--threads", args.threads,
+                    "CPU worker threads, 0 = one per core but one (left to the window)")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 4096u).description(""))
+        ->capture_default_str();
+    cmd->add_option("--spp", args.spp,
+                    "Progressive samples (the path tracer) stop refining at this many samples "
+                    "per pixel; 0 = never")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 1000000u).description(""))
+        ->capture_default_str();
+    cmd->add_option("--frames", args.frames,
+                    "Render this many frames, then exit (with --screenshot: a headless check)")
+        ->type_name("N")
+        ->check(CLI::Range(1u, 1000000u).description(""));
+    cmd->add_option("--screenshot", args.screenshot,
+                    "With --frames: save what the window shows, as a .png, before exiting")
+        ->type_name("FILE");
+    cmd->add_flag("--no-panel", args.no_panel, "Hide the control panel (H toggles it)");
+    cmd->add_flag("-v,--verbose", args.verbose,
+                  "Print the backend, and UI and render frames/s at exit");
+    cmd->footer(
+        "Mouse: left-drag orbit, right- or middle-drag pan, wheel zoom.\n"
+        "Keys: W A S D fly, Q E down/up (Shift: faster); R reset accumulation; C camera back\n"
+        "      to the start; P save a PNG of the render; L show VPLs, I GI on/off, M merging\n"
+        "      on/off (the samples with those options: radiosity); H panel; Esc quit.\n"
+        "\nExamples:\n"
+        "  lucent view --sample pathtracer --scene cornell-materials\n"
+        "  lucent view --sample whitted --backend cpu --size 640x480\n"
+        "  lucent view --sample fog --set step=0.1\n"
+        "  lucent view --sample radiosity --set show_vpls=1     # then M, I and L toggle\n"
+        "  xvfb-run -a -s '-screen 0 1280x1024x24' lucent view --sample whitted "
+        "--size 160x120 --frames 2 --no-panel --screenshot view.png\n");
+    return cmd;
+}
+
+int run_view(const ViewArgs& args) {
+    samples::RenderSettings settings;
+    const Size size = parse_size("--size", args.size);
+    settings.width = size.width;
+    settings.height = size.height;
+    settings.backend = parse_backend("--backend", args.backend);
+    // The CPU backend leaves one core to the window by default, so the panel stays fluid
+    // while a frame renders; --threads N overrides.
+    settings.threads = args.threads;
+    if (settings.threads == 0) {
+        const unsigned cores = std::thread::hardware_concurrency();  // 0: unknown
+        settings.threads = cores > 1 ? cores - 1 : 1;
+    }
+    settings.scene = args.scene;
+    settings.spp = args.spp;
+    for (const std::string& text : args.sets) {
+        auto [name, value] = parse_set("--set", text);
+        settings.sets[name] = value;
+    }
+    if (!args.screenshot.empty()) {
+        if (args.frames == 0)
+            throw UsageError("--screenshot " + quoted(args.screenshot) +
+                             ": needs --frames N (the frame to save)");
+        check_image_path("--screenshot", args.screenshot);
+        if (!args.screenshot.ends_with(".png"))
+            throw UsageError("--screenshot " + quoted(args.screenshot) +
+                             ": the window is saved as 8-bit sRGB; the name must end in .png");
+    }
+    const samples::SampleInfo& info = samples::find_sample(args.sample);
+    samples::check_options(settings, info);
+#ifdef LUCENT_HAVE_VIEWER
+    viewer::ViewerConfig config;
+    config.info = &info;
+    config.settings = settings;
+    config.frames = args.frames;
+    config.screenshot = args.screenshot;
+    config.panel = !args.no_panel;
+    config.verbose = args.verbose;
+    return viewer::run_viewer(config);
+#else
+    throw Error(
+        "this build has no viewer: GLFW, Dear ImGui or OpenGL was missing at configure time; "
+        "install libglfw3-dev libimgui-dev libgl-dev (scripts/install-deps.sh does), then "
+        "configure and build again");
+#endif
+}
+
+}  // namespace lucent::cli

@@ -1,0 +1,30 @@
+// `lucent view`: a window showing a sample rendered interactively (apps/viewer/).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace lucent::cli {
+
+/// The view options as typed; parsed and checked by run_view.
+struct ViewArgs {
+    std::string sample = "whitted";
+    std::string size = "800x600";
+    std::string backend = "auto";
+    std::string scene;
+    std::vector<std::string> sets;
+    unsigned threads = 0;
+    unsigned spp = 0;        // progressive samples stop refining here; 0 = never
+    unsigned frames = 0;     // >0: render this many frames, then exit (headless checks)
+    std::string screenshot;  // with --frames: save what the window shows here
+    bool no_panel = false;   // hide the ImGui panel (screenshots of the image alone)
+    bool verbose = false;
+};
+
+/// Adds the `view` subcommand to `app`; its options fill `args`.
+CLI::App* add_view_command(CLI::App& app, ViewArgs& args);
+/// Runs a parsed `view`; returns the exit code. Throws UsageError, lucent::Error.
+int run_view(const ViewArgs& args);
+
+}  // namespace lucent::cli

@@ -1,0 +1,25 @@
+// The ImGui panel: frames/s, the last frame's stage timings, and a control per sample
+// option (checkbox, slider or text field, from the option's help text).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "render_worker.h"
+#include "samples/sample.h"
+
+namespace lucent::viewer {
+
+/// What the panel shows besides the worker's status.
+struct PanelState {
+    double ui_fps = 0;      // window frames/s
+    double render_fps = 0;  // finished renders/s (smoothed)
+    const ShownFrame* frame = nullptr;
+    std::string message;  // the last key's effect ("saved lucent-view-1.png")
+};
+
+/// Draws the panel; returns the options the user changed (name → new value).
+std::map<std::string, std::string> draw_panel(const samples::SampleInfo& info,
+                                              const WorkerStatus& status, const PanelState& state);
+
+}  // namespace lucent::viewer

@@ -1,0 +1,161 @@
+#include "render_worker.h"
+
+#include <chrono>
+#include <exception>
+
+#include "lucent/error.h"
+
+namespace lucent::viewer {
+
+RenderWorker::RenderWorker(const samples::SampleInfo& info, samples::RenderSettings settings,
+                           uint64_t frame_limit)
+    : m_info(info), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
+    m_settings.repeat = 1;
+    m_settings.progress = nullptr;
+    m_status.sets = m_settings.sets;
+    m_thread = std::thread([this] { run(); });
+}
+
+RenderWorker::~RenderWorker() {
+    {
+        std::lock_guard lock(m_mutex);
+        m_stop = true;
+    }
+    m_wake.notify_all();
+    m_thread.join();  // a frame in progress finishes first: launches cannot be interrupted
+}
+
+void RenderWorker::set_camera(const scene::Camera& camera) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_pending_camera = camera;
+    }
+    m_wake.notify_all();
+}
+
+void RenderWorker::set_option(const std::string& name, const std::string& value) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_pending_sets[name] = value;
+        m_status.sets[name] = value;
+    }
+    m_wake.notify_all();
+}
+
+void RenderWorker::reset() {
+    {
+        std::lock_guard lock(m_mutex);
+        m_pending_reset = true;
+    }
+    m_wake.notify_all();
+}
+
+std::optional<ShownFrame> RenderWorker::frame_after(uint64_t after) {
+    std::lock_guard lock(m_mutex);
+    if (m_latest.number <= after) return std::nullopt;
+    return m_latest;
+}
+
+WorkerStatus RenderWorker::status() {
+    std::lock_guard lock(m_mutex);
+    return m_status;
+}
+
+uint64_t RenderWorker::frames_done() {
+    std::lock_guard lock(m_mutex);
+    return m_latest.number;
+}
+
+bool RenderWorker::has_work() const {
+    if (m_pending_camera || !m_pending_sets.empty() || m_pending_reset) return true;
+    if (m_frame_limit > 0) return m_latest.number < m_frame_limit && m_status.error.empty();
+    return !m_converged;
+}
+
+void RenderWorker::open_session() {
+    m_session = samples::open_session(m_info, m_settings);
+    std::lock_guard lock(m_mutex);
+    m_status.opened = true;
+    m_status.fixed_camera = m_session->fixed_camera();
+    m_status.progressive = m_session->progressive();
+    m_status.backend = m_session->backend();
+    m_status.backend_notice = m_session->backend_notice();
+    m_status.initial_camera = m_session->initial_camera();
+}
+
+void RenderWorker::run() {
+    try {
+        open_session();
+    } catch (const std::exception& e) {
+        std::lock_guard lock(m_mutex);
+        m_status.error = e.what();
+        return;  // the window stays up and shows why
+    }
+    scene::Camera camera = m_status.initial_camera;
+    while (true) {
+        std::optional<scene::Camera> new_camera;
+        std::map<std::string, std::string> new_sets;
+        bool reset = false;
+        {
+            std::unique_lock lock(m_mutex);
+            m_wake.wait(lock, [this] { return m_stop || has_work(); });
+            if (m_stop) return;
+            new_camera.swap(m_pending_camera);
+            new_sets.swap(m_pending_sets);
+            reset = m_pending_reset;
+            m_pending_reset = false;
+            m_status.busy = true;
+        }
+        const auto start = std::chrono::steady_clock::now();
+        ShownFrame shown;
+        std::string error;
+        try {
+            if (new_camera) {
+                camera = *new_camera;
+                m_session->set_camera(camera);
+            }
+            bool rebuild = false;
+            for (const auto& [name, value] : new_sets) {
+                samples::RenderSettings changed = m_settings;
+                changed.sets[name] = value;
+                samples::check_options(changed, m_info);
+                if (!m_session->set_option(name, value)) rebuild = true;
+                m_settings = changed;
+            }
+            if (rebuild) {
+                // The option changes the scene's shape: build it again where the camera is.
+                open_session();
+                m_session->set_camera(camera);
+            }
+            if (reset) m_session->reset();
+            samples::FrameResult frame = m_session->frame();
+            shown.width = frame.image.width;
+            shown.height = frame.image.height;
+            shown.rgb = scene::to_srgb8(frame.image);
+            shown.linear = std::move(frame.image);
+            shown.stages = std::move(frame.stages);
+            shown.samples = frame.samples;
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+        shown.frame_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        std::lock_guard lock(m_mutex);
+        m_status.busy = false;
+        m_status.error = error;
+        m_status.backend = m_session->backend();
+        if (!error.empty()) {
+            // Show the message and wait for the next change instead of failing again.
+            m_converged = true;
+            continue;
+        }
+        shown.number = m_latest.number + 1;
+        const bool refining =
+            m_session->progressive() && (m_settings.spp == 0 || shown.samples < m_settings.spp);
+        m_converged = !refining;
+        m_latest = std::move(shown);
+    }
+}
+
+}  // namespace lucent::viewer

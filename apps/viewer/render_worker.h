@@ -1,0 +1,84 @@
+// Renders on its own thread so the window stays responsive while a slow frame (the CPU
+// backend, a full IGI render) is in progress: the window shows the last finished frame.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "samples/sample.h"
+
+namespace lucent::viewer {
+
+/// A finished frame, ready to show: 8-bit sRGB (scene::to_srgb8, the same conversion as
+/// `lucent render`'s PNGs) and what it cost.
+struct ShownFrame {
+    uint64_t number = 0;  // 1, 2, ... in the order frames finished; 0: none yet
+    unsigned width = 0, height = 0;
+    std::vector<unsigned char> rgb;
+    scene::Image linear;  // for P (screenshot of the render)
+    std::vector<samples::StageTiming> stages;
+    double frame_ms = 0;   // wall clock of the whole frame on the worker
+    unsigned samples = 1;  // accumulated (progressive sessions)
+};
+
+/// What the panel shows about the worker.
+struct WorkerStatus {
+    bool opened = false;  // the session exists (the first frame may still be rendering)
+    bool busy = false;    // a frame is being rendered now
+    bool fixed_camera = false;
+    bool progressive = false;
+    std::string backend, backend_notice;
+    std::string error;  // the last failure (a bad option value, an engine error)
+    scene::Camera initial_camera;
+    std::map<std::string, std::string> sets;  // the options in effect
+};
+
+class RenderWorker {
+  public:
+    /// Opens the sample's session on the worker thread. `frame_limit` > 0: render frames
+    /// until that many finished even when nothing changes (headless checks), then stop.
+    RenderWorker(const samples::SampleInfo& info, samples::RenderSettings settings,
+                 uint64_t frame_limit);
+    ~RenderWorker();
+    RenderWorker(const RenderWorker&) = delete;
+    RenderWorker& operator=(const RenderWorker&) = delete;
+
+    void set_camera(const scene::Camera& camera);
+    void set_option(const std::string& name, const std::string& value);
+    void reset();
+
+    /// The newest finished frame when it is newer than `after`.
+    std::optional<ShownFrame> frame_after(uint64_t after);
+    WorkerStatus status();
+    uint64_t frames_done();
+
+  private:
+    void run();
+    bool has_work() const;  // under m_mutex
+    void open_session();    // on the worker thread
+
+    const samples::SampleInfo& m_info;
+    samples::RenderSettings m_settings;  // the worker thread's copy of the options in effect
+    uint64_t m_frame_limit;
+    std::unique_ptr<samples::InteractiveSession> m_session;
+
+    std::mutex m_mutex;
+    std::condition_variable m_wake;
+    bool m_stop = false;
+    std::optional<scene::Camera> m_pending_camera;
+    std::map<std::string, std::string> m_pending_sets;
+    bool m_pending_reset = false;
+    bool m_converged = false;  // a still image is up to date, or the spp limit was reached
+    ShownFrame m_latest;
+    WorkerStatus m_status;
+    std::thread m_thread;  // last: starts after everything above exists
+};
+
+}  // namespace lucent::viewer

@@ -1,0 +1,213 @@
+// The viewer's loop: input moves the camera, the worker renders, the newest finished frame is
+// uploaded and drawn, the panel on top. The loop never waits for a render, so the window
+// stays responsive however slow a frame is (the CPU backend shows the last finished frame).
+#include "viewer.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "gl.h"
+#include "image_view.h"
+#include "input.h"
+#include "panel.h"
+#include "render_worker.h"
+#include "screenshot.h"
+#include "window.h"
+
+namespace lucent::viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+}
+
+/// The blog's toggles (Radiosity demo): L show VPLs, I GI, M merging.
+const char* toggled_option(int key) {
+    switch (key) {
+        case GLFW_KEY_L:
+            return "show_vpls";
+        case GLFW_KEY_I:
+            return "gi";
+        case GLFW_KEY_M:
+            return "merge";
+        default:
+            return nullptr;
+    }
+}
+
+/// A file name in the working directory that does not exist yet.
+std::string next_screenshot_name(const std::string& sample) {
+    for (int i = 1;; ++i) {
+        const std::string name = "lucent-view-" + sample + "-" + std::to_string(i) + ".png";
+        if (!std::filesystem::exists(name)) return name;
+    }
+}
+
+/// Frames per second over a sliding second: what the panel shows.
+class RateMeter {
+  public:
+    void tick(Clock::time_point now) {
+        m_times.push_back(now);
+        while (!m_times.empty() && seconds_between(m_times.front(), now) > 1.0)
+            m_times.erase(m_times.begin());
+    }
+    double rate(Clock::time_point now) const {
+        if (m_times.size() < 2) return 0;
+        const double span = std::max(seconds_between(m_times.front(), now), 1e-3);
+        return double(m_times.size() - 1) / span;
+    }
+
+  private:
+    std::vector<Clock::time_point> m_times;
+};
+
+}  // namespace
+
+int run_viewer(const ViewerConfig& config) {
+    const samples::SampleInfo& info = *config.info;
+    const bool headless_check = config.frames > 0;
+    Window window("lucent view: " + info.name, int(config.settings.width),
+                  int(config.settings.height), /*exact=*/headless_check);
+    Input input(window.handle());
+    window.start_ui();
+    ImageView view;
+    RenderWorker worker(info, config.settings, config.frames);
+
+    std::optional<scene::CameraController> camera;
+    ShownFrame shown;
+    PanelState panel;
+    bool show_panel = config.panel;
+    RateMeter ui_rate, render_rate;
+    const Clock::time_point start = Clock::now();
+    Clock::time_point last = start;
+    uint64_t ui_frames = 0;
+    std::vector<double> ui_frame_ms;  // intervals between window frames, for --verbose
+    int exit_code = 0;
+
+    while (!window.should_close()) {
+        // Up to 60 window frames/s while idle; input wakes it at once.
+        window.wait_events(1.0 / 60.0);
+        const Clock::time_point now = Clock::now();
+        const float dt = float(seconds_between(last, now));
+        if (ui_frames > 0) ui_frame_ms.push_back(1000.0 * dt);
+        last = now;
+        ui_rate.tick(now);
+        ++ui_frames;
+
+        const WorkerStatus status = worker.status();
+        if (!camera && status.opened && !status.fixed_camera) camera.emplace(status.initial_camera);
+        const ImGuiIO& io = ImGui::GetIO();
+        if (camera && input.move_camera(*camera, dt, io.WantCaptureMouse, io.WantCaptureKeyboard))
+            worker.set_camera(camera->camera());
+
+        for (int key : input.take_presses()) {
+            if (io.WantCaptureKeyboard) break;
+            if (key == GLFW_KEY_ESCAPE) window.close();
+            if (key == GLFW_KEY_H) show_panel = !show_panel;
+            if (key == GLFW_KEY_R) {
+                worker.reset();
+                panel.message = "accumulation reset";
+            }
+            if (key == GLFW_KEY_C && camera) {
+                camera->reset();
+                worker.set_camera(camera->camera());
+            }
+            if (key == GLFW_KEY_P) {
+                if (shown.number == 0) {
+                    panel.message = "nothing rendered yet to save";
+                } else {
+                    const std::string name = next_screenshot_name(info.name);
+                    try {
+                        scene::write_image(name, shown.linear);
+                        panel.message = "saved " + name;
+                    } catch (const std::exception& e) {
+                        panel.message = e.what();
+                    }
+                }
+                std::printf("%s\n", panel.message.c_str());
+            }
+            if (const char* option = toggled_option(key)) {
+                const bool has = std::any_of(info.options.begin(), info.options.end(),
+                                             [&](const auto& o) { return o.name == option; });
+                if (!has) {
+                    panel.message = "the " + info.name + " sample has no option '" +
+                                    std::string(option) + "' (radiosity has)";
+                } else {
+                    auto it = status.sets.find(option);
+                    std::string value = "0";
+                    for (const auto& o : info.options)
+                        if (o.name == option) value = o.default_value;
+                    if (it != status.sets.end()) value = it->second;
+                    const std::string flipped = value == "1" ? "0" : "1";
+                    worker.set_option(option, flipped);
+                    panel.message = std::string(option) + "=" + flipped;
+                }
+            }
+        }
+
+        if (std::optional<ShownFrame> frame = worker.frame_after(shown.number)) {
+            shown = std::move(*frame);
+            view.upload(shown.rgb.data(), shown.width, shown.height);
+            render_rate.tick(now);
+        }
+        if (headless_check && !status.error.empty() && !status.busy) {
+            std::fprintf(stderr, "lucent view: error: %s\n", status.error.c_str());
+            exit_code = 1;
+            break;
+        }
+
+        int fb_width = 0, fb_height = 0;
+        window.framebuffer_size(fb_width, fb_height);
+        glViewport(0, 0, fb_width, fb_height);
+        glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        view.draw(fb_width, fb_height);
+        window.begin_ui_frame();
+        if (show_panel) {
+            panel.ui_fps = ui_rate.rate(now);
+            panel.render_fps = render_rate.rate(now);
+            panel.frame = &shown;
+            for (const auto& [name, value] : draw_panel(info, status, panel))
+                worker.set_option(name, value);
+        }
+        window.end_ui_frame();
+
+        if (headless_check && shown.number >= config.frames) {
+            // What the window shows now, before the swap: the back buffer just drawn.
+            if (!config.screenshot.empty())
+                save_framebuffer_png(config.screenshot, fb_width, fb_height);
+            break;
+        }
+        window.swap();
+    }
+
+    const double elapsed = seconds_between(start, Clock::now());
+    if (config.verbose && !ui_frame_ms.empty()) {
+        const WorkerStatus status = worker.status();
+        std::sort(ui_frame_ms.begin(), ui_frame_ms.end());
+        const auto at = [&](double q) {
+            return ui_frame_ms[size_t(q * double(ui_frame_ms.size() - 1))];
+        };
+        std::printf(
+            "lucent view: %s on %s; window %llu frames in %.2f s (%.1f frames/s; frame "
+            "interval median %.1f ms, 95th percentile %.1f ms, slowest %.1f ms); "
+            "%llu renders\n",
+            info.name.c_str(), status.backend.c_str(), (unsigned long long)ui_frames, elapsed,
+            double(ui_frames) / std::max(elapsed, 1e-9), at(0.5), at(0.95), ui_frame_ms.back(),
+            (unsigned long long)shown.number);
+    }
+    if (exit_code == 0 && !config.screenshot.empty())
+        std::printf("wrote %s\n", config.screenshot.c_str());
+    return exit_code;
+}
+
+}  // namespace lucent::viewer

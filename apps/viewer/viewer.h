@@ -1,0 +1,24 @@
+// The interactive viewer behind `lucent view`: a GLFW window, the render on a worker thread,
+// an ImGui panel. Built only with GLFW, Dear ImGui and OpenGL (LUCENT_HAVE_VIEWER).
+#pragma once
+
+#include <string>
+
+#include "samples/sample.h"
+
+namespace lucent::viewer {
+
+struct ViewerConfig {
+    const samples::SampleInfo* info = nullptr;
+    samples::RenderSettings settings;
+    unsigned frames = 0;     // >0: exit after this many rendered frames were shown
+    std::string screenshot;  // with frames: save the window's pixels here (.png)
+    bool panel = true;
+    bool verbose = false;
+};
+
+/// Opens the window and runs until it is closed (or `frames` were shown); returns the exit
+/// code. Throws lucent::Error when no window can be opened.
+int run_viewer(const ViewerConfig& config);
+
+}  // namespace lucent::viewer

@@ -1,0 +1,60 @@
+// The interactive session of a sample that has none of its own (direct, IGI, radiosity):
+// each frame is a full render through SampleInfo::render from the sample's own camera, so
+// the viewer can still show it and change its options (IGI's and radiosity's keys). Moving
+// the camera would need the sample's camera in a buffer, which these samples do not have yet.
+#include <chrono>
+
+#include "samples/sample.h"
+
+namespace lucent::samples {
+namespace {
+
+class StillSession final : public InteractiveSession {
+  public:
+    StillSession(const SampleInfo& info, const RenderSettings& settings)
+        : m_info(info), m_settings(settings) {
+        check_options(settings, info);
+        m_settings.repeat = 1;
+        m_settings.progress = nullptr;
+    }
+
+    std::string backend() const override { return m_backend; }
+    std::string backend_notice() const override { return m_notice; }
+    scene::Camera initial_camera() const override { return {}; }
+    bool fixed_camera() const override { return true; }
+    void set_camera(const scene::Camera&) override {}
+
+    bool set_option(const std::string& name, const std::string& value) override {
+        RenderSettings changed = m_settings;
+        changed.sets[name] = value;
+        check_options(changed, m_info);
+        m_settings = changed;  // a bad value shows at the next render, as a SettingsError
+        return true;
+    }
+
+    FrameResult frame() override {
+        RenderResult r = m_info.render(m_settings);
+        m_backend = r.backend;
+        m_notice = r.backend_notice;
+        FrameResult out;
+        out.image = std::move(r.image);
+        out.stages = std::move(r.stages);
+        out.report = r.report;
+        return out;
+    }
+
+  private:
+    const SampleInfo& m_info;
+    RenderSettings m_settings;
+    std::string m_backend = "(not yet rendered)", m_notice;
+};
+
+}  // namespace
+
+std::unique_ptr<InteractiveSession> open_session(const SampleInfo& info,
+                                                 const RenderSettings& settings) {
+    if (info.open) return info.open(settings);
+    return std::make_unique<StillSession>(info, settings);
+}
+
+}  // namespace lucent::samples
