@@ -345,10 +345,17 @@ TEST_F(VariablesTest, EveryFieldKindReachesTheRecord) {
     EXPECT_EQ(o.light.intensity, 42.0f);
     EXPECT_EQ(o.light.flags, 0xabcu);
 
-    // New buffer contents and a rebound buffer are both seen at the next launch.
+    // New buffer contents and a rebound buffer are both seen at the next launch. New
+    // contents are only uploaded; new texels rebuild the texture, through a recompile.
     values->upload(std::vector<float>{10, 20, 30, 40});
     ctx.launch(0, 1);
     EXPECT_EQ(all_out->data<AllKindsOut>()[0].value_sum, 100.0f);
+    EXPECT_FALSE(ctx.last_launch().recompiled) << "new buffer contents need no recompile";
+    texels->upload(std::vector<float4>{make_float4(0.5f, 0.25f, 0.125f, 1)});
+    ctx.launch(0, 1);
+    EXPECT_EQ(all_out->data<AllKindsOut>()[0].texel.x, 0.5f);
+    EXPECT_EQ(all_out->data<AllKindsOut>()[0].texel.z, 0.125f);
+    EXPECT_TRUE(ctx.last_launch().recompiled) << "a texture is rebuilt from new texels";
     s["values"] = input_buffer(ctx, std::vector<float>{1, 1});
     ctx.launch(0, 1);
     EXPECT_EQ(all_out->data<AllKindsOut>()[0].value_count, 2u);
