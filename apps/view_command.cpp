@@ -14,8 +14,14 @@
 namespace lucent::cli {
 
 CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
-    CLI::App* cmd =
-        app.add_subcommand("view", "Show a sample in a window, rendered as the camera moves");
+#ifdef LUCENT_HAVE_VIEWER
+    const char* description = "Show a sample in a window, rendered as the camera moves";
+#else
+    const char* description =
+        "Show a sample in a window (not in this build: it needs libglfw3-dev libimgui-dev "
+        "libgl-dev at configure time)";
+#endif
+    CLI::App* cmd = app.add_subcommand("view", description);
     cmd->add_option("--sample", args.sample, "Sample to show (see `lucent render --help`)")
         ->type_name("NAME")
         ->capture_default_str();

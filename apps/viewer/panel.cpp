@@ -2,6 +2,7 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -68,9 +69,9 @@ bool option_control(const samples::SampleOption& option, const std::string& curr
 
 }  // namespace
 
-std::map<std::string, std::string> draw_panel(const samples::SampleInfo& info,
-                                              const WorkerStatus& status, const PanelState& state) {
-    std::map<std::string, std::string> changes;
+PanelChanges draw_panel(const samples::SampleInfo& info, const WorkerStatus& status,
+                        const PanelState& state) {
+    PanelChanges changes;
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowBgAlpha(0.8f);
     ImGui::Begin("lucent view", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
@@ -96,6 +97,16 @@ std::map<std::string, std::string> draw_panel(const samples::SampleInfo& info,
     if (!status.error.empty())
         ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status.error.c_str());
     if (!state.message.empty()) ImGui::Text("%s", state.message.c_str());
+    if (status.progressive) {
+        // Applied on Enter or when the field loses focus, not per keystroke.
+        int limit = int(status.spp_limit);
+        ImGui::PushItemWidth(140);
+        const bool entered = ImGui::InputInt("stop at spp (0: never)", &limit, 16, 256,
+                                             ImGuiInputTextFlags_EnterReturnsTrue);
+        if (entered || ImGui::IsItemDeactivatedAfterEdit())
+            changes.spp_limit = unsigned(std::max(limit, 0));
+        ImGui::PopItemWidth();
+    }
     if (!info.options.empty() &&
         ImGui::CollapsingHeader("options", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::PushItemWidth(140);
@@ -103,7 +114,7 @@ std::map<std::string, std::string> draw_panel(const samples::SampleInfo& info,
             auto it = status.sets.find(option.name);
             const std::string current = it != status.sets.end() ? it->second : option.default_value;
             std::string value;
-            if (option_control(option, current, value)) changes[option.name] = value;
+            if (option_control(option, current, value)) changes.options[option.name] = value;
             if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", option.help.c_str());
         }
         ImGui::PopItemWidth();

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "render_worker.h"
@@ -18,8 +19,14 @@ struct PanelState {
     std::string message;  // the last key's effect ("saved lucent-view-1.png")
 };
 
-/// Draws the panel; returns the options the user changed (name → new value).
-std::map<std::string, std::string> draw_panel(const samples::SampleInfo& info,
-                                              const WorkerStatus& status, const PanelState& state);
+/// What the user changed in the panel this frame.
+struct PanelChanges {
+    std::map<std::string, std::string> options;  // name → new value
+    std::optional<unsigned> spp_limit;
+};
+
+/// Draws the panel; returns what the user changed.
+PanelChanges draw_panel(const samples::SampleInfo& info, const WorkerStatus& status,
+                        const PanelState& state);
 
 }  // namespace lucent::viewer

@@ -13,6 +13,7 @@ RenderWorker::RenderWorker(const samples::SampleInfo& info, samples::RenderSetti
     m_settings.repeat = 1;
     m_settings.progress = nullptr;
     m_status.sets = m_settings.sets;
+    m_status.spp_limit = m_settings.spp;
     m_thread = std::thread([this] { run(); });
 }
 
@@ -46,6 +47,16 @@ void RenderWorker::reset() {
     {
         std::lock_guard lock(m_mutex);
         m_pending_reset = true;
+    }
+    m_wake.notify_all();
+}
+
+void RenderWorker::set_spp_limit(unsigned spp) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_status.spp_limit = spp;
+        // A higher limit (or none) resumes the refinement where it stopped.
+        if (m_status.progressive && (spp == 0 || m_latest.samples < spp)) m_converged = false;
     }
     m_wake.notify_all();
 }
@@ -151,8 +162,8 @@ void RenderWorker::run() {
             continue;
         }
         shown.number = m_latest.number + 1;
-        const bool refining =
-            m_session->progressive() && (m_settings.spp == 0 || shown.samples < m_settings.spp);
+        const unsigned limit = m_status.spp_limit;
+        const bool refining = m_session->progressive() && (limit == 0 || shown.samples < limit);
         m_converged = !refining;
         m_latest = std::move(shown);
     }

@@ -38,6 +38,7 @@ struct WorkerStatus {
     std::string error;  // the last failure (a bad option value, an engine error)
     scene::Camera initial_camera;
     std::map<std::string, std::string> sets;  // the options in effect
+    unsigned spp_limit = 0;                   // progressive: stop refining here; 0 = never
 };
 
 class RenderWorker {
@@ -53,6 +54,8 @@ class RenderWorker {
     void set_camera(const scene::Camera& camera);
     void set_option(const std::string& name, const std::string& value);
     void reset();
+    /// Progressive sessions stop refining at this many samples per pixel; 0 = never.
+    void set_spp_limit(unsigned spp);
 
     /// The newest finished frame when it is newer than `after`.
     std::optional<ShownFrame> frame_after(uint64_t after);

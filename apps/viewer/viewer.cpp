@@ -176,8 +176,9 @@ int run_viewer(const ViewerConfig& config) {
             panel.ui_fps = ui_rate.rate(now);
             panel.render_fps = render_rate.rate(now);
             panel.frame = &shown;
-            for (const auto& [name, value] : draw_panel(info, status, panel))
-                worker.set_option(name, value);
+            const PanelChanges changes = draw_panel(info, status, panel);
+            for (const auto& [name, value] : changes.options) worker.set_option(name, value);
+            if (changes.spp_limit) worker.set_spp_limit(*changes.spp_limit);
         }
         window.end_ui_frame();
 
