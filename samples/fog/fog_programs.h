@@ -4,8 +4,8 @@
 // floor whose density is TEA gradient noise in x, z times a linear falloff in y.
 //
 // The fog box's any-hit lets shadow rays through. Its closest hit traces the same ray again
-// with the fog ignored, to find what lies beneath, then marches from where the ray enters
-// the fog (or starts, inside it) to where it leaves or meets that surface, and composites
+// against the solid objects alone, to find what lies beneath, then marches from where the ray
+// enters the fog (or starts, inside it) to where it leaves or meets that surface, and composites
 // the fog over it. Rays that start inside the fog (the camera, reflections off the floor)
 // are shaded too: the paper's stated limitation is lifted by reporting a hit at the ray's
 // start when its origin lies inside the box.
@@ -37,7 +37,6 @@ struct RadiancePayload {
     float3 color;
     float distance;  // to the surface shaded (1e30 for the environment)
     int depth;
-    int skip_fog;  // 1: the fog box does not count (its own look behind itself)
 };
 struct ShadowPayload {
     float3 attenuation;
@@ -117,10 +116,10 @@ struct FogRecord {
     unsigned rounds;    // TEA rounds of the noise
     uint4 noise_key;    // generate_tea_key(device, seed): Sebald Fig. 4
     float3 fog_color;
-    lucent::Handle top_object;
+    lucent::Handle solid_object;  // the scene without the fog box
 };
 LUCENT_RECORD(FogRecord, box_min, box_max, density, step, noise_scale, noise, falloff, rounds,
-              noise_key, fog_color, top_object)
+              noise_key, fog_color, solid_object)
 
 struct MeshRecord {
     lucent::BufferView<float3> positions;
@@ -181,7 +180,7 @@ LUCENT_RAY_GENERATION(fog_camera, fog::CameraRecord) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
     const fog::CameraFrame c = rec.camera[0u];
     const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
-    fog::RadiancePayload prd{make_float3(0.0f), 0.0f, 0, 0};
+    fog::RadiancePayload prd{make_float3(0.0f), 0.0f, 0};
     lucent::trace(
         rec.top_object,
         lucent::make_ray(c.eye, normalize(c.W + sx * c.U + sy * c.V), fog::kRadianceRay, 0.0f),
@@ -240,7 +239,7 @@ LUCENT_CLOSEST_HIT(fog_phong, fog::PhongRecord, fog::RadiancePayload, fog::HitAt
         color += arriving * (kd * cos_l + rec.Ks * spec);
     }
     if (max_component(rec.Kr) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
-        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1};
         lucent::trace(
             rec.top_object,
             lucent::make_ray(origin, reflect(normalize(ray.direction), n), fog::kRadianceRay, 0.0f),
@@ -265,7 +264,7 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
     const float F = fog::fresnel(cos_i, eta);
     float3 color = make_float3(0.0f);
     if (prd.depth + 1 < int(rec.max_depth)) {
-        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+        fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1};
         lucent::trace(
             rec.top_object,
             lucent::make_ray(p + rec.scene_epsilon * n, reflect(d, n), fog::kRadianceRay, 0.0f),
@@ -274,7 +273,7 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
         if (F < 1.0f) {
             const float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
             const float3 t = normalize(eta * d + (eta * cos_i - sqrtf(1.0f - sin2_t)) * n);
-            fog::RadiancePayload refracted{make_float3(0.0f), 0.0f, prd.depth + 1, 0};
+            fog::RadiancePayload refracted{make_float3(0.0f), 0.0f, prd.depth + 1};
             lucent::trace(rec.top_object,
                           lucent::make_ray(p - rec.scene_epsilon * n, t, fog::kRadianceRay, 0.0f),
                           refracted);
@@ -326,22 +325,19 @@ LUCENT_INTERSECTION(fog_box_intersect, fog::FogBoxRecord, fog::HitAttributes) {
     }
 }
 
-// Shadows pass through fog (Sebald: "simply ignores the intersection"); a radiance ray
-// looking behind the fog ignores it too.
+// Shadows pass through fog (Sebald: "simply ignores the intersection").
 LUCENT_ANY_HIT(fog_volume_shadow, lucent::NoRecord, fog::ShadowPayload, fog::HitAttributes) {
     lucent::ignore_intersection();
-}
-LUCENT_ANY_HIT(fog_volume_radiance, lucent::NoRecord, fog::RadiancePayload, fog::HitAttributes) {
-    if (prd.skip_fog) lucent::ignore_intersection();
 }
 
 LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAttributes) {
     const lucent::Ray& ray = lucent::current_ray();
-    // What lies beneath: the same ray again, the fog ignored (its hits are exactly those of
-    // a scene without fog, so zero density reproduces it).
-    fog::RadiancePayload behind{make_float3(0.0f), 0.0f, prd.depth, 1};
+    // What lies beneath: the same ray again against the solid objects alone (exactly the hits
+    // of a scene without fog, so zero density reproduces it). What it hits traces its own
+    // rays through the whole scene, fog and all.
+    fog::RadiancePayload behind{make_float3(0.0f), 0.0f, prd.depth};
     lucent::trace(
-        rec.top_object,
+        rec.solid_object,
         lucent::make_ray(ray.origin, ray.direction, fog::kRadianceRay, ray.tmin, ray.tmax), behind);
     const float t_start = lucent::t_hit(), t_end = lc_min(attr.t_exit, behind.distance);
     const float speed = length(ray.direction);  // t to distance

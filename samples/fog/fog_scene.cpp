@@ -32,7 +32,8 @@ Mesh floor_mesh() {
 Mesh box_mesh(float3 lo, float3 hi) {
     Mesh m;
     for (int i = 0; i < 8; ++i)
-        m.positions.push_back(make_float3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+        m.positions.push_back(
+            make_float3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
     const unsigned quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     for (const auto& q : quads) {
@@ -49,7 +50,8 @@ Mesh crystal_mesh(float3 base, float radius) {
     for (float y : ring_y)
         for (int k = 0; k < 6; ++k) {
             const float a = 1.0471976f * float(k) + 0.3f;
-            m.positions.push_back(base + make_float3(radius * std::cos(a), y, radius * std::sin(a)));
+            m.positions.push_back(base +
+                                  make_float3(radius * std::cos(a), y, radius * std::sin(a)));
         }
     m.positions.push_back(base + make_float3(0.0f, 0.05f, 0.0f));  // 12: bottom tip
     m.positions.push_back(base + make_float3(0.0f, 4.6f, 0.0f));   // 13: top tip
@@ -116,7 +118,8 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
     const std::vector<fog::PointLight> lights = {
         {make_float3(-8.0f, 20.0f, -10.0f), make_float3(420.0f, 410.0f, 390.0f)},
         {make_float3(10.0f, 14.0f, 9.0f), make_float3(110.0f, 95.0f, 75.0f)}};
-    auto light_buffer = ctx.create_buffer<fog::PointLight>(BufferType::kInput, unsigned(lights.size()));
+    auto light_buffer =
+        ctx.create_buffer<fog::PointLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
     ctx["ambient"] = make_float3(0.12f, 0.13f, 0.15f);
@@ -151,19 +154,25 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
     (*box_material)["pattern_scale"] = 1.2f;
     auto glass_material = ctx.create_material();
     glass_material->set_name("crystal");
-    glass_material->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog_glass)));
-    glass_material->set_any_hit(fog::kShadowRay, ctx.create_program(LUCENT_PROGRAM(fog_glass_shadow)));
+    glass_material->set_closest_hit(fog::kRadianceRay,
+                                    ctx.create_program(LUCENT_PROGRAM(fog_glass)));
+    glass_material->set_any_hit(fog::kShadowRay,
+                                ctx.create_program(LUCENT_PROGRAM(fog_glass_shadow)));
     (*glass_material)["ior"] = 1.5f;
     (*glass_material)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
     (*glass_material)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
 
     auto attributes = ctx.create_program(LUCENT_PROGRAM(fog_mesh_attributes));
-    auto top = ctx.create_geometry_group();
+    // The triangles in a GeometryGroup of their own: it gets the triangle BVH's fast
+    // traversal, which a group holding the fog box (a custom primitive) would lose.
+    auto solids = ctx.create_geometry_group();
     auto add_mesh = [&](const Mesh& mesh, const std::shared_ptr<Material>& material,
                         const char* name) {
-        auto positions = ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
+        auto positions =
+            ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));
         positions->upload(mesh.positions);
-        auto triangles = ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.triangles.size()));
+        auto triangles =
+            ctx.create_buffer<uint3>(BufferType::kInput, unsigned(mesh.triangles.size()));
         triangles->upload(mesh.triangles);
         auto geometry = ctx.create_geometry_triangles();
         geometry->set_name(name);
@@ -175,21 +184,21 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(geometry);
         instance->add_material(material);
-        top->add_child(instance);
+        solids->add_child(instance);
     };
     add_mesh(floor_mesh(), floor_material, "floor");
-    add_mesh(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)), box_material,
-             "box");
+    add_mesh(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)),
+             box_material, "box");
     add_mesh(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), glass_material, "crystal");
 
     if (options.fog) {
         // Sebald §3.1: a box with the floor's x, z extent and the fog's height.
         auto fog_material = ctx.create_material();
         fog_material->set_name("fog");
-        fog_material->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog_volume)));
-        fog_material->set_any_hit(fog::kRadianceRay,
-                                  ctx.create_program(LUCENT_PROGRAM(fog_volume_radiance)));
-        fog_material->set_any_hit(fog::kShadowRay, ctx.create_program(LUCENT_PROGRAM(fog_volume_shadow)));
+        fog_material->set_closest_hit(fog::kRadianceRay,
+                                      ctx.create_program(LUCENT_PROGRAM(fog_volume)));
+        fog_material->set_any_hit(fog::kShadowRay,
+                                  ctx.create_program(LUCENT_PROGRAM(fog_volume_shadow)));
         (*fog_material)["density"] = options.density;
         (*fog_material)["step"] = options.step;
         (*fog_material)["noise_scale"] = options.noise_scale;
@@ -208,9 +217,16 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         (*instance)["box_min"] = make_float3(-kFloorHalf, 0.0f, -kFloorHalf);
         (*instance)["box_max"] = make_float3(kFloorHalf, options.height, kFloorHalf);
         instance->add_material(fog_material);
-        top->add_child(instance);
+        auto fog_group = ctx.create_geometry_group();
+        fog_group->add_child(instance);
+        auto top = ctx.create_group();
+        top->add_child(solids);
+        top->add_child(fog_group);
+        ctx["top_object"] = top;
+        ctx["solid_object"] = solids;
+    } else {
+        ctx["top_object"] = solids;
     }
-    ctx["top_object"] = top;
 
     auto miss = ctx.create_program(LUCENT_PROGRAM(fog_environment));
     DiffuseTextures textures(ctx);  // a white texel stands in when there is no map
@@ -262,7 +278,11 @@ const LaunchReport& FogScene::render(const scene::Camera& camera) {
     return m->ctx.last_launch();
 }
 
-Context& FogScene::context() { return m->ctx; }
-const Buffer& FogScene::output() const { return *m->output; }
+Context& FogScene::context() {
+    return m->ctx;
+}
+const Buffer& FogScene::output() const {
+    return *m->output;
+}
 
 }  // namespace lucent::samples
