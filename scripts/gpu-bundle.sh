@@ -3,18 +3,20 @@
 # driver but not Debian's packages: the binaries, the Debian runtime libraries they load
 # (run through the bundled loader, so the machine's own glibc does not matter) and the
 # benchmark scenes. On that machine: `.gpu-bundle/run .gpu-bundle/bin/lucent ...`.
-# Embree is left out (the GPU benchmark compares against Lucent's CPU backend).
+# Embree is left out (the GPU benchmark compares against Lucent's CPU backend), and so is the
+# viewer (the GPU machine has no display; its GL libraries would not fit the 64 MiB carry).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=.gpu-bundle
 build=build-gpu-bundle
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLUCENT_NATIVE=OFF \
       -DCMAKE_CXX_FLAGS="-mavx2 -mfma -mf16c -mbmi -mbmi2 -mlzcnt -mpopcnt" \
-      -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON > /dev/null
+      -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON > /dev/null
 cmake --build "$build" -j"$(nproc)"
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 cp "$build/lucent" "$build"/tests/*_test "$out/bin/"
+strip --strip-unneeded "$out"/bin/*  # symbols are not needed there, and the carry is 64 MiB
 for lib in $(ldd "$out"/bin/* | awk '/=>/ {print $3}' | sort -u); do cp -L "$lib" "$out/lib/"; done
 cp -L /lib64/ld-linux-x86-64.so.2 "$out/lib/"
 scenes=../shared/scenes
