@@ -365,14 +365,41 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
     const float limit = rec.density * dt > 0.0f ? 9.2f / (rec.density * dt) : 3.4e38f;
     float weight_sum = 0.0f;  // optical depth / (density dt)
     lucent::GradientCell cell;
-    for (unsigned s = 0; s < steps && weight_sum < limit; ++s) {
-        float w = 1.0f;
-        if (noise) w = lucent::tea_gradient_noise(nx, nz, key, rounds, cell);
-        if (falloff) w *= clampf(fall, 0.0f, 1.0f);
-        weight_sum += w;
-        nx += dnx;
-        nz += dnz;
-        fall += dfall;
+    unsigned s = 0;
+    while (s < steps && weight_sum < limit) {
+        // The samples from s on that stay in one lattice cell: its gradients are fetched
+        // once, and the offsets in the cell only grow by their increments (no floor per
+        // sample). A run may end a rounding error past the cell's edge, where the noise
+        // continues smoothly.
+        unsigned run = steps - s;
+        float tx = 0.0f, tz = 0.0f;
+        if (noise) {
+            const float x = nx + float(s) * dnx, z = nz + float(s) * dnz;
+            const float fx = floorf(x), fz = floorf(z);
+            cell.fetch(int(fx), int(fz), key, rounds);
+            tx = x - fx;
+            tz = z - fz;
+            // Samples with an offset still in [0, 1): ceil((1 - t) / dt) going up,
+            // floor(t / -dt) + 1 going down.
+            const float kx = dnx > 0.0f   ? ceilf((1.0f - tx) / dnx)
+                             : dnx < 0.0f ? floorf(tx / -dnx) + 1.0f
+                                          : 3e9f;
+            const float kz = dnz > 0.0f   ? ceilf((1.0f - tz) / dnz)
+                             : dnz < 0.0f ? floorf(tz / -dnz) + 1.0f
+                                          : 3e9f;
+            const float k = lc_min(kx, kz);
+            if (k < float(run)) run = lc_max(1u, unsigned(k));
+        }
+        float fall_s = fall + float(s) * dfall;
+        for (unsigned i = 0; i < run; ++i) {
+            float w = noise ? lucent::gradient_noise_in_cell(cell, tx, tz) : 1.0f;
+            if (falloff) w *= clampf(fall_s, 0.0f, 1.0f);
+            weight_sum += w;
+            tx += dnx;
+            tz += dnz;
+            fall_s += dfall;
+        }
+        s += run;
     }
     const float optical_depth = weight_sum * rec.density * dt;
     const float transmittance = expf(-optical_depth);

@@ -35,21 +35,26 @@ struct GradientCell {
     }
 };
 
+/// The noise inside a fetched cell at (tx, ty) in [0, 1)^2 from its corner (ix, iy), mapped
+/// to [0, 1]: the corner gradients dotted with the offsets to the corners, blended by the
+/// quintic fade.
+LUCENT_HD inline float gradient_noise_in_cell(const GradientCell& c, float tx, float ty) {
+    const float n00 = dot(c.g00, make_float2(tx, ty));
+    const float n10 = dot(c.g10, make_float2(tx - 1.0f, ty));
+    const float n01 = dot(c.g01, make_float2(tx, ty - 1.0f));
+    const float n11 = dot(c.g11, make_float2(tx - 1.0f, ty - 1.0f));
+    const float u = quintic_fade(tx), v = quintic_fade(ty);
+    const float n = lerpf(lerpf(n00, n10, u), lerpf(n01, n11, u), v);  // in [-0.71, 0.71]
+    return clampf(0.5f + n * 0.70710678f, 0.0f, 1.0f);
+}
+
 /// One octave of gradient noise at (x, y), in lattice units, mapped to [0, 1]; `cell` keeps
 /// the last cell's gradients between calls.
 LUCENT_HD inline float tea_gradient_noise(float x, float y, uint4 key, unsigned rounds,
                                           GradientCell& cell) {
     const float fx = floorf(x), fy = floorf(y);
     cell.fetch(int(fx), int(fy), key, rounds);
-    const float tx = x - fx, ty = y - fy;
-    // Dot products of the corner gradients with the offsets to the corners.
-    const float n00 = dot(cell.g00, make_float2(tx, ty));
-    const float n10 = dot(cell.g10, make_float2(tx - 1.0f, ty));
-    const float n01 = dot(cell.g01, make_float2(tx, ty - 1.0f));
-    const float n11 = dot(cell.g11, make_float2(tx - 1.0f, ty - 1.0f));
-    const float u = quintic_fade(tx), v = quintic_fade(ty);
-    const float n = lerpf(lerpf(n00, n10, u), lerpf(n01, n11, u), v);  // in [-0.71, 0.71]
-    return clampf(0.5f + n * 0.70710678f, 0.0f, 1.0f);
+    return gradient_noise_in_cell(cell, x - fx, y - fy);
 }
 
 LUCENT_HD inline float tea_gradient_noise(float x, float y, uint4 key, unsigned rounds) {
