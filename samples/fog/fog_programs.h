@@ -391,13 +391,34 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
             if (k < float(run)) run = lc_max(1u, unsigned(k));
         }
         float fall_s = fall + float(s) * dfall;
-        for (unsigned i = 0; i < run; ++i) {
-            float w = noise ? lucent::gradient_noise_in_cell(cell, tx, tz) : 1.0f;
-            if (falloff) w *= clampf(fall_s, 0.0f, 1.0f);
-            weight_sum += w;
-            tx += dnx;
-            tz += dnz;
-            fall_s += dfall;
+        if (noise) {
+            // In a cell the four corner terms of the noise (gradient . offset) are linear in
+            // the step too: each grows by a constant. Only the fades are evaluated anew.
+            const lucent::GradientCell& c = cell;
+            float n00 = c.g00.x * tx + c.g00.y * tz, n10 = c.g10.x * (tx - 1.0f) + c.g10.y * tz;
+            float n01 = c.g01.x * tx + c.g01.y * (tz - 1.0f);
+            float n11 = c.g11.x * (tx - 1.0f) + c.g11.y * (tz - 1.0f);
+            const float d00 = c.g00.x * dnx + c.g00.y * dnz, d10 = c.g10.x * dnx + c.g10.y * dnz;
+            const float d01 = c.g01.x * dnx + c.g01.y * dnz, d11 = c.g11.x * dnx + c.g11.y * dnz;
+            for (unsigned i = 0; i < run; ++i) {
+                const float u = lucent::quintic_fade(tx), v = lucent::quintic_fade(tz);
+                const float n = lerpf(lerpf(n00, n10, u), lerpf(n01, n11, u), v);
+                float w = clampf(0.5f + n * 0.70710678f, 0.0f, 1.0f);  // as tea_gradient_noise
+                if (falloff) w *= clampf(fall_s, 0.0f, 1.0f);
+                weight_sum += w;
+                tx += dnx;
+                tz += dnz;
+                n00 += d00;
+                n10 += d10;
+                n01 += d01;
+                n11 += d11;
+                fall_s += dfall;
+            }
+        } else {
+            for (unsigned i = 0; i < run; ++i) {
+                weight_sum += falloff ? clampf(fall_s, 0.0f, 1.0f) : 1.0f;
+                fall_s += dfall;
+            }
         }
         s += run;
     }
