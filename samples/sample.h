@@ -122,6 +122,10 @@ bool option_range(const SampleOption& option, double& lo, double& hi);
 /// when that launch recompiled, then "launch".
 void add_launch_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
 
+/// Appends the stages a launch that compiled the scene reports: "compile + accel", and
+/// "megakernel JIT" (cold compile or cache load) when the CUDA backend ran it.
+void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
+
 /// Every sample, in the order `--help` lists them.
 const std::vector<SampleInfo>& all_samples();
 /// The sample with this name, or an Error listing the names.

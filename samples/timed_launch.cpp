@@ -9,16 +9,19 @@
 
 namespace lucent::samples {
 
+void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& stages) {
+    stages.push_back({"compile + accel", report.compile_ms + report.accel_ms, ""});
+    if (report.jit_ms > 0)
+        stages.push_back(
+            {"megakernel JIT", report.jit_ms,
+             report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+}
+
 void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
                   RenderResult& result) {
     ctx.launch(entry, settings.width, settings.height);
     result.report = ctx.last_launch();
-    result.stages.push_back(
-        {"compile + accel", result.report.compile_ms + result.report.accel_ms, ""});
-    if (result.report.jit_ms > 0)
-        result.stages.push_back(
-            {"megakernel JIT", result.report.jit_ms,
-             result.report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+    add_compile_stages(result.report, result.stages);
     if (settings.repeat <= 1) {
         result.stages.push_back({"launch", result.report.launch_ms, ""});
         return;

@@ -33,11 +33,7 @@ RenderResult render_fog(const RenderSettings& settings) {
          options.fog ? "tutorial scene with fog" : "tutorial scene, no fog"});
     // The first launch compiles; --repeat gives the median of the rest.
     out.report = scene.render(options.orbit_degrees);
-    out.stages.push_back({"compile + accel", out.report.compile_ms + out.report.accel_ms, ""});
-    if (out.report.jit_ms > 0)
-        out.stages.push_back({"megakernel JIT", out.report.jit_ms,
-                              out.report.jit_cached ? "loaded from the kernel cache"
-                                                    : "cold NVRTC compile"});
+    add_compile_stages(out.report, out.stages);
     std::vector<double> ms{out.report.launch_ms};
     for (unsigned i = 1; i < settings.repeat; ++i) {
         if (i == 1) ms.clear();

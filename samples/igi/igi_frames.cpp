@@ -86,11 +86,7 @@ void render_igi_frames(Context& ctx, const IgiConfig& config, const RenderSettin
     constexpr size_t kStages = kIgiStageNames.size();
     std::array<double, kStages> ms{};
     const LaunchReport first = launch_frame(ctx, config, ms);
-    result.stages.push_back({"compile + accel", first.compile_ms + first.accel_ms, ""});
-    if (first.jit_ms > 0)
-        result.stages.push_back(
-            {"megakernel JIT", first.jit_ms,
-             first.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+    add_compile_stages(first, result.stages);
     const unsigned frames = std::max(1u, settings.repeat);
     if (settings.progress) settings.progress(1, frames);
     // Per stage, its times over the frames after the first (or the first, if alone).

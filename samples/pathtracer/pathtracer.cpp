@@ -199,11 +199,7 @@ RenderResult render_pathtracer(const RenderSettings& settings) {
         const LaunchReport& report = ctx.last_launch();
         if (f == 0) {
             out.report = report;
-            out.stages.push_back({"compile + accel", report.compile_ms + report.accel_ms, ""});
-            if (report.jit_ms > 0)
-                out.stages.push_back(
-                    {"megakernel JIT", report.jit_ms,
-                     report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+            add_compile_stages(report, out.stages);
         } else if (report.exception_count() > 0 && out.report.exception_count() == 0) {
             out.report = report;
         }

@@ -151,11 +151,7 @@ RenderResult render_radiosity(const RenderSettings& settings) {
     ctx.launch(radiosity::kPhotonEntry, options.photon_side, options.photon_side,
                unsigned(lights.size()));
     const LaunchReport first = ctx.last_launch();
-    out.stages.push_back({"compile + accel", first.compile_ms + first.accel_ms, ""});
-    if (first.jit_ms > 0)
-        out.stages.push_back(
-            {"megakernel JIT", first.jit_ms,
-             first.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
+    add_compile_stages(first, out.stages);
     out.stages.push_back({"photons", first.launch_ms,
                           std::to_string(photons) + " photons, up to " +
                               std::to_string(options.bounces) + " bounces"});

@@ -316,6 +316,26 @@ bool report_candidate(ThreadState& ts, unsigned material) {
     return true;
 }
 
+namespace {
+/// The next trace frame of `ts`, set up for `ray` before traversal (the caller pops it).
+TraceFrame& push_frame(ThreadState& ts, const Ray& ray, void* payload, bool occlusion) {
+    TraceFrame& frame = ts.frames[ts.depth++];
+    frame.world_ray = ray;
+    frame.object_ray = ray;
+    frame.payload = payload;
+    frame.ray_type = ray.ray_type;
+    frame.closest = ray.tmax;
+    frame.has_hit = false;
+    frame.terminated = false;
+    frame.occlusion = occlusion;
+    frame.transformed = false;
+    frame.candidate_open = false;
+    frame.to_world = frame.to_object = kIdentity;
+    frame.context = ProgramContext::kIntersection;
+    return frame;
+}
+}  // namespace
+
 void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const void* payload_tag) {
     const CompiledScene& scene = *ts.scene;
     if (ray.ray_type >= scene.ray_types.size())
@@ -326,19 +346,7 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
         throw ProgramException{kExceptionInvalidHandle, root.index};
     if (ts.depth >= scene.max_depth) throw ProgramException{kExceptionStackOverflow, ts.depth + 1};
 
-    TraceFrame& frame = ts.frames[ts.depth++];
-    frame.world_ray = ray;
-    frame.object_ray = ray;
-    frame.payload = payload;
-    frame.ray_type = ray.ray_type;
-    frame.closest = ray.tmax;
-    frame.has_hit = false;
-    frame.terminated = false;
-    frame.occlusion = false;
-    frame.transformed = false;
-    frame.candidate_open = false;
-    frame.to_world = frame.to_object = kIdentity;
-    frame.context = ProgramContext::kIntersection;
+    TraceFrame& frame = push_frame(ts, ray, payload, /*occlusion=*/false);
 
     Traverser(ts, frame).node(root.index, ray.origin, ray.direction);
 
@@ -389,19 +397,7 @@ bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
                                                       ray.tmax);
     // Anything else needs a frame: intersection programs and selectors run in it.
     if (ts.depth >= scene.max_depth) throw ProgramException{kExceptionStackOverflow, ts.depth + 1};
-    TraceFrame& frame = ts.frames[ts.depth++];
-    frame.world_ray = ray;
-    frame.object_ray = ray;
-    frame.payload = nullptr;
-    frame.ray_type = ray.ray_type;
-    frame.closest = ray.tmax;
-    frame.has_hit = false;
-    frame.terminated = false;
-    frame.occlusion = true;
-    frame.transformed = false;
-    frame.candidate_open = false;
-    frame.to_world = frame.to_object = kIdentity;
-    frame.context = ProgramContext::kIntersection;
+    TraceFrame& frame = push_frame(ts, ray, nullptr, /*occlusion=*/true);
     Traverser(ts, frame).node(root.index, ray.origin, ray.direction);
     frame.occlusion = false;
     --ts.depth;

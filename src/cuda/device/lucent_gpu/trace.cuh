@@ -307,6 +307,37 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
 }
 #endif  // LUCENT_GPU_NESTED
 
+/// A trace frame for `ray`, before traversal.
+__device__ __forceinline__ void begin_frame(Frame& f, const Ray& ray, void* payload,
+                                            bool occlusion) {
+    f.world_ray = ray;
+#if LUCENT_GPU_TRANSFORMS
+    f.object_ray = ray;
+    f.transformed = false;
+#endif
+    f.payload = payload;
+    f.ray_type = ray.ray_type;
+    f.closest = ray.tmax;
+    f.has_hit = false;
+    f.terminated = false;
+    f.occlusion = occlusion;
+    f.candidate_open = false;
+    f.context = kCtxIntersection;
+}
+
+/// Traverses the graph below `root`. A GeometryGroup root (the common case) is traversed
+/// here, inline: one call level less (ncu: returns and register restores of the call ABI
+/// were a third of the stalls).
+__device__ __forceinline__ void traverse_root(Frame& f, Handle root, const Ray& ray) {
+    const GpuNode& root_node = params.nodes[root.index];
+#if LUCENT_GPU_NESTED
+    if (root_node.kind != kGpuGeometryGroup)
+        traverse_node(f, root.index, ray.origin, ray.direction);
+    else
+#endif
+        geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
+}
+
 __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
                                        unsigned payload_signature) {
     ThreadState& s = self();
@@ -328,33 +359,11 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
         return;
     }
     Frame f;
-    f.world_ray = ray;
-#if LUCENT_GPU_TRANSFORMS
-    f.object_ray = ray;
-#endif
-    f.payload = payload;
-    f.ray_type = ray.ray_type;
-    f.closest = ray.tmax;
-    f.has_hit = false;
-    f.terminated = false;
-    f.occlusion = false;
-    f.candidate_open = false;
-    f.context = kCtxIntersection;
-#if LUCENT_GPU_TRANSFORMS
-    f.transformed = false;
-#endif
+    begin_frame(f, ray, payload, /*occlusion=*/false);
     Frame* outer = s.frame;
     s.frame = &f;
     ++s.depth;
-    // A GeometryGroup root (the common case) is traversed here, inline: one call level less
-    // (ncu: returns and register restores of the call ABI were a third of the stalls).
-    const GpuNode& root_node = params.nodes[root.index];
-#if LUCENT_GPU_NESTED
-    if (root_node.kind != kGpuGeometryGroup)
-        traverse_node(f, root.index, ray.origin, ray.direction);
-    else
-#endif
-        geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
+    traverse_root(f, root, ray);
     if (!s.exception_code) {
         if (f.has_hit) {
             const GpuInstance& inst = params.instances[f.hit_instance];
@@ -408,34 +417,16 @@ __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
         detail::raise_exception(kExceptionInvalidHandle, root.index);
         return false;
     }
-    const GpuNode& root_node = params.nodes[root.index];
     if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
         detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
         return false;
     }
     Frame f;
-    f.world_ray = ray;
-#if LUCENT_GPU_TRANSFORMS
-    f.object_ray = ray;
-    f.transformed = false;
-#endif
-    f.payload = nullptr;
-    f.ray_type = ray.ray_type;
-    f.closest = ray.tmax;
-    f.has_hit = false;
-    f.terminated = false;
-    f.occlusion = true;
-    f.candidate_open = false;
-    f.context = kCtxIntersection;
+    begin_frame(f, ray, nullptr, /*occlusion=*/true);
     Frame* outer = s.frame;
     s.frame = &f;
     ++s.depth;
-#if LUCENT_GPU_NESTED
-    if (root_node.kind != kGpuGeometryGroup)
-        traverse_node(f, root.index, ray.origin, ray.direction);
-    else
-#endif
-        geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
+    traverse_root(f, root, ray);
     --s.depth;
     s.frame = outer;
     return f.has_hit && !s.exception_code;
