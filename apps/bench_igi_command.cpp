@@ -18,6 +18,10 @@ CLI::App* add_bench_igi_command(CLI::App* bench, BenchIgiArgs& args) {
     c->add_option("--backend", args.backend, "cpu, cuda or auto")
         ->type_name("KIND")
         ->capture_default_str();
+    c->add_option("--devices", args.devices,
+                  "Spread each launch over these devices: GPU numbers and cpu, or all "
+                  "(replaces --backend)")
+        ->type_name("0,1|cpu,0|all");
     c->add_option("--threads", args.threads, "CPU worker threads, 0 = one per core")
         ->type_name("N")
         ->check(CLI::Range(0u, 4096u).description(""));
@@ -52,6 +56,7 @@ int run_bench_igi_command(const BenchIgiArgs& args) {
     samples::IgiBenchOptions options;
     options.scene = args.scene;
     options.backend = parse_backend("--backend", args.backend);
+    options.devices = parse_devices("--devices", args.devices);
     options.threads = args.threads;
     const Size size = parse_size("--size", args.size);
     options.width = size.width;

@@ -10,6 +10,7 @@ namespace lucent::cli {
 struct BenchIgiArgs {
     std::string scene = "cornell";
     std::string backend = "cpu";
+    std::string devices;
     unsigned threads = 0;
     std::string size = "800x600";
     unsigned frames = 10;

@@ -79,6 +79,15 @@ BackendKind parse_backend(const std::string& flag, const std::string& text) {
     throw UsageError(flag + " " + quoted(text) + ": expected auto, cpu or cuda");
 }
 
+std::vector<DeviceSpec> parse_devices(const std::string& flag, const std::string& text) {
+    if (text.empty()) return {};
+    try {
+        return parse_device_list(text);
+    } catch (const Error& e) {
+        throw UsageError(flag + ": " + e.what());
+    }
+}
+
 int parse_sm(const std::string& flag, const std::string& text) {
     std::string digits = text.rfind("sm_", 0) == 0 ? text.substr(3) : text;
     int sm = 0;

@@ -32,6 +32,8 @@ float parse_float(const std::string& flag, const std::string& text, float lo, fl
                   bool open = false);
 /// "auto", "cpu" or "cuda".
 BackendKind parse_backend(const std::string& flag, const std::string& text);
+/// A --devices list ("0,1", "cpu,0", "all"); empty text: none (the --backend device).
+std::vector<DeviceSpec> parse_devices(const std::string& flag, const std::string& text);
 /// 'text', for messages that quote what the user typed.
 std::string quoted(const std::string& text);
 /// "sm_90" or "90" → 90; UsageError naming the flag otherwise.

@@ -68,6 +68,7 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.width = size.width;
     s.height = size.height;
     s.backend = parse_backend("--backend", args.backend);
+    s.devices = parse_devices("--devices", args.devices);
     s.threads = args.threads;
     s.scene = args.scene;
     s.verbose = args.verbose;
@@ -98,6 +99,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
         ->type_name("KIND")
         ->capture_default_str();
+    cmd->add_option("--devices", args.devices,
+                    "Spread each launch over these devices: GPU numbers and cpu, or all "
+                    "(replaces --backend)")
+        ->type_name("0,1|cpu,0|all");
     cmd->add_option("--scene", args.scene,
                     "Built-in scene or scene file (default: the sample's own)")
         ->type_name("NAME|FILE");

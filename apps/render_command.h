@@ -13,6 +13,7 @@ struct RenderArgs {
     std::string size = "1024x1024";
     std::string out = "lucent.png";
     std::string backend = "auto";
+    std::string devices;  // --devices 0,1: launches spread over several devices
     std::string scene;
     std::vector<std::string> sets;
     unsigned threads = 0;

@@ -31,6 +31,10 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
     cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
         ->type_name("KIND")
         ->capture_default_str();
+    cmd->add_option("--devices", args.devices,
+                    "Spread each launch over these devices: GPU numbers and cpu, or all "
+                    "(replaces --backend)")
+        ->type_name("0,1|cpu,0|all");
     cmd->add_option("--scene", args.scene,
                     "Built-in scene or scene file (default: the sample's own)")
         ->type_name("NAME|FILE");
@@ -77,6 +81,7 @@ int run_view(const ViewArgs& args) {
     settings.width = size.width;
     settings.height = size.height;
     settings.backend = parse_backend("--backend", args.backend);
+    settings.devices = parse_devices("--devices", args.devices);
     // The CPU backend leaves one core to the window by default, so the panel stays fluid
     // while a frame renders; --threads N overrides.
     settings.threads = args.threads;

@@ -12,6 +12,7 @@ struct ViewArgs {
     std::string sample = "whitted";
     std::string size = "800x600";
     std::string backend = "auto";
+    std::string devices;
     std::string scene;
     std::vector<std::string> sets;
     unsigned threads = 0;

@@ -24,6 +24,7 @@ struct SampleOption {
 struct RenderSettings {
     unsigned width = 1024, height = 1024;
     BackendKind backend = BackendKind::kAuto;
+    std::vector<DeviceSpec> devices;          // --devices: launches spread over these
     unsigned threads = 0;                     // CPU workers, 0 = all cores
     std::string scene;                        // built-in scene name or file; empty = default
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
@@ -38,7 +39,9 @@ struct RenderSettings {
 
     /// The Context options these settings ask for.
     ContextOptions context_options() const {
-        return ContextOptions{backend, threads, jit_check_sm};
+        ContextOptions options{backend, threads, jit_check_sm};
+        options.devices = devices;
+        return options;
     }
 };
 

@@ -91,6 +91,49 @@ igi)
     LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent render --sample igi --backend cuda \
         --scene bench/scenes/sponza-igi.json --size 800x600 --out "$out/igi_sponza.png" --repeat 50
     ;;
+multi)
+    # Several devices per launch (issue 8): the multi-device tests, the suites through the
+    # multi-device path, images against one device, and the IGI scaling figure.
+    gpus=$(nvidia-smi -L | wc -l)
+    lists="0 0,0"; [ "$gpus" -ge 2 ] && lists="0 0,1 all"
+    for list in $lists; do
+        $R $B/bin/lucent render --sample igi --devices $list --size 1920x1080 --set vpls=180 \
+            --out "$out/igi_devices_$list.exr" | tail -3
+    done
+    $R $B/bin/lucent render --sample igi --backend cuda --size 1920x1080 --set vpls=180 --out "$out/igi_one.exr" | tail -2
+    for list in $lists; do
+        cmp "$out/igi_one.exr" "$out/igi_devices_$list.exr" && echo "igi 1920x1080 --devices $list: identical file to one GPU"
+    done
+    echo "== bench igi 1920x1080, 180 VPLs: one GPU, then every list"
+    for scene in cornell bench/scenes/sponza-igi.json; do
+        LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda --scene $scene \
+            --size 1920x1080 --vpls 180 --frames 30 --json > "$out/igi_scale_one_$(basename $scene .json).json"
+        for list in $lists; do
+            LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --devices $list --scene $scene \
+                --size 1920x1080 --vpls 180 --frames 30 --json > "$out/igi_scale_${list}_$(basename $scene .json).json"
+        done
+        python3 - "$out" "$(basename $scene .json)" $lists <<'PY'
+import json, sys
+out, scene, lists = sys.argv[1], sys.argv[2], sys.argv[3:]
+one = json.load(open(f"{out}/igi_scale_one_{scene}.json"))
+def fps(doc):
+    return {r["configuration"]: r["fps"] for r in doc["rows"]}
+base = fps(one)
+for l in lists:
+    got = fps(json.load(open(f"{out}/igi_scale_{l}_{scene}.json")))
+    print(scene, "--devices", l, " ".join(f"{c}: {got[c]:.1f} fps ({got[c] / base[c]:.2f}x of {base[c]:.1f})" for c in base))
+PY
+    done
+    echo "== multi_device_test ($gpus GPUs)"
+    $R $B/bin/multi_device_test 2>&1 | tail -25
+    for list in 0,0 cpu,0; do
+        for t in ${MULTI_SUITES:-programs exceptions igi pathtracer}; do
+            LUCENT_TEST_BACKEND=cuda LUCENT_TEST_DEVICES=$list $R $B/bin/${t}_test > /tmp/md.log 2>&1
+            echo "${t}_test through --devices $list: $(grep -E '^\[  (PASSED|FAILED)  \]' /tmp/md.log | tr '\n' ' ')"
+            grep -E '^\[  FAILED  \] [A-Z]' /tmp/md.log | head -5
+        done
+    done
+    ;;
 pathtracer)
     echo "== path tracer, Cornell box 1024x1024"
     $R $B/bin/lucent render --sample pathtracer --scene cornell --backend cuda --size 1024x1024 --spp 256 --out "$out/pathtracer_cornell.png"

@@ -44,6 +44,12 @@ inline ContextOptions test_context_options() {
     options.threads = 2;
     // LUCENT_TEST_JIT_CHECK=90: also compile each test scene's CUDA megakernel (slow).
     if (const char* sm = std::getenv("LUCENT_TEST_JIT_CHECK")) options.jit_check_sm = std::atoi(sm);
+    // LUCENT_TEST_DEVICES=0,0 (or cpu,0, ...): every suite through the multi-device path,
+    // in pieces of two rows.
+    if (const char* devices = std::getenv("LUCENT_TEST_DEVICES")) {
+        options.devices = parse_device_list(devices);
+        options.piece_rows = 2;
+    }
     return options;
 }
 

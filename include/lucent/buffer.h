@@ -63,10 +63,11 @@ class Buffer : public ContextObject {
     uint64_t version() const { return m_version; }
     /// A GPU launch wrote the buffer: the host copy is refreshed on the next map or data.
     void mark_device_newer() const { m_device_newer = true; }
+    /// Brings the host copy up to date now if a launch wrote the buffer on a device.
+    void sync_from_device() const;
 
   private:
     void check_element(const TypeInfo& requested) const;
-    void sync_from_device() const;
     struct alignas(16) Block {
         unsigned char bytes[16];
     };

@@ -15,6 +15,21 @@ namespace lucent {
 
 enum class BackendKind { kAuto, kCpu, kCuda };
 
+/// One device a Context launches on: the CPU (all its cores) or a CUDA GPU by ordinal.
+struct DeviceSpec {
+    enum class Kind { kCpu, kCuda };
+    Kind kind = Kind::kCpu;
+    int ordinal = 0;  // kCuda: the GPU's CUDA ordinal
+    bool operator==(const DeviceSpec&) const = default;
+};
+
+/// Parses a device list: "all" (every CUDA GPU, or the CPU where there is none), or
+/// comma-separated items, each a GPU ordinal ("0") or "cpu": "0,1", "cpu,0", "0,0" (GPU 0
+/// twice: two devices sharing one GPU). Throws Error naming the bad item.
+std::vector<DeviceSpec> parse_device_list(const std::string& text);
+/// "cpu" or "cuda:1".
+std::string device_spec_name(const DeviceSpec& device);
+
 struct ContextOptions {
     BackendKind backend = BackendKind::kAuto;
     unsigned threads = 0;  // CPU backend workers; 0 = one per core
@@ -22,7 +37,17 @@ struct ContextOptions {
     /// with NVRTC for this compute capability (e.g. 90), without a GPU; 0 = off. A check
     /// that the GPU path compiles; needs a build with the CUDA toolkit.
     int jit_check_sm = 0;
+    /// The devices every launch is spread over (at most kMaxDevices). Empty: the one device
+    /// `backend` chooses. With several, each launch's rows are taken from a shared queue by
+    /// all of them, and the images are those of a one-device run (docs/multi-device.md).
+    /// When set, `backend` is ignored; `threads` is the CPU device's worker count.
+    std::vector<DeviceSpec> devices;
+    /// Multi-device launches: launch-grid rows per piece taken from the queue (1D launches:
+    /// 64 x this many indices); 0 = sized by each device's measured speed. For tests.
+    unsigned piece_rows = 0;
 };
+
+constexpr unsigned kMaxDevices = 16;
 
 /// A ray type: its name, the payload type every program handling it must use, and whether
 /// rays of this type need a closest-hit program on every material they can reach
@@ -54,6 +79,17 @@ struct LaunchReport {
     double jit_ms = 0;  // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
     bool jit_cached = false;  // CUDA: the megakernel came from the disk cache
     double kernel_ms = 0;     // CUDA: the megakernel alone (CUDA events), within launch_ms
+    /// Multi-device launches: what each device ran, in ContextOptions::devices order.
+    struct DeviceShare {
+        std::string device;      // "cuda:0"
+        uint64_t indices = 0;    // launch indices it ran
+        unsigned pieces = 0;     // pieces it took from the queue
+        double busy_ms = 0;      // from its first piece's start to its last piece's end
+    };
+    std::vector<DeviceShare> devices;
+    /// Multi-device launches: bringing every device's copy of the written buffers up to
+    /// date with the pieces the other devices ran (within launch_ms).
+    double exchange_ms = 0;
     uint64_t exception_count() const;
     /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
     std::string summary() const;
@@ -73,6 +109,12 @@ class Context : public VariableScope {
     std::string backend_name() const;
     /// Why BackendKind::kAuto chose the CPU ("no NVIDIA driver ..."), or empty.
     const std::string& backend_notice() const;
+    /// How many devices each launch is spread over (1 unless ContextOptions::devices).
+    unsigned device_count() const;
+
+    /// The seed of the per-device TEA keys (device API device_tea_key(); Sebald Fig. 4).
+    void set_random_seed(unsigned seed);
+    unsigned random_seed() const;
     std::string scope_name() const override { return "Context"; }
 
     // ---- entry points and ray types ------------------------------------------

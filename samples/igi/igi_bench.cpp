@@ -39,6 +39,7 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
     settings.width = options.width;
     settings.height = options.height;
     settings.backend = options.backend;
+    settings.devices = options.devices;
     settings.threads = options.threads;
     settings.scene = options.scene;
     settings.repeat = options.frames + 1;  // the first frame compiles: not timed

@@ -14,6 +14,7 @@ namespace lucent::samples {
 struct IgiBenchOptions {
     std::string scene = "cornell";  // built-in name or file
     BackendKind backend = BackendKind::kCpu;
+    std::vector<DeviceSpec> devices;  // non-empty: launches spread over these
     unsigned threads = 0;
     unsigned width = 800, height = 600;  // the paper's resolution
     unsigned frames = 10;                // timed after one warm-up frame

@@ -1,26 +1,77 @@
-// The interface every backend implements: run one launch of a compiled scene.
+// The interface every backend implements: run one launch of a compiled scene, whole or in
+// pieces (the multi-device backend hands pieces to several backends, then exchanges what
+// each wrote).
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/compiled_scene.h"
 
 namespace lucent::core {
+
+/// What a launch runs.
+struct LaunchSpec {
+    unsigned entry = 0;
+    uint3 size{1, 1, 1};
+    /// Per device slot, the key device_tea_key() returns (at least one).
+    std::vector<uint4> device_keys;
+    uint64_t count() const { return uint64_t(size.x) * size.y * size.z; }
+    /// Launches of more than one row are cut into pieces of whole rows.
+    bool by_rows() const { return size.y > 1 || size.z > 1; }
+};
+
+/// Part of a launch: the launch indices with linear index (z * height + y) * width + x in
+/// [first, last). In launches of more than one row both are multiples of the width.
+struct LaunchPiece {
+    uint64_t first = 0, last = 0;
+};
 
 class Backend {
   public:
     virtual ~Backend() = default;
     /// "cpu (2 threads)", for the user.
     virtual std::string name() const = 0;
-    /// Runs entry point `entry` over the grid `size`; fills the exception part of `report`.
-    virtual void launch(const CompiledScene& scene, unsigned entry, uint3 size,
-                        LaunchReport& report) = 0;
+    /// One whole launch on this device: begin, one piece, end, publish the outputs.
+    virtual void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report);
     /// Brings the host copy of a buffer that the last launch wrote on a device up to date.
     virtual void fetch(const Buffer& /*buffer*/) {}
+
+    // ---- a launch in pieces ----------------------------------------------------------------
+    /// Brings this device's copy of the scene up to date (compiling its kernel if need be)
+    /// and readies the launch; fills the report's compile fields.
+    virtual void begin_launch(const CompiledScene& scene, const LaunchSpec& spec,
+                              LaunchReport& report) = 0;
+    /// Runs one piece. May return before it finished (a GPU queues it); at most one piece
+    /// waits behind the one running.
+    virtual void run_piece(LaunchPiece piece) = 0;
+    /// Waits for every piece; adds the exceptions they raised (and kernel time) to `report`.
+    virtual void end_launch(LaunchReport& report) = 0;
+    /// After a one-device launch: the host copies of the buffers it may have written are
+    /// this device's (fetched when the host reads them).
+    virtual void publish_outputs() {}
+
+    // ---- copies between the devices' copies of a buffer -----------------------------------
+    /// True when this device's copy of a buffer is the Buffer's host storage (the CPU).
+    virtual bool uses_host_storage() const { return false; }
+    /// Host storage, bytes [offset, offset + bytes) → this device's copy.
+    virtual void upload_range(const Buffer& /*buffer*/, size_t /*offset*/, size_t /*bytes*/) {}
+    /// This device's copy → host storage.
+    virtual void download_range(const Buffer& /*buffer*/, size_t /*offset*/, size_t /*bytes*/) {}
+    /// Readies copies from this device to `peer` (GPUs: peer access where the pair allows).
+    virtual void connect(Backend& /*peer*/) {}
+    /// This device's copy → `target`'s copy (a peer copy between GPUs).
+    virtual void copy_range_to(Backend& target, const Buffer& buffer, size_t offset,
+                               size_t bytes);
 };
 
 /// The CPU backend: a worker per core (or `threads`), tiles of the launch grid.
 std::unique_ptr<Backend> make_cpu_backend(unsigned threads);
+
+/// One launch spread over several backends (docs/multi-device.md).
+std::unique_ptr<Backend> make_multi_device_backend(std::vector<std::unique_ptr<Backend>> devices,
+                                                   std::vector<std::string> device_names,
+                                                   unsigned piece_rows);
 
 }  // namespace lucent::core

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/backend.h"
+#include "lucent/device/tea.h"
 #include "core/context_state.h"
 #include "core/scene_compiler.h"
 #if LUCENT_HAVE_CUDA
@@ -24,6 +25,8 @@ struct Context::Impl {
     LaunchReport last;
     std::string notice;  // why kAuto chose the CPU
     int jit_check_sm = 0;
+    unsigned device_count = 1;
+    unsigned seed = 0;
     unsigned next_id = 0;
 
     std::string next_name(const char* kind) {
@@ -38,12 +41,41 @@ double ms_since(Clock::time_point t0) {
 }
 }  // namespace
 
+namespace {
+std::unique_ptr<core::Backend> make_device_backend(const DeviceSpec& device, unsigned threads) {
+    if (device.kind == DeviceSpec::Kind::kCpu) return core::make_cpu_backend(threads);
+#if LUCENT_HAVE_CUDA
+    std::string why;
+    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why)) return backend;
+    throw Error("Context: device " + device_spec_name(device) + " cannot run here: " + why +
+                "; list the GPUs `nvidia-smi -L` shows, or cpu");
+#else
+    throw Error("Context: device " + device_spec_name(device) +
+                " needs the CUDA backend, which is not part of this build (it needs the CUDA "
+                "toolkit at configure time); use the device cpu");
+#endif
+}
+}  // namespace
+
 Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     m_impl->state.context = this;
-    if (options.backend != BackendKind::kCpu) {
+    if (options.devices.size() > kMaxDevices)
+        throw Error("Context: " + std::to_string(options.devices.size()) +
+                    " devices listed; at most " + std::to_string(kMaxDevices));
+    if (!options.devices.empty()) {
+        std::vector<std::unique_ptr<core::Backend>> devices;
+        std::vector<std::string> names;
+        for (const DeviceSpec& device : options.devices) {
+            devices.push_back(make_device_backend(device, options.threads));
+            names.push_back(device_spec_name(device));
+        }
+        m_impl->device_count = unsigned(devices.size());
+        m_impl->backend = core::make_multi_device_backend(std::move(devices), std::move(names),
+                                                          options.piece_rows);
+    } else if (options.backend != BackendKind::kCpu) {
 #if LUCENT_HAVE_CUDA
         std::string why;
-        m_impl->backend = cuda::make_cuda_backend(&why);
+        m_impl->backend = cuda::make_cuda_backend(0, &why);
         if (!m_impl->backend && options.backend == BackendKind::kCuda)
             throw Error("Context: the CUDA backend cannot run here: " + why +
                         "; use --backend cpu or --backend auto");
@@ -79,6 +111,16 @@ Context::~Context() {
 
 std::string Context::backend_name() const {
     return m_impl->backend->name();
+}
+
+unsigned Context::device_count() const {
+    return m_impl->device_count;
+}
+void Context::set_random_seed(unsigned seed) {
+    m_impl->seed = seed;
+}
+unsigned Context::random_seed() const {
+    return m_impl->seed;
 }
 
 void Context::variables_changed() {
@@ -344,8 +386,15 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
                         (dims == 3 ? "x" + std::to_string(depth) : "") +
                         "; resize the buffer to the launch size");
     }
+    core::LaunchSpec spec;
+    spec.entry = entry;
+    spec.size = uint3{width, height, depth};
+    // Sebald's Fig. 4: one key per device slot from the slot and the seed.
+    for (unsigned slot = 0; slot < m_impl->device_count; ++slot)
+        spec.device_keys.push_back(
+            generate_tea_key(zafar_tea_key(), make_uint2(slot, m_impl->seed)));
     auto t1 = Clock::now();
-    m_impl->backend->launch(scene, entry, uint3{width, height, depth}, report);
+    m_impl->backend->launch(scene, spec, report);
     report.launch_ms = ms_since(t1) - report.jit_ms;  // the kernel compile is reported apart
     m_impl->last = std::move(report);
 }

@@ -43,37 +43,55 @@ class CpuBackend final : public core::Backend {
                (m_pool.size() == 1 ? "" : "s") + ")";
     }
 
-    void launch(const core::CompiledScene& scene, unsigned entry, uint3 size,
-                LaunchReport& report) override {
-        const core::CompiledEntry& e = scene.entries[entry];
-        const bool one_d = size.y == 1 && size.z == 1;
-        const unsigned tiles_x =
-            one_d ? (size.x + kTile1D - 1) / kTile1D : (size.x + kTileWidth - 1) / kTileWidth;
-        const unsigned tiles_y = one_d ? 1 : (size.y + kTileHeight - 1) / kTileHeight;
-        const uint64_t tile_count = uint64_t(tiles_x) * tiles_y * size.z;
+    void begin_launch(const core::CompiledScene& scene, const core::LaunchSpec& spec,
+                      LaunchReport& /*report*/) override {
+        m_scene = &scene;
+        m_spec = spec;
+        m_exceptions.assign(m_pool.size(), WorkerExceptions{});
+    }
+
+    void run_piece(core::LaunchPiece piece) override {
+        const core::CompiledScene& scene = *m_scene;
+        const core::CompiledEntry& e = scene.entries[m_spec.entry];
+        const uint3 size = m_spec.size;
+        // A piece of whole rows (row = z * height + y) in 8x8 tiles, or of one row in 64s.
+        const bool by_rows = m_spec.by_rows();
+        const uint64_t first_row = by_rows ? piece.first / size.x : 0;
+        const uint64_t rows = by_rows ? piece.last / size.x - first_row : 1;
+        const uint64_t tiles_x =
+            by_rows ? (size.x + kTileWidth - 1) / kTileWidth : (piece.last - piece.first + kTile1D - 1) / kTile1D;
+        const uint64_t tile_count = tiles_x * ((rows + kTileHeight - 1) / kTileHeight);
 
         std::atomic<uint64_t> next_tile{0};
-        std::vector<WorkerExceptions> exceptions(m_pool.size());
         std::mutex error_mutex;
         std::exception_ptr error;
-
         m_pool.run([&](unsigned worker) {
             ThreadState ts;
             ts.scene = &scene;
             ts.launch_size = size;
+            ts.device_keys = m_spec.device_keys.data();
+            ts.device_slots = unsigned(m_spec.device_keys.size());
             ts.frames.resize(scene.max_depth);
             set_thread_state(&ts);
             try {
                 for (uint64_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
-                    unsigned z = unsigned(tile / (uint64_t(tiles_x) * tiles_y));
-                    unsigned rest = unsigned(tile % (uint64_t(tiles_x) * tiles_y));
-                    unsigned tx = rest % tiles_x, ty = rest / tiles_x;
-                    unsigned x0 = tx * (one_d ? kTile1D : kTileWidth), y0 = ty * kTileHeight;
-                    unsigned x1 = std::min(size.x, x0 + (one_d ? kTile1D : kTileWidth));
-                    unsigned y1 = one_d ? 1 : std::min(size.y, y0 + kTileHeight);
-                    for (unsigned y = y0; y < y1; ++y)
+                    const uint64_t tx = tile % tiles_x, ty = tile / tiles_x;
+                    if (!by_rows) {
+                        const uint64_t i0 = piece.first + tx * kTile1D;
+                        const uint64_t i1 = std::min(piece.last, i0 + kTile1D);
+                        for (uint64_t i = i0; i < i1; ++i)
+                            run_index(ts, scene, e, uint3{unsigned(i), 0, 0}, m_exceptions[worker]);
+                        continue;
+                    }
+                    const unsigned x0 = unsigned(tx) * kTileWidth;
+                    const unsigned x1 = std::min(size.x, x0 + kTileWidth);
+                    const uint64_t r0 = first_row + ty * kTileHeight;
+                    const uint64_t r1 = std::min(first_row + rows, r0 + kTileHeight);
+                    for (uint64_t r = r0; r < r1; ++r) {
+                        const unsigned y = unsigned(r % size.y), z = unsigned(r / size.y);
                         for (unsigned x = x0; x < x1; ++x)
-                            run_index(ts, scene, e, uint3{x, y, z}, exceptions[worker]);
+                            run_index(ts, scene, e, uint3{x, y, z}, m_exceptions[worker]);
+                    }
                 }
             } catch (...) {
                 // A C++ exception that is not the engine's (e.g. std::bad_alloc in a program).
@@ -84,19 +102,24 @@ class CpuBackend final : public core::Backend {
             set_thread_state(nullptr);
         });
         if (error) std::rethrow_exception(error);
+    }
 
-        std::map<int, WorkerExceptions::Entry> merged;
-        for (auto& w : exceptions)
+    void end_launch(LaunchReport& report) override {
+        for (auto& w : m_exceptions)
             for (auto& [code, entry] : w.by_code) {
-                auto& m = merged[code];
+                auto& m = m_merged[code];
                 m.count += entry.count;
                 if (entry.first_linear < m.first_linear) {
                     m.first_linear = entry.first_linear;
                     m.first_index = entry.first_index;
                 }
             }
-        for (auto& [code, m] : merged) report.exceptions[code] = {m.count, m.first_index};
+        for (auto& [code, m] : m_merged) report.exceptions[code] = {m.count, m.first_index};
+        m_merged.clear();
+        m_exceptions.clear();
     }
+
+    bool uses_host_storage() const override { return true; }
 
   private:
     static void run_index(ThreadState& ts, const core::CompiledScene& scene,
@@ -129,6 +152,10 @@ class CpuBackend final : public core::Backend {
     }
 
     ThreadPool m_pool;
+    const core::CompiledScene* m_scene = nullptr;
+    core::LaunchSpec m_spec;
+    std::vector<WorkerExceptions> m_exceptions;  // per worker, for the launch's pieces
+    std::map<int, WorkerExceptions::Entry> m_merged;
 };
 
 }  // namespace

@@ -73,6 +73,8 @@ struct ThreadState {
     const core::CompiledScene* scene = nullptr;
     uint3 launch_index{0, 0, 0};
     uint3 launch_size{1, 1, 1};
+    const uint4* device_keys = nullptr;  // per device slot (device_tea_key())
+    unsigned device_slots = 1;
     unsigned depth = 0;              // active traces
     std::vector<TraceFrame> frames;  // frames[depth - 1] is the innermost trace
     ProgramContext context = ProgramContext::kRayGeneration;  // outside any trace

@@ -71,6 +71,10 @@ uint3 launch_index() {
 uint3 launch_size() {
     return cpu::thread_state().launch_size;
 }
+uint4 device_tea_key() {
+    const cpu::ThreadState& ts = cpu::thread_state();
+    return ts.device_keys[device_slot_of(ts.launch_index, ts.launch_size, ts.device_slots)];
+}
 
 const Ray& current_ray() {
     TraceFrame* f = cpu::thread_state().current();

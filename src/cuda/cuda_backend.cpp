@@ -59,8 +59,8 @@ struct ShapeTuning {
 
 class CudaBackend final : public core::Backend {
   public:
-    explicit CudaBackend(const DriverApi& d) : m_driver(d) {
-        check(d.cuDeviceGet(&m_device, 0), "cuDeviceGet");
+    CudaBackend(const DriverApi& d, int ordinal) : m_driver(d), m_ordinal(ordinal) {
+        check(d.cuDeviceGet(&m_device, ordinal), "cuDeviceGet");
         char name[256] = {};
         d.cuDeviceGetName(name, sizeof name, m_device);
         m_device_name = name;
@@ -71,9 +71,18 @@ class CudaBackend final : public core::Backend {
         m_sm = major * 10 + minor;
         check(d.cuDevicePrimaryCtxRetain(&m_context, m_device), "cuDevicePrimaryCtxRetain");
         check(d.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Its own stream: two devices on one GPU (a GPU listed twice) run side by side. A
+        // blocking stream: the synchronous uploads on the default stream come before kernels.
+        check(d.cuStreamCreate(&m_stream, CU_STREAM_DEFAULT), "cuStreamCreate");
+        for (CUevent& e : m_piece_done) check(d.cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate");
+        check(d.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
+        check(d.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
     }
     ~CudaBackend() override {
+        m_driver.cuCtxSetCurrent(m_context);
         m_scene.reset();
+        for (CUevent e : m_piece_done) m_driver.cuEventDestroy(e);
+        if (m_stream) m_driver.cuStreamDestroy(m_stream);
         if (m_start) m_driver.cuEventDestroy(m_start);
         if (m_stop) m_driver.cuEventDestroy(m_stop);
         if (m_module) m_driver.cuModuleUnload(m_module);
@@ -81,11 +90,12 @@ class CudaBackend final : public core::Backend {
     }
 
     std::string name() const override {
-        return "cuda (" + m_device_name + ", sm_" + std::to_string(m_sm) + ")";
+        return "cuda:" + std::to_string(m_ordinal) + " (" + m_device_name + ", sm_" +
+               std::to_string(m_sm) + ")";
     }
 
-    void launch(const core::CompiledScene& scene, unsigned entry, uint3 size,
-                LaunchReport& report) override {
+    void begin_launch(const core::CompiledScene& scene, const core::LaunchSpec& spec,
+                      LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
             if (!m_scene) m_scene = std::make_unique<GpuScene>();
@@ -96,45 +106,64 @@ class CudaBackend final : public core::Backend {
         } else {
             m_scene->sync_buffers();
         }
+        if (spec.device_keys.empty() || spec.device_keys.size() > gpu::kGpuMaxDeviceSlots)
+            throw Error("CUDA backend: a launch needs 1 to 16 device keys");
 
         gpu::LaunchParams p = m_scene->params();
-        p.ray_generation = m_scene->ray_generation(entry);
-        p.exception = m_scene->exception(entry);
-        p.launch_size = size;
-        p.launch_count = uint64_t(size.x) * size.y * size.z;
+        p.ray_generation = m_scene->ray_generation(spec.entry);
+        p.exception = m_scene->exception(spec.entry);
+        p.launch_size = spec.size;
+        p.launch_count = spec.count();
+        p.device_slots = unsigned(spec.device_keys.size());
+        for (size_t i = 0; i < spec.device_keys.size(); ++i) p.device_keys[i] = spec.device_keys[i];
         m_counter.alloc(sizeof(unsigned long long));
-        m_counter.fill(0);
         m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
         m_exceptions.fill(0);
         p.work_counter = const_cast<unsigned long long*>(m_counter.as<unsigned long long>());
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
         // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
-        ShapeTuning& tuning = m_tuning[{entry, p.launch_count}];
-        const int shape = m_fixed_shape ? kOccupancyFirst : tuning.next_shape();
-        apply_shape(m_shapes[shape]);
+        m_tuning_key = {spec.entry, p.launch_count};
+        m_shape = m_fixed_shape ? kOccupancyFirst : m_tuning[m_tuning_key].next_shape();
+        apply_shape(m_shapes[m_shape]);
         const unsigned threads = unsigned(std::max(m_shapes[0].grid, m_shapes[1].grid)) * kBlock;
         if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
             m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
         check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
+        m_size = spec.size;
+        m_pieces = 0;
+        check(m_driver.cuEventRecord(m_start, m_stream), "cuEventRecord");
+    }
 
-        if (!m_start) {
-            check(m_driver.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
-            check(m_driver.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
-        }
-        check(m_driver.cuEventRecord(m_start, nullptr), "cuEventRecord");
+    void run_piece(core::LaunchPiece piece) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Queued on the stream: the counter reset, the kernel over the piece, its event.
+        // Then wait for the piece before it, so one piece waits while one runs.
+        check(m_driver.cuMemsetD32Async(m_counter.ptr(), 0, 2, m_stream), "reset the work counter");
+        unsigned long long first = piece.first, last = piece.last;
+        void* args[] = {&first, &last};
         check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
-                                      nullptr, nullptr, nullptr),
+                                      m_stream, args, nullptr),
               "launch the megakernel");
-        check(m_driver.cuEventRecord(m_stop, nullptr), "cuEventRecord");
-        check(m_driver.cuCtxSynchronize(), "run the megakernel");
+        check(m_driver.cuEventRecord(m_piece_done[m_pieces % 2], m_stream), "cuEventRecord");
+        if (m_pieces > 0)
+            check(m_driver.cuEventSynchronize(m_piece_done[(m_pieces - 1) % 2]),
+                  "run the megakernel");
+        ++m_pieces;
+    }
+
+    void end_launch(LaunchReport& report) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        check(m_driver.cuEventRecord(m_stop, m_stream), "cuEventRecord");
+        check(m_driver.cuStreamSynchronize(m_stream), "run the megakernel");
         float kernel_ms = 0;
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
-        if (!m_fixed_shape) tuning.record(shape, kernel_ms);
+        if (!m_fixed_shape && m_pieces > 0) m_tuning[m_tuning_key].record(m_shape, kernel_ms);
 
         std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
         m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
+        const uint3 size = m_size;
         for (const auto& s : slots) {
             if (s.code == 0) continue;
             uint64_t linear = ~s.first_linear_inverted;
@@ -142,7 +171,47 @@ class CudaBackend final : public core::Backend {
                         unsigned(linear / (uint64_t(size.x) * size.y))};
             report.exceptions[s.code] = {s.count, first};
         }
+    }
+
+    void publish_outputs() override {
         m_scene->mark_outputs_device_newer();  // copied back when the host reads them
+    }
+
+    void upload_range(const Buffer& buffer, size_t offset, size_t bytes) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        const auto* host = static_cast<const unsigned char*>(buffer.raw());
+        check(m_driver.cuMemcpyHtoD(mirror_of(buffer) + offset, host + offset, bytes),
+              "upload a piece of a buffer");
+    }
+
+    void download_range(const Buffer& buffer, size_t offset, size_t bytes) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        auto* host = static_cast<unsigned char*>(const_cast<void*>(buffer.raw()));
+        check(m_driver.cuMemcpyDtoH(host + offset, mirror_of(buffer) + offset, bytes),
+              "download a piece of a buffer");
+    }
+
+    void copy_range_to(core::Backend& target, const Buffer& buffer, size_t offset,
+                       size_t bytes) override {
+        auto* gpu = dynamic_cast<CudaBackend*>(&target);
+        if (!gpu) return core::Backend::copy_range_to(target, buffer, offset, bytes);
+        // GPU to GPU: directly over NVLink or PCIe where peer access is on (connect()), else
+        // the driver stages it through host memory.
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        check(m_driver.cuMemcpyPeer(gpu->mirror_of(buffer) + offset, gpu->m_context,
+                                    mirror_of(buffer) + offset, m_context, bytes),
+              "copy a piece of a buffer between GPUs");
+    }
+
+    void connect(core::Backend& peer) override {
+        auto* gpu = dynamic_cast<CudaBackend*>(&peer);
+        if (!gpu || gpu->m_device == m_device) return;
+        int can = 0;
+        m_driver.cuDeviceCanAccessPeer(&can, m_device, gpu->m_device);
+        if (!can) return;
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        CUresult r = m_driver.cuCtxEnablePeerAccess(gpu->m_context, 0);
+        if (r != CUDA_ERROR_PEER_ACCESS_ALREADY_ENABLED) check(r, "enable peer access");
     }
 
     void fetch(const Buffer& buffer) override {
@@ -199,6 +268,13 @@ class CudaBackend final : public core::Backend {
     }
 
   private:
+    CUdeviceptr mirror_of(const Buffer& buffer) const {
+        CUdeviceptr ptr = m_scene ? m_scene->mirror(buffer) : 0;
+        if (!ptr)
+            throw Error("CUDA backend: " + buffer.describe() + " has no copy on " + name());
+        return ptr;
+    }
+
     /// Blocks of the megakernel resident per SM with this carveout.
     int resident_blocks(int carveout) {
         check(m_driver.cuFuncSetAttribute(
@@ -220,7 +296,14 @@ class CudaBackend final : public core::Backend {
     }
 
     const DriverApi& m_driver;
+    int m_ordinal = 0;
     CUdevice m_device = 0;
+    CUstream m_stream = nullptr;
+    CUevent m_piece_done[2] = {nullptr, nullptr};
+    unsigned m_pieces = 0;  // of the current launch
+    uint3 m_size{1, 1, 1};
+    int m_shape = kOccupancyFirst;
+    std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
     CUcontext m_context = nullptr;
     CUmodule m_module = nullptr;
     CUfunction m_kernel = nullptr;
@@ -239,7 +322,7 @@ class CudaBackend final : public core::Backend {
 
 }  // namespace
 
-std::unique_ptr<core::Backend> make_cuda_backend(std::string* why) {
+std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why) {
     const DriverApi* d = driver(why);
     if (!d) return nullptr;
     std::string nvrtc_why;
@@ -247,7 +330,22 @@ std::unique_ptr<core::Backend> make_cuda_backend(std::string* why) {
         if (why) *why = nvrtc_why;
         return nullptr;
     }
-    return std::make_unique<CudaBackend>(*d);
+    int count = 0;
+    d->cuDeviceGetCount(&count);
+    if (ordinal < 0 || ordinal >= count) {
+        if (why)
+            *why = "there is no GPU " + std::to_string(ordinal) + " (the driver reports " +
+                   std::to_string(count) + ")";
+        return nullptr;
+    }
+    return std::make_unique<CudaBackend>(*d, ordinal);
+}
+
+int gpu_count() {
+    const DriverApi* d = driver();
+    int count = 0;
+    if (d) d->cuDeviceGetCount(&count);
+    return count;
 }
 
 }  // namespace lucent::cuda

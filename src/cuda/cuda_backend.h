@@ -8,8 +8,11 @@
 
 namespace lucent::cuda {
 
-/// The CUDA backend on GPU 0, or null (with the reason in `why`) when no driver, GPU or
-/// NVRTC answers.
-std::unique_ptr<core::Backend> make_cuda_backend(std::string* why);
+/// The CUDA backend on GPU `ordinal`, or null (with the reason in `why`) when no driver,
+/// such GPU or NVRTC answers.
+std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why);
+
+/// GPUs the driver reports (0 without a driver).
+int gpu_count();
 
 }  // namespace lucent::cuda

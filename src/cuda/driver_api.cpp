@@ -64,6 +64,13 @@ Loaded load() {
     LUCENT_LOAD(cuFuncSetAttribute, "cuFuncSetAttribute")
     LUCENT_LOAD(cuOccupancyMaxActiveBlocksPerMultiprocessor,
                 "cuOccupancyMaxActiveBlocksPerMultiprocessor")
+    LUCENT_LOAD(cuStreamCreate, "cuStreamCreate")
+    LUCENT_LOAD(cuStreamDestroy, "cuStreamDestroy_v2")
+    LUCENT_LOAD(cuStreamSynchronize, "cuStreamSynchronize")
+    LUCENT_LOAD(cuMemsetD32Async, "cuMemsetD32Async")
+    LUCENT_LOAD(cuMemcpyPeer, "cuMemcpyPeer")
+    LUCENT_LOAD(cuDeviceCanAccessPeer, "cuDeviceCanAccessPeer")
+    LUCENT_LOAD(cuCtxEnablePeerAccess, "cuCtxEnablePeerAccess")
 #undef LUCENT_LOAD
     if (missing) return l;
     if (CUresult r = l.api.cuInit(0); r != CUDA_SUCCESS) {

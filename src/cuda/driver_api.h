@@ -40,6 +40,13 @@ struct DriverApi {
     LUCENT_CU_FN(cuFuncGetAttribute)
     LUCENT_CU_FN(cuFuncSetAttribute)
     LUCENT_CU_FN(cuOccupancyMaxActiveBlocksPerMultiprocessor)
+    LUCENT_CU_FN(cuStreamCreate)
+    LUCENT_CU_FN(cuStreamDestroy)
+    LUCENT_CU_FN(cuStreamSynchronize)
+    LUCENT_CU_FN(cuMemsetD32Async)
+    LUCENT_CU_FN(cuMemcpyPeer)
+    LUCENT_CU_FN(cuDeviceCanAccessPeer)
+    LUCENT_CU_FN(cuCtxEnablePeerAccess)
 #undef LUCENT_CU_FN
 };
 

@@ -295,6 +295,11 @@ void GpuScene::fetch_mirror(BufferMirror& mirror) {
     mirror.device_newer = false;
 }
 
+CUdeviceptr GpuScene::mirror(const Buffer& buffer) const {
+    auto found = m_buffers.find(&buffer);
+    return found == m_buffers.end() ? 0 : found->second.memory.ptr();
+}
+
 void GpuScene::fetch(const Buffer& buffer) {
     auto found = m_buffers.find(&buffer);
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);

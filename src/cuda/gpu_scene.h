@@ -26,6 +26,8 @@ class GpuScene {
     void mark_outputs_device_newer();
     /// Copies one buffer's device contents to its host copy (no-op if not mirrored).
     void fetch(const Buffer& buffer);
+    /// The device copy of a buffer this compile uses, or 0.
+    CUdeviceptr mirror(const Buffer& buffer) const;
 
     /// The scene part of the launch parameters (per-launch fields left for the caller).
     const gpu::LaunchParams& params() const { return m_params; }

@@ -2,6 +2,7 @@
 // non-template functions (the CPU backend in src/cpu/device_runtime.cpp).
 #pragma once
 
+#include "lucent/device/device_slot.h"
 #include "lucent/device/types.h"
 
 #if !LUCENT_GPU_CODE
@@ -33,6 +34,10 @@ LUCENT_HD void print_text(const char* text);
 LUCENT_HD uint3 launch_index();
 /// Size of the launch grid (unused dimensions are 1).
 LUCENT_HD uint3 launch_size();
+/// This launch index's own TEA key (Sebald, Fig. 4): generate_tea_key(zafar_tea_key(),
+/// (slot, seed)) for the device slot the index belongs to (device_slot_of) and the
+/// Context's random seed. Streams differ per device of the Context's list; one device: slot 0.
+LUCENT_HD uint4 device_tea_key();
 /// The ray being traced, in the space of the current program (object space in
 /// intersection, any-hit and visit programs below a Transform; world space elsewhere).
 LUCENT_HD const Ray& current_ray();

@@ -82,6 +82,8 @@ struct GpuExceptionSlot {
     unsigned long long first_linear_inverted;
 };
 
+constexpr unsigned kGpuMaxDeviceSlots = 16;  // lucent::kMaxDevices
+
 struct LaunchParams {
     const GpuNode* nodes;
     const unsigned* children;
@@ -110,6 +112,8 @@ struct LaunchParams {
     unsigned char* scratch;  // per-thread out-of-bounds scratch, kGpuScratchBytes each
     int3 print_index;
     unsigned print_enabled;
+    unsigned device_slots;                   // devices of the Context's list (device_tea_key())
+    uint4 device_keys[kGpuMaxDeviceSlots];  // per slot: generate_tea_key(initial, (slot, seed))
 };
 
 constexpr unsigned kGpuScratchBytes = 256;

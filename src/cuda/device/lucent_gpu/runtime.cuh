@@ -155,6 +155,10 @@ LUCENT_HD uint3 launch_index() {
 LUCENT_HD uint3 launch_size() {
     return gpu::params.launch_size;
 }
+LUCENT_HD uint4 device_tea_key() {
+    const gpu::LaunchParams& p = gpu::params;
+    return p.device_keys[device_slot_of(gpu::self().launch_index, p.launch_size, p.device_slots)];
+}
 
 namespace gpu {
 __device__ const Ray g_no_ray = {};  // current_ray() outside any trace

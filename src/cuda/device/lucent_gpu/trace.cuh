@@ -496,26 +496,28 @@ LUCENT_HD bool report_intersection(unsigned material) {
 }  // namespace lucent
 
 /// The megakernel: persistent threads take launch indices from a global counter, a warp's
-/// worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
+/// worth at a time (Aila and Laine 2009), and run the ray-generation program on each. One
+/// kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole rows
+/// (row = z * height + y) when the launch has more than one.
 extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
-    lucent_megakernel() {
+    lucent_megakernel(unsigned long long piece_first, unsigned long long piece_last) {
     using namespace lucent;
     using namespace lucent::gpu;
     ThreadState& s = self();
     const LaunchParams& p = params;
     const unsigned lane = threadIdx.x & 31u;
 #if LUCENT_GPU_TILES
-    // 2D and 3D launches: a warp takes an 8x4 tile of launch indices, so neighbouring rays,
-    // and their secondary rays, run together (less divergence than a row of 32).
-    const bool tiled = p.launch_size.y > 1;
-    const unsigned tiles_x = (p.launch_size.x + 7) / 8, tiles_y = (p.launch_size.y + 3) / 4;
-    const unsigned long long work =
-        tiled ? 32ull * tiles_x * tiles_y * p.launch_size.z : p.launch_count;
+    // Launches of several rows: a warp takes an 8x4 tile of launch indices, so neighbouring
+    // rays, and their secondary rays, run together (less divergence than a row of 32).
+    const bool tiled = p.launch_size.y > 1 || p.launch_size.z > 1;
 #else
     const bool tiled = false;
-    const unsigned tiles_x = 1, tiles_y = 1;
-    const unsigned long long work = p.launch_count;
 #endif
+    const unsigned long long first_row = piece_first / p.launch_size.x;
+    const unsigned long long end_row = piece_last / p.launch_size.x;
+    const unsigned tiles_x = (p.launch_size.x + 7) / 8;
+    const unsigned long long work =
+        tiled ? 32ull * tiles_x * ((end_row - first_row + 3) / 4) : piece_last - piece_first;
     for (;;) {
         unsigned long long base = 0;
         if (lane == 0) base = atomicAdd(p.work_counter, 32ull);
@@ -523,16 +525,15 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         if (base >= work) return;
         unsigned x, y, z;
         if (tiled) {
-            unsigned long long tile = base / 32;
-            unsigned tx = unsigned(tile % tiles_x);
-            unsigned long long rest = tile / tiles_x;
-            x = tx * 8 + (lane & 7u);
-            y = unsigned(rest % tiles_y) * 4 + (lane >> 3);
-            z = unsigned(rest / tiles_y);
-            if (x >= p.launch_size.x || y >= p.launch_size.y) continue;
+            const unsigned long long tile = base / 32;
+            x = unsigned(tile % tiles_x) * 8 + (lane & 7u);
+            const unsigned long long row = first_row + (tile / tiles_x) * 4 + (lane >> 3);
+            if (x >= p.launch_size.x || row >= end_row) continue;
+            y = unsigned(row % p.launch_size.y);
+            z = unsigned(row / p.launch_size.y);
         } else {
-            unsigned long long index = base + lane;
-            if (index >= p.launch_count) continue;
+            unsigned long long index = piece_first + base + lane;
+            if (index >= piece_last) continue;
             x = unsigned(index % p.launch_size.x);
             unsigned long long rest = index / p.launch_size.x;
             y = unsigned(rest % p.launch_size.y);
@@ -540,7 +541,6 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         }
         const unsigned long long linear =
             (unsigned long long)(z * p.launch_size.y + y) * p.launch_size.x + x;
-        (void)tiles_y;
         s.launch_index = make_uint3(x, y, z);
         s.depth = 0;
         s.exception_code = 0;

@@ -1,0 +1,280 @@
+// One launch spread over several devices (OptiX's multi-GPU launch, paper §5): every device
+// holds the whole scene and every buffer; the launch's rows are taken piece by piece from a
+// shared queue (core/piece_queue.h); then each device's copy of the buffers the launch may
+// have written receives the pieces the other devices ran, so all copies, and the images, are
+// those of a one-device run. docs/multi-device.md says what a program may write.
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include "core/backend.h"
+#include "core/piece_queue.h"
+#include "cpu/thread_pool.h"
+#include "lucent/error.h"
+
+namespace lucent::core {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+/// The buffers a launch of `entry` may write: those not of type input that its
+/// ray-generation and exception programs view, or any program a trace can reach.
+std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene& scene,
+                                                            unsigned entry) {
+    std::set<const Buffer*> seen;
+    std::vector<std::shared_ptr<const Buffer>> out;
+    auto add = [&](const CompiledProgram& p) {
+        for (const auto& b : p.buffers)
+            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
+                out.push_back(b);
+    };
+    add(scene.entries[entry].ray_generation);
+    add(scene.entries[entry].exception);
+    for (const CompiledProgram& p : scene.miss) add(p);
+    for (const CompiledProgram& p : scene.callables) add(p);
+    for (const CompiledNode& n : scene.nodes) add(n.visit);
+    for (const CompiledInstance& inst : scene.instances) {
+        add(inst.intersection);
+        add(inst.attribute);
+        for (const CompiledMaterial& m : inst.materials) {
+            for (const CompiledProgram& p : m.closest_hit) add(p);
+            for (const CompiledProgram& p : m.any_hit) add(p);
+        }
+    }
+    return out;
+}
+
+/// A buffer the size and shape of the launch grid: launch index i owns element i, so a
+/// piece's part of it is one byte range.
+bool launch_shaped(const Buffer& b, uint3 size) {
+    const unsigned dims = size.z > 1 ? 3 : size.y > 1 ? 2 : 1;
+    const uint3 s = b.size();
+    return b.dimensionality() == dims && s.x == size.x && s.y == size.y && s.z == size.z;
+}
+
+class MultiDeviceBackend final : public Backend {
+  public:
+    MultiDeviceBackend(std::vector<std::unique_ptr<Backend>> devices,
+                       std::vector<std::string> names, unsigned piece_rows)
+        : m_devices(std::move(devices)),
+          m_names(std::move(names)),
+          m_piece_rows(piece_rows),
+          m_pool(unsigned(m_devices.size())) {
+        for (auto& a : m_devices)
+            for (auto& b : m_devices)
+                if (a != b) a->connect(*b);
+    }
+
+    std::string name() const override {
+        std::string s = std::to_string(m_devices.size()) + " device" +
+                        (m_devices.size() == 1 ? "" : "s") + ": ";
+        for (size_t d = 0; d < m_devices.size(); ++d)
+            s += (d ? " + " : "") + m_devices[d]->name();
+        return s;
+    }
+
+    void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report) override {
+        const unsigned n = unsigned(m_devices.size());
+        // What a new compile drops from the devices must reach the host first.
+        if (&scene != m_scene || scene.generation != m_generation) flush_host_copies();
+        m_scene = &scene;
+        m_generation = scene.generation;
+
+        // Pieces of launch-shaped buffers are exchanged; any other written buffer can be
+        // written anywhere by any index, so such a launch runs whole on one device.
+        std::vector<std::shared_ptr<const Buffer>> shaped, other;
+        for (auto& b : writable_buffers(scene, spec.entry))
+            (launch_shaped(*b, spec.size) ? shaped : other).push_back(b);
+        std::vector<double>& speeds = m_speeds[{spec.entry, spec.count()}];
+        speeds.resize(n, 0.0);
+        PieceQueue queue(spec, speeds, m_piece_rows);
+        const bool split = n > 1 && other.empty() && queue.units() >= 2 * n * queue.min_units();
+        const unsigned whole_on = fastest(speeds);
+
+        std::vector<LaunchReport> reports(n);
+        std::vector<std::vector<LaunchPiece>> pieces(n);
+        std::vector<double> busy(n, 0.0);
+        run_on_devices([&](unsigned d) {
+            m_devices[d]->begin_launch(scene, spec, reports[d]);
+            const auto t0 = Clock::now();
+            if (split) {
+                while (auto piece = queue.take(d)) {
+                    m_devices[d]->run_piece(*piece);
+                    pieces[d].push_back(*piece);
+                }
+            } else if (d == whole_on) {
+                LaunchPiece all{0, spec.count()};
+                m_devices[d]->run_piece(all);
+                pieces[d].push_back(all);
+            }
+            m_devices[d]->end_launch(reports[d]);
+            busy[d] = ms_between(t0, Clock::now());
+        });
+
+        const auto t_exchange = Clock::now();
+        exchange(shaped, other, pieces);
+        report.exchange_ms = ms_between(t_exchange, Clock::now());
+        merge_reports(reports, pieces, busy, spec, report);
+        if (split) {
+            // Each device's speed on this entry and size, for the next launch's pieces.
+            for (unsigned d = 0; d < n; ++d) {
+                const double indices = double(report.devices[d].indices);
+                if (indices > 0 && busy[d] > 0) {
+                    const double speed = indices / busy[d];
+                    speeds[d] = speeds[d] > 0 ? 0.5 * (speeds[d] + speed) : speed;
+                }
+            }
+        }
+    }
+
+    void fetch(const Buffer& buffer) override {
+        if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
+        // Every device's copy is complete after a launch: any non-host one will do.
+        for (auto& device : m_devices)
+            if (!device->uses_host_storage()) {
+                device->download_range(buffer, 0, buffer.count() * buffer.element().size);
+                return;
+            }
+    }
+
+    // A multi-device backend is not itself one of a set of devices.
+    void begin_launch(const CompiledScene&, const LaunchSpec&, LaunchReport&) override {
+        throw Error("multi-device backend: launches whole, not in pieces");
+    }
+    void run_piece(LaunchPiece) override {}
+    void end_launch(LaunchReport&) override {}
+
+  private:
+    /// Runs job(d) for every device d at once, one thread each; rethrows the first error.
+    template <class Job>
+    void run_on_devices(const Job& job) {
+        std::mutex mutex;
+        std::exception_ptr error;
+        m_pool.run([&](unsigned d) {
+            try {
+                job(d);
+            } catch (...) {
+                std::lock_guard lock(mutex);
+                if (!error) error = std::current_exception();
+            }
+        });
+        if (error) std::rethrow_exception(error);
+    }
+
+    static unsigned fastest(const std::vector<double>& speeds) {
+        return unsigned(std::max_element(speeds.begin(), speeds.end()) - speeds.begin());
+    }
+
+    /// After the pieces: every device's copy of each written buffer receives the ranges
+    /// other devices wrote. Devices whose copy is host storage (the CPU) share one copy:
+    /// the first of them receives for all. Each device receives on its own thread.
+    void exchange(const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                  const std::vector<std::shared_ptr<const Buffer>>& other,
+                  const std::vector<std::vector<LaunchPiece>>& pieces) {
+        const unsigned n = unsigned(m_devices.size());
+        if (n == 1) {
+            m_devices[0]->publish_outputs();  // the device fetches for the host, as alone
+            return;
+        }
+        int host_receiver = -1;
+        for (unsigned d = 0; d < n && host_receiver < 0; ++d)
+            if (m_devices[d]->uses_host_storage()) host_receiver = int(d);
+        auto same_copy = [&](unsigned a, unsigned b) {
+            return a == b ||
+                   (m_devices[a]->uses_host_storage() && m_devices[b]->uses_host_storage());
+        };
+        run_on_devices([&](unsigned d) {
+            if (m_devices[d]->uses_host_storage() && int(d) != host_receiver) return;
+            for (unsigned owner = 0; owner < n; ++owner) {
+                if (same_copy(owner, d)) continue;
+                for (const LaunchPiece& piece : pieces[owner]) {
+                    for (const auto& b : shaped) {
+                        const size_t element = b->element().size;
+                        m_devices[owner]->copy_range_to(*m_devices[d], *b, piece.first * element,
+                                                        (piece.last - piece.first) * element);
+                    }
+                    // A launch with other written buffers ran whole on `owner`: all of them.
+                    for (const auto& b : other)
+                        m_devices[owner]->copy_range_to(*m_devices[d], *b, 0,
+                                                        b->count() * b->element().size);
+                }
+            }
+        });
+        if (host_receiver < 0) remember_host_stale(shaped, other);
+    }
+
+    /// No device keeps its copy in host storage: the host copies are fetched when read.
+    void remember_host_stale(const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                             const std::vector<std::shared_ptr<const Buffer>>& other) {
+        for (const auto* list : {&shaped, &other})
+            for (const auto& b : *list) {
+                b->mark_device_newer();
+                m_host_stale[b.get()] = b;
+            }
+    }
+
+    /// Fetches every buffer whose host copy is behind the devices' (before a new compile
+    /// lets the devices drop their copies).
+    void flush_host_copies() {
+        for (auto& [raw, buffer] : m_host_stale) buffer->sync_from_device();
+        m_host_stale.clear();
+    }
+
+    void merge_reports(const std::vector<LaunchReport>& reports,
+                       const std::vector<std::vector<LaunchPiece>>& pieces,
+                       const std::vector<double>& busy, const LaunchSpec& spec,
+                       LaunchReport& report) {
+        const uint3 size = spec.size;
+        auto linear = [&](uint3 i) {
+            return (uint64_t(i.z) * size.y + i.y) * size.x + i.x;
+        };
+        report.jit_cached = true;
+        for (unsigned d = 0; d < m_devices.size(); ++d) {
+            const LaunchReport& r = reports[d];
+            report.jit_ms = std::max(report.jit_ms, r.jit_ms);
+            report.jit_cached = report.jit_cached && (r.jit_ms == 0 || r.jit_cached);
+            report.kernel_ms = std::max(report.kernel_ms, r.kernel_ms);
+            for (const auto& [code, e] : r.exceptions) {
+                auto [it, fresh] = report.exceptions.try_emplace(code, e);
+                if (fresh) continue;
+                it->second.count += e.count;
+                if (linear(e.first_index) < linear(it->second.first_index))
+                    it->second.first_index = e.first_index;
+            }
+            LaunchReport::DeviceShare share;
+            share.device = m_names[d];
+            for (const LaunchPiece& p : pieces[d]) share.indices += p.last - p.first;
+            share.pieces = unsigned(pieces[d].size());
+            share.busy_ms = busy[d];
+            report.devices.push_back(share);
+        }
+        if (report.jit_ms == 0) report.jit_cached = false;
+    }
+
+    std::vector<std::unique_ptr<Backend>> m_devices;
+    std::vector<std::string> m_names;
+    unsigned m_piece_rows;
+    cpu::ThreadPool m_pool;
+    const CompiledScene* m_scene = nullptr;
+    uint64_t m_generation = 0;
+    std::map<std::pair<unsigned, uint64_t>, std::vector<double>> m_speeds;  // by entry, count
+    std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_multi_device_backend(std::vector<std::unique_ptr<Backend>> devices,
+                                                   std::vector<std::string> device_names,
+                                                   unsigned piece_rows) {
+    return std::make_unique<MultiDeviceBackend>(std::move(devices), std::move(device_names),
+                                                piece_rows);
+}
+
+}  // namespace lucent::core
