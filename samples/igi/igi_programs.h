@@ -114,7 +114,7 @@ LUCENT_HD inline float wrap01(float x) {
 
 // ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
-    lucent::BufferView<PointLight> lights;
+    lucent::BufferView<const PointLight> lights;
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
     unsigned bounces;
     float scene_epsilon;
@@ -140,7 +140,7 @@ LUCENT_RECORD(CameraRecord, eye, U, V, W, direct, gbuffer_position, gbuffer_norm
 
 /// What Eq. (1) needs wherever it is evaluated: the VPLs and how to test their visibility.
 struct IndirectParams {
-    lucent::BufferView<Vpl> vpls;
+    lucent::BufferView<const Vpl> vpls;
     float min_d;  // Eq. (1)'s bounding distance
     float scene_epsilon;
     lucent::Handle top_object;
@@ -150,8 +150,8 @@ struct IndirectParams {
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
-    lucent::BufferView<PointLight> lights;
-    lucent::BufferView<Vpl> vpls;
+    lucent::BufferView<const PointLight> lights;
+    lucent::BufferView<const Vpl> vpls;
     float min_d;
     unsigned max_depth;
     float scene_epsilon;
@@ -163,9 +163,9 @@ LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_e
               imperfect_visibility, vpl_shadow_object)
 
 struct IndirectRecord {
-    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<const float4> gbuffer_position, gbuffer_normal;
     lucent::BufferView<float4> indirect;  // 1/downsample resolution: irradiance, w = 1 if valid
-    lucent::BufferView<Vpl> vpls;
+    lucent::BufferView<const Vpl> vpls;
     unsigned downsample, interleave;
     float min_d;
     float scene_epsilon;
@@ -177,8 +177,9 @@ LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, 
               interleave, min_d, scene_epsilon, top_object, imperfect_visibility, vpl_shadow_object)
 
 struct DiscontinuityRecord {
-    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
-    lucent::BufferView<float4> indirect, merged;  // both at 1/downsample resolution
+    lucent::BufferView<const float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<const float4> indirect;  // both at 1/downsample resolution
+    lucent::BufferView<float4> merged;
     unsigned downsample, interleave;
     float depth_threshold;   // largest relative depth difference of continuous neighbours
     float normal_threshold;  // smallest cosine between the normals of continuous neighbours
@@ -187,16 +188,17 @@ LUCENT_RECORD(DiscontinuityRecord, gbuffer_position, gbuffer_normal, indirect, m
               interleave, depth_threshold, normal_threshold)
 
 struct UpsampleRecord {
-    lucent::BufferView<float4> gbuffer_position, gbuffer_normal;
-    lucent::BufferView<float4> low, full;  // 1/downsample and full resolution
+    lucent::BufferView<const float4> gbuffer_position, gbuffer_normal;
+    lucent::BufferView<const float4> low;  // 1/downsample resolution
+    lucent::BufferView<float4> full;
     unsigned downsample;
     float sigma;  // of the spatial Gaussian, in low-resolution pixels
 };
 LUCENT_RECORD(UpsampleRecord, gbuffer_position, gbuffer_normal, low, full, downsample, sigma)
 
 struct ComposeRecord {
-    lucent::BufferView<float4> direct, gbuffer_albedo;
-    lucent::BufferView<float4> indirect;  // full resolution irradiance
+    lucent::BufferView<const float4> direct, gbuffer_albedo;
+    lucent::BufferView<const float4> indirect;  // full resolution irradiance
     lucent::BufferView<float4> output;
 };
 LUCENT_RECORD(ComposeRecord, direct, gbuffer_albedo, indirect, output)
@@ -207,8 +209,8 @@ struct ParticleRecord {
 LUCENT_RECORD(ParticleRecord, Kd)
 
 struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
+    lucent::BufferView<const float3> positions;
+    lucent::BufferView<const uint3> triangles;
 };
 LUCENT_RECORD(MeshRecord, positions, triangles)
 

@@ -35,6 +35,8 @@ struct CompiledProgram {
     std::string label;                     // "closest hit 'phong' of Material 'glass'"
     std::vector<std::shared_ptr<const Buffer>>
         buffers;  // every buffer the record views (kept alive)
+    /// Those viewed through a BufferView<T> that is not BufferView<const T>.
+    std::vector<std::shared_ptr<const Buffer>> writable_buffers;
 
     explicit operator bool() const { return desc != nullptr; }
     const void* rec() const { return record ? record->data() : nullptr; }

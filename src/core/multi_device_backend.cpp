@@ -25,13 +25,14 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
 }
 
 /// The buffers a launch of `entry` may write: those not of type input that its
-/// ray-generation and exception programs view, or any program a trace can reach.
+/// ray-generation and exception programs, or any program a trace can reach, view through a
+/// BufferView<T> that is not BufferView<const T>.
 std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene& scene,
                                                             unsigned entry) {
     std::set<const Buffer*> seen;
     std::vector<std::shared_ptr<const Buffer>> out;
     auto add = [&](const CompiledProgram& p) {
-        for (const auto& b : p.buffers)
+        for (const auto& b : p.writable_buffers)
             if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
                 out.push_back(b);
     };

@@ -97,7 +97,10 @@ CompiledProgram SceneCompiler::pack(const std::shared_ptr<Program>& program,
                         "\"] = ...");
         pack_field(field, *value, out.record->data() + field.offset,
                    out.label + ", variable '" + std::string(field.name) + "'", output_buffers);
-        if (value->kind == FieldKind::kBuffer) out.buffers.push_back(value->buffer);
+        if (value->kind == FieldKind::kBuffer) {
+            out.buffers.push_back(value->buffer);
+            if (!field.read_only) out.writable_buffers.push_back(value->buffer);
+        }
         if (value->kind == FieldKind::kTexture) {
             out.buffers.push_back(value->texture->buffer());
             m_rebuild_inputs.push_back(value->texture->buffer().get());  // GPU texture objects

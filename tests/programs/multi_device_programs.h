@@ -78,7 +78,7 @@ LUCENT_RAY_GENERATION(md_last_row, LastRowRecord) {
 }
 
 struct SpreadRecord {
-    BufferView<float> last_row;  // what md_last_row wrote, on whichever device
+    BufferView<const float> last_row;  // what md_last_row wrote; only read here
     BufferView<float> spread;    // 2D
 };
 LUCENT_RECORD(SpreadRecord, last_row, spread)

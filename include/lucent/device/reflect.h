@@ -7,6 +7,7 @@
 #if !LUCENT_GPU_CODE
 #include <cstddef>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 namespace lucent {
@@ -101,7 +102,17 @@ struct FieldElement {
 };
 template <class T>
 struct FieldElement<BufferView<T>> {
-    using type = T;
+    using type = std::remove_const_t<T>;  // BufferView<const T> views a buffer of T
+};
+/// BufferView<const T>: the program only reads the buffer. A multi-device launch then need
+/// not gather it from the devices (docs/multi-device.md).
+template <class T>
+struct FieldReadOnly {
+    static constexpr bool value = false;
+};
+template <class T>
+struct FieldReadOnly<BufferView<const T>> {
+    static constexpr bool value = true;
 };
 template <class S>
 struct FieldElement<Callable<S>> {
@@ -115,6 +126,7 @@ struct FieldInfo {
     size_t size;
     FieldKind kind;
     const TypeInfo* element;  // buffer element, callable signature or user struct; else null
+    bool read_only = false;   // BufferView<const T>
 };
 
 /// A record type: its name, size and fields, from LUCENT_RECORD.
@@ -132,7 +144,7 @@ FieldInfo make_field_info(std::string_view name, size_t offset) {
     const bool has_element =
         kind == FieldKind::kBuffer || kind == FieldKind::kCallable || kind == FieldKind::kUserData;
     return FieldInfo{name, offset, sizeof(Field), kind,
-                     has_element ? &type_info_of<Element>() : nullptr};
+                     has_element ? &type_info_of<Element>() : nullptr, FieldReadOnly<Field>::value};
 }
 
 inline const RecordInfo& lucent_record_info(const NoRecord*) {
