@@ -5,6 +5,8 @@
 // those of a one-device run. docs/multi-device.md says what a program may write.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -123,6 +125,15 @@ class MultiDeviceBackend final : public Backend {
         exchange(shaped, other, pieces);
         report.exchange_ms = ms_between(t_exchange, Clock::now());
         merge_reports(reports, pieces, busy, spec, report);
+        if (m_trace) {
+            std::fprintf(stderr, "multi-device: entry %u, %llu indices, %s, exchange %.3f ms:",
+                         spec.entry, (unsigned long long)spec.count(), split ? "split" : "whole",
+                         report.exchange_ms);
+            for (const auto& d : report.devices)
+                std::fprintf(stderr, " [%s %u pieces %llu indices %.3f ms]", d.device.c_str(),
+                             d.pieces, (unsigned long long)d.indices, d.busy_ms);
+            std::fprintf(stderr, "\n");
+        }
         if (split) {
             // Each device's speed on this entry and size, for the next launch's pieces.
             for (unsigned d = 0; d < n; ++d) {
@@ -267,6 +278,7 @@ class MultiDeviceBackend final : public Backend {
     uint64_t m_generation = 0;
     std::map<std::pair<unsigned, uint64_t>, std::vector<double>> m_speeds;  // by entry, count
     std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
+    const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;  // a line per launch
 };
 
 }  // namespace

@@ -39,7 +39,8 @@ enum : int { kOccupancyFirst = 0, kL1First = 1 };
 
 /// Per entry point and launch size: launch 1 runs the occupancy-first shape (and warms up),
 /// launch 2 the L1-first, launch 3 the occupancy-first again; from then on, the faster of
-/// launches 2 and 3.
+/// launches 2 and 3, per launch index (a device of several runs a different share of each
+/// launch).
 struct ShapeTuning {
     unsigned launches = 0;
     double ms[2] = {0, 0};
@@ -49,9 +50,9 @@ struct ShapeTuning {
         if (choice >= 0) return choice;
         return launches == 1 ? kL1First : kOccupancyFirst;
     }
-    void record(int shape, double kernel_ms) {
+    void record(int shape, double ms_per_index) {
         if (choice >= 0) return;
-        if (launches >= 1) ms[shape] = kernel_ms;
+        if (launches >= 1) ms[shape] = ms_per_index;
         if (++launches == 3)
             choice = ms[kL1First] < ms[kOccupancyFirst] ? kL1First : kOccupancyFirst;
     }
@@ -73,7 +74,8 @@ class CudaBackend final : public core::Backend {
         check(d.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         // Its own stream: two devices on one GPU (a GPU listed twice) run side by side. A
         // blocking stream: the synchronous uploads on the default stream come before kernels.
-        check(d.cuStreamCreate(&m_stream, CU_STREAM_DEFAULT), "cuStreamCreate");
+        // Two: a piece queued behind another starts on the SMs the other's tail frees.
+        for (CUstream& s : m_streams) check(d.cuStreamCreate(&s, CU_STREAM_DEFAULT), "cuStreamCreate");
         for (CUevent& e : m_piece_done) check(d.cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate");
         check(d.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
         check(d.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
@@ -82,7 +84,8 @@ class CudaBackend final : public core::Backend {
         m_driver.cuCtxSetCurrent(m_context);
         m_scene.reset();
         for (CUevent e : m_piece_done) m_driver.cuEventDestroy(e);
-        if (m_stream) m_driver.cuStreamDestroy(m_stream);
+        for (CUstream s : m_streams)
+            if (s) m_driver.cuStreamDestroy(s);
         if (m_start) m_driver.cuEventDestroy(m_start);
         if (m_stop) m_driver.cuEventDestroy(m_stop);
         if (m_module) m_driver.cuModuleUnload(m_module);
@@ -116,10 +119,9 @@ class CudaBackend final : public core::Backend {
         p.launch_count = spec.count();
         p.device_slots = unsigned(spec.device_keys.size());
         for (size_t i = 0; i < spec.device_keys.size(); ++i) p.device_keys[i] = spec.device_keys[i];
-        m_counter.alloc(sizeof(unsigned long long));
+        m_counters.alloc(2 * sizeof(unsigned long long));  // one per stream
         m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
         m_exceptions.fill(0);
-        p.work_counter = const_cast<unsigned long long*>(m_counter.as<unsigned long long>());
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
         // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
         m_tuning_key = {spec.entry, p.launch_count};
@@ -132,20 +134,28 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
         m_size = spec.size;
         m_pieces = 0;
-        check(m_driver.cuEventRecord(m_start, m_stream), "cuEventRecord");
+        m_indices = 0;
+        check(m_driver.cuEventRecord(m_start, m_streams[0]), "cuEventRecord");
+        check(m_driver.cuStreamWaitEvent(m_streams[1], m_start, 0), "cuStreamWaitEvent");
     }
 
     void run_piece(core::LaunchPiece piece) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
-        // Queued on the stream: the counter reset, the kernel over the piece, its event.
-        // Then wait for the piece before it, so one piece waits while one runs.
-        check(m_driver.cuMemsetD32Async(m_counter.ptr(), 0, 2, m_stream), "reset the work counter");
+        // Pieces alternate between the two streams, each with its counter: the counter
+        // reset, the kernel over the piece, its event. Then wait for the piece before, so
+        // one piece is queued while one runs, and the queued one fills the running one's tail.
+        const unsigned slot = m_pieces % 2;
+        m_indices += piece.last - piece.first;
+        CUstream stream = m_streams[slot];
+        const CUdeviceptr counter = m_counters.ptr() + slot * sizeof(unsigned long long);
+        check(m_driver.cuMemsetD32Async(counter, 0, 2, stream), "reset the work counter");
         unsigned long long first = piece.first, last = piece.last;
-        void* args[] = {&first, &last};
+        void* counter_arg = reinterpret_cast<void*>(counter);
+        void* args[] = {&first, &last, &counter_arg};
         check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
-                                      m_stream, args, nullptr),
+                                      stream, args, nullptr),
               "launch the megakernel");
-        check(m_driver.cuEventRecord(m_piece_done[m_pieces % 2], m_stream), "cuEventRecord");
+        check(m_driver.cuEventRecord(m_piece_done[slot], stream), "cuEventRecord");
         if (m_pieces > 0)
             check(m_driver.cuEventSynchronize(m_piece_done[(m_pieces - 1) % 2]),
                   "run the megakernel");
@@ -154,12 +164,16 @@ class CudaBackend final : public core::Backend {
 
     void end_launch(LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
-        check(m_driver.cuEventRecord(m_stop, m_stream), "cuEventRecord");
-        check(m_driver.cuStreamSynchronize(m_stream), "run the megakernel");
+        // Stop after both streams' pieces.
+        check(m_driver.cuEventRecord(m_piece_done[1], m_streams[1]), "cuEventRecord");
+        check(m_driver.cuStreamWaitEvent(m_streams[0], m_piece_done[1], 0), "cuStreamWaitEvent");
+        check(m_driver.cuEventRecord(m_stop, m_streams[0]), "cuEventRecord");
+        check(m_driver.cuStreamSynchronize(m_streams[0]), "run the megakernel");
         float kernel_ms = 0;
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
-        if (!m_fixed_shape && m_pieces > 0) m_tuning[m_tuning_key].record(m_shape, kernel_ms);
+        if (!m_fixed_shape && m_indices > 0)
+            m_tuning[m_tuning_key].record(m_shape, kernel_ms / double(m_indices));
 
         std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
         m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
@@ -212,6 +226,9 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         CUresult r = m_driver.cuCtxEnablePeerAccess(gpu->m_context, 0);
         if (r != CUDA_ERROR_PEER_ACCESS_ALREADY_ENABLED) check(r, "enable peer access");
+        if (std::getenv("LUCENT_MULTI_TRACE"))
+            std::fprintf(stderr, "multi-device: %s reaches %s directly (peer access)\n",
+                         name().c_str(), gpu->name().c_str());
     }
 
     void fetch(const Buffer& buffer) override {
@@ -298,9 +315,10 @@ class CudaBackend final : public core::Backend {
     const DriverApi& m_driver;
     int m_ordinal = 0;
     CUdevice m_device = 0;
-    CUstream m_stream = nullptr;
+    CUstream m_streams[2] = {nullptr, nullptr};
     CUevent m_piece_done[2] = {nullptr, nullptr};
-    unsigned m_pieces = 0;  // of the current launch
+    unsigned m_pieces = 0;   // of the current launch
+    uint64_t m_indices = 0;  // launch indices in them
     uint3 m_size{1, 1, 1};
     int m_shape = kOccupancyFirst;
     std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
@@ -316,7 +334,7 @@ class CudaBackend final : public core::Backend {
     std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
     const core::CompiledScene* m_last_scene = nullptr;
     uint64_t m_last_generation = 0;
-    DeviceBuffer m_counter, m_exceptions, m_scratch;
+    DeviceBuffer m_counters, m_exceptions, m_scratch;
     CUevent m_start = nullptr, m_stop = nullptr;
 };
 

@@ -67,6 +67,7 @@ Loaded load() {
     LUCENT_LOAD(cuStreamCreate, "cuStreamCreate")
     LUCENT_LOAD(cuStreamDestroy, "cuStreamDestroy_v2")
     LUCENT_LOAD(cuStreamSynchronize, "cuStreamSynchronize")
+    LUCENT_LOAD(cuStreamWaitEvent, "cuStreamWaitEvent")
     LUCENT_LOAD(cuMemsetD32Async, "cuMemsetD32Async")
     LUCENT_LOAD(cuMemcpyPeer, "cuMemcpyPeer")
     LUCENT_LOAD(cuDeviceCanAccessPeer, "cuDeviceCanAccessPeer")

@@ -43,6 +43,7 @@ struct DriverApi {
     LUCENT_CU_FN(cuStreamCreate)
     LUCENT_CU_FN(cuStreamDestroy)
     LUCENT_CU_FN(cuStreamSynchronize)
+    LUCENT_CU_FN(cuStreamWaitEvent)
     LUCENT_CU_FN(cuMemsetD32Async)
     LUCENT_CU_FN(cuMemcpyPeer)
     LUCENT_CU_FN(cuDeviceCanAccessPeer)

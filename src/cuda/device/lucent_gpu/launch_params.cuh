@@ -107,7 +107,6 @@ struct LaunchParams {
     unsigned exception_mask;  // bit c (1..6): engine code c runs the exception program; bit 31:
                               // user codes
     unsigned long long launch_count;
-    unsigned long long* work_counter;
     GpuExceptionSlot* exceptions;
     unsigned char* scratch;  // per-thread out-of-bounds scratch, kGpuScratchBytes each
     int3 print_index;

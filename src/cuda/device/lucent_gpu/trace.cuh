@@ -498,9 +498,11 @@ LUCENT_HD bool report_intersection(unsigned material) {
 /// The megakernel: persistent threads take launch indices from a global counter, a warp's
 /// worth at a time (Aila and Laine 2009), and run the ray-generation program on each. One
 /// kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole rows
-/// (row = z * height + y) when the launch has more than one.
+/// (row = z * height + y) when the launch has more than one, counted by its own `counter`
+/// (two pieces may run at once, the second filling the SMs the first's tail leaves idle).
 extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
-    lucent_megakernel(unsigned long long piece_first, unsigned long long piece_last) {
+    lucent_megakernel(unsigned long long piece_first, unsigned long long piece_last,
+                      unsigned long long* counter) {
     using namespace lucent;
     using namespace lucent::gpu;
     ThreadState& s = self();
@@ -520,7 +522,7 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         tiled ? 32ull * tiles_x * ((end_row - first_row + 3) / 4) : piece_last - piece_first;
     for (;;) {
         unsigned long long base = 0;
-        if (lane == 0) base = atomicAdd(p.work_counter, 32ull);
+        if (lane == 0) base = atomicAdd(counter, 32ull);
         base = __shfl_sync(0xffffffffu, base, 0);
         if (base >= work) return;
         unsigned x, y, z;
