@@ -43,8 +43,7 @@ class Backend {
     /// and readies the launch; fills the report's compile fields.
     virtual void begin_launch(const CompiledScene& scene, const LaunchSpec& spec,
                               LaunchReport& report) = 0;
-    /// Runs one piece. May return before it finished (a GPU queues it); at most one piece
-    /// waits behind the one running.
+    /// Runs one piece. May return before it finished (a GPU queues a few).
     virtual void run_piece(LaunchPiece piece) = 0;
     /// Waits for every piece; adds the exceptions they raised (and kernel time) to `report`.
     virtual void end_launch(LaunchReport& report) = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 
 namespace lucent::core {
@@ -19,7 +20,9 @@ PieceQueue::PieceQueue(const LaunchSpec& spec, std::vector<double> speeds, unsig
       m_units((m_count + m_unit_indices - 1) / m_unit_indices),
       m_min_units(spec.by_rows() ? kMinRows : kMinOneRowUnits),
       m_fixed_units(fixed_units),
-      m_speeds(std::move(speeds)) {}
+      m_speeds(std::move(speeds)) {
+    if (const char* d = std::getenv("LUCENT_PIECE_DIVISOR")) m_divisor = std::max(1.0, std::atof(d));
+}
 
 std::optional<LaunchPiece> PieceQueue::take(unsigned device) {
     std::lock_guard lock(m_mutex);
@@ -33,7 +36,8 @@ std::optional<LaunchPiece> PieceQueue::take(unsigned device) {
         const double total = std::accumulate(m_speeds.begin(), m_speeds.end(), 0.0);
         const double mine = m_speeds[device];
         const double share = total > 0 && mine > 0 ? mine / total : 1.0 / m_speeds.size();
-        units = std::max<uint64_t>(m_min_units, uint64_t(std::ceil(0.5 * share * double(left))));
+        units = std::max<uint64_t>(m_min_units,
+                                   uint64_t(std::ceil(share * double(left) / m_divisor)));
         units = std::min(units, left);
         const double fastest = *std::max_element(m_speeds.begin(), m_speeds.end());
         if (total > 0 && mine > 0 && mine < fastest) {

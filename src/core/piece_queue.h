@@ -33,6 +33,8 @@ class PieceQueue {
     uint64_t m_min_units;
     uint64_t m_fixed_units;
     std::vector<double> m_speeds;
+    /// A piece is this device's share of what is left over this (LUCENT_PIECE_DIVISOR).
+    double m_divisor = 2.0;
     std::mutex m_mutex;
     uint64_t m_next = 0;  // first unit not handed out
 };

@@ -21,6 +21,10 @@ namespace lucent::cuda {
 namespace {
 
 constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
+/// Pieces of a multi-device launch queued on a GPU at once, each on its own stream: 4, the
+/// best of 4 and 8 on two H200s (docs/multi-device.md); LUCENT_GPU_PIECES_IN_FLIGHT sets
+/// 1 to kMaxPiecesInFlight, for experiments.
+constexpr unsigned kPiecesInFlight = 4, kMaxPiecesInFlight = 8;
 
 /// How the megakernel is launched: the share of the SM's on-chip memory given to shared
 /// memory (the rest is L1) and the persistent grid that share lets run at once.
@@ -74,7 +78,9 @@ class CudaBackend final : public core::Backend {
         check(d.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         // Its own stream: two devices on one GPU (a GPU listed twice) run side by side. A
         // blocking stream: the synchronous uploads on the default stream come before kernels.
-        // Two: a piece queued behind another starts on the SMs the other's tail frees.
+        // Several: a piece queued behind another starts on the SMs the other's tail frees.
+        if (const char* n = std::getenv("LUCENT_GPU_PIECES_IN_FLIGHT"))
+            m_in_flight = std::clamp(unsigned(std::atoi(n)), 1u, kMaxPiecesInFlight);
         for (CUstream& s : m_streams) check(d.cuStreamCreate(&s, CU_STREAM_DEFAULT), "cuStreamCreate");
         for (CUevent& e : m_piece_done) check(d.cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate");
         check(d.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
@@ -119,7 +125,7 @@ class CudaBackend final : public core::Backend {
         p.launch_count = spec.count();
         p.device_slots = unsigned(spec.device_keys.size());
         for (size_t i = 0; i < spec.device_keys.size(); ++i) p.device_keys[i] = spec.device_keys[i];
-        m_counters.alloc(2 * sizeof(unsigned long long));  // one per stream
+        m_counters.alloc(m_in_flight * sizeof(unsigned long long));  // one per stream
         m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
         m_exceptions.fill(0);
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
@@ -136,15 +142,17 @@ class CudaBackend final : public core::Backend {
         m_pieces = 0;
         m_indices = 0;
         check(m_driver.cuEventRecord(m_start, m_streams[0]), "cuEventRecord");
-        check(m_driver.cuStreamWaitEvent(m_streams[1], m_start, 0), "cuStreamWaitEvent");
+        for (unsigned i = 1; i < m_in_flight; ++i)
+            check(m_driver.cuStreamWaitEvent(m_streams[i], m_start, 0), "cuStreamWaitEvent");
     }
 
     void run_piece(core::LaunchPiece piece) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
-        // Pieces alternate between the two streams, each with its counter: the counter
-        // reset, the kernel over the piece, its event. Then wait for the piece before, so
-        // one piece is queued while one runs, and the queued one fills the running one's tail.
-        const unsigned slot = m_pieces % 2;
+        // Pieces take turns on the streams, each with its counter: the counter reset, the
+        // kernel over the piece, its event. Then wait for the oldest piece in flight, so the
+        // pieces queued behind a running one fill the SMs its tail leaves idle (a few warps
+        // on costly tiles, such as IGI's mirror pixels, can outlast a piece's other work).
+        const unsigned slot = m_pieces % m_in_flight;
         m_indices += piece.last - piece.first;
         CUstream stream = m_streams[slot];
         const CUdeviceptr counter = m_counters.ptr() + slot * sizeof(unsigned long long);
@@ -156,17 +164,20 @@ class CudaBackend final : public core::Backend {
                                       stream, args, nullptr),
               "launch the megakernel");
         check(m_driver.cuEventRecord(m_piece_done[slot], stream), "cuEventRecord");
-        if (m_pieces > 0)
-            check(m_driver.cuEventSynchronize(m_piece_done[(m_pieces - 1) % 2]),
+        if (m_pieces + 1 >= m_in_flight)
+            check(m_driver.cuEventSynchronize(
+                      m_piece_done[(m_pieces + 1 - m_in_flight) % m_in_flight]),
                   "run the megakernel");
         ++m_pieces;
     }
 
     void end_launch(LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
-        // Stop after both streams' pieces.
-        check(m_driver.cuEventRecord(m_piece_done[1], m_streams[1]), "cuEventRecord");
-        check(m_driver.cuStreamWaitEvent(m_streams[0], m_piece_done[1], 0), "cuStreamWaitEvent");
+        // Stop after every stream's pieces.
+        for (unsigned i = 1; i < m_in_flight; ++i) {
+            check(m_driver.cuEventRecord(m_piece_done[i], m_streams[i]), "cuEventRecord");
+            check(m_driver.cuStreamWaitEvent(m_streams[0], m_piece_done[i], 0), "cuStreamWaitEvent");
+        }
         check(m_driver.cuEventRecord(m_stop, m_streams[0]), "cuEventRecord");
         check(m_driver.cuStreamSynchronize(m_streams[0]), "run the megakernel");
         float kernel_ms = 0;
@@ -315,8 +326,9 @@ class CudaBackend final : public core::Backend {
     const DriverApi& m_driver;
     int m_ordinal = 0;
     CUdevice m_device = 0;
-    CUstream m_streams[2] = {nullptr, nullptr};
-    CUevent m_piece_done[2] = {nullptr, nullptr};
+    CUstream m_streams[kMaxPiecesInFlight] = {};
+    CUevent m_piece_done[kMaxPiecesInFlight] = {};
+    unsigned m_in_flight = kPiecesInFlight;
     unsigned m_pieces = 0;   // of the current launch
     uint64_t m_indices = 0;  // launch indices in them
     uint3 m_size{1, 1, 1};
