@@ -28,6 +28,22 @@ struct LaunchPiece {
     uint64_t first = 0, last = 0;
 };
 
+/// GPUs that share one tile counter in device memory (peer atomics over NVLink): each runs
+/// the whole launch as one kernel, taking 32-index tiles from the shared counter as a
+/// single GPU's threads do, so no piece ever waits for another's last tile; then each copies
+/// in the tiles the others ran.
+class SharedTileQueue {
+  public:
+    virtual ~SharedTileQueue() = default;
+    /// After every device's begin_launch: starts the launch on every device.
+    virtual void run(const LaunchSpec& spec) = 0;
+    /// After every device's end_launch: each device gathers the others' tiles of `written`;
+    /// `indices[d]` gets the launch indices device d ran.
+    virtual void gather(const LaunchSpec& spec,
+                        const std::vector<std::shared_ptr<const Buffer>>& written,
+                        std::vector<uint64_t>& indices) = 0;
+};
+
 class Backend {
   public:
     virtual ~Backend() = default;
@@ -60,6 +76,12 @@ class Backend {
     virtual void download_range(const Buffer& /*buffer*/, size_t /*offset*/, size_t /*bytes*/) {}
     /// Readies copies from this device to `peer` (GPUs: peer access where the pair allows).
     virtual void connect(Backend& /*peer*/) {}
+    /// A tile queue shared by `devices` (this one first, all connected), or null where they
+    /// cannot share one (a CPU among them, two GPUs without peer atomics).
+    virtual std::unique_ptr<SharedTileQueue> share_tile_queue(
+        const std::vector<Backend*>& /*devices*/) {
+        return nullptr;
+    }
     /// This device's copy → `target`'s copy (a peer copy between GPUs).
     virtual void copy_range_to(Backend& target, const Buffer& buffer, size_t offset,
                                size_t bytes);

@@ -73,6 +73,10 @@ class MultiDeviceBackend final : public Backend {
         for (auto& a : m_devices)
             for (auto& b : m_devices)
                 if (a != b) a->connect(*b);
+        std::vector<Backend*> all;
+        for (auto& d : m_devices) all.push_back(d.get());
+        if (all.size() > 1 && !std::getenv("LUCENT_NO_SHARED_TILE_QUEUE"))
+            m_tile_queue = m_devices[0]->share_tile_queue(all);
     }
 
     std::string name() const override {
@@ -104,6 +108,10 @@ class MultiDeviceBackend final : public Backend {
         std::vector<LaunchReport> reports(n);
         std::vector<std::vector<LaunchPiece>> pieces(n);
         std::vector<double> busy(n, 0.0);
+        if (split && m_tile_queue) {
+            run_with_shared_tiles(scene, spec, shaped, reports, busy, report);
+            return;
+        }
         run_on_devices([&](unsigned d) {
             m_devices[d]->begin_launch(scene, spec, reports[d]);
             const auto t0 = Clock::now();
@@ -125,15 +133,7 @@ class MultiDeviceBackend final : public Backend {
         exchange(shaped, other, pieces);
         report.exchange_ms = ms_between(t_exchange, Clock::now());
         merge_reports(reports, pieces, busy, spec, report);
-        if (m_trace) {
-            std::fprintf(stderr, "multi-device: entry %u, %llu indices, %s, exchange %.3f ms:",
-                         spec.entry, (unsigned long long)spec.count(), split ? "split" : "whole",
-                         report.exchange_ms);
-            for (const auto& d : report.devices)
-                std::fprintf(stderr, " [%s %u pieces %llu indices %.3f ms]", d.device.c_str(),
-                             d.pieces, (unsigned long long)d.indices, d.busy_ms);
-            std::fprintf(stderr, "\n");
-        }
+        trace(spec, split ? "pieces" : "whole", report);
         if (split) {
             // Each device's speed on this entry and size, for the next launch's pieces.
             for (unsigned d = 0; d < n; ++d) {
@@ -164,6 +164,49 @@ class MultiDeviceBackend final : public Backend {
     void end_launch(LaunchReport&) override {}
 
   private:
+    /// GPUs sharing one tile counter: each runs the whole launch, taking tiles as the
+    /// threads of one GPU do; then each gathers the tiles the others ran.
+    void run_with_shared_tiles(const CompiledScene& scene, const LaunchSpec& spec,
+                               const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                               std::vector<LaunchReport>& reports, std::vector<double>& busy,
+                               LaunchReport& report) {
+        const unsigned n = unsigned(m_devices.size());
+        const auto t_begin = Clock::now();
+        run_on_devices([&](unsigned d) { m_devices[d]->begin_launch(scene, spec, reports[d]); });
+        const auto t0 = Clock::now();
+        m_tile_queue->run(spec);
+        run_on_devices([&](unsigned d) {
+            m_devices[d]->end_launch(reports[d]);
+            busy[d] = ms_between(t0, Clock::now());
+        });
+        const auto t_exchange = Clock::now();
+        std::vector<uint64_t> indices;
+        m_tile_queue->gather(spec, shaped, indices);
+        report.exchange_ms = ms_between(t_exchange, Clock::now());
+        remember_host_stale(shaped, {});
+        // The report lists tiles as pieces: each device's share of the 32-index tiles.
+        std::vector<std::vector<LaunchPiece>> pieces(n);
+        merge_reports(reports, pieces, busy, spec, report);
+        for (unsigned d = 0; d < n; ++d) {
+            report.devices[d].indices = indices[d];
+            report.devices[d].pieces = unsigned((indices[d] + 31) / 32);
+        }
+        if (m_trace)
+            std::fprintf(stderr, "multi-device: shared tiles: begin %.3f ms, run %.3f ms\n",
+                         ms_between(t_begin, t0), ms_between(t0, t_exchange));
+        trace(spec, "shared tiles", report);
+    }
+
+    void trace(const LaunchSpec& spec, const char* how, const LaunchReport& report) const {
+        if (!m_trace) return;
+        std::fprintf(stderr, "multi-device: entry %u, %llu indices, %s, exchange %.3f ms:",
+                     spec.entry, (unsigned long long)spec.count(), how, report.exchange_ms);
+        for (const auto& d : report.devices)
+            std::fprintf(stderr, " [%s %u pieces %llu indices %.3f ms]", d.device.c_str(),
+                         d.pieces, (unsigned long long)d.indices, d.busy_ms);
+        std::fprintf(stderr, "\n");
+    }
+
     /// Runs job(d) for every device d at once, one thread each; rethrows the first error.
     template <class Job>
     void run_on_devices(const Job& job) {
@@ -278,6 +321,7 @@ class MultiDeviceBackend final : public Backend {
     uint64_t m_generation = 0;
     std::map<std::pair<unsigned, uint64_t>, std::vector<double>> m_speeds;  // by entry, count
     std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
+    std::unique_ptr<SharedTileQueue> m_tile_queue;  // GPUs with peer atomics; else null
     const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;  // a line per launch
 };
 

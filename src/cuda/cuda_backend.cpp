@@ -159,7 +159,9 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuMemsetD32Async(counter, 0, 2, stream), "reset the work counter");
         unsigned long long first = piece.first, last = piece.last;
         void* counter_arg = reinterpret_cast<void*>(counter);
-        void* args[] = {&first, &last, &counter_arg};
+        void* no_owners = nullptr;
+        unsigned device = 0;
+        void* args[] = {&first, &last, &counter_arg, &no_owners, &device};
         check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
                                       stream, args, nullptr),
               "launch the megakernel");
@@ -170,6 +172,46 @@ class CudaBackend final : public core::Backend {
                   "run the megakernel");
         ++m_pieces;
     }
+
+    /// The whole launch as one kernel taking tiles from a counter other GPUs share.
+    void run_shared(uint64_t count, CUdeviceptr counter, CUdeviceptr owners, unsigned device) {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        m_indices = count;
+        ++m_pieces;
+        unsigned long long first = 0, last = count;
+        void* counter_arg = reinterpret_cast<void*>(counter);
+        void* owners_arg = reinterpret_cast<void*>(owners);
+        void* args[] = {&first, &last, &counter_arg, &owners_arg, &device};
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+                                      m_streams[0], args, nullptr),
+              "launch the megakernel");
+    }
+
+    /// Copies into this GPU's copy of `buffer` the tiles other GPUs ran (queued; sync()).
+    void gather_tiles(const Buffer& buffer, CUdeviceptr owners, unsigned device, uint64_t tiles,
+                      const gpu::DeviceCopies& copies, uint3 size) {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        unsigned long long tile_count = tiles;
+        unsigned element_bytes = unsigned(buffer.element().size);
+        void* owners_arg = reinterpret_cast<void*>(owners);
+        gpu::DeviceCopies by_value = copies;
+        void* args[] = {&owners_arg, &device, &tile_count, &by_value, &element_bytes, &size};
+        const unsigned blocks = unsigned(std::min<uint64_t>((tiles * 32 + 255) / 256, 4096));
+        check(m_driver.cuLaunchKernel(m_gather, std::max(1u, blocks), 1, 1, 256, 1, 1, 0,
+                                      m_streams[0], args, nullptr),
+              "gather the tiles of other GPUs");
+    }
+    void sync() {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        check(m_driver.cuStreamSynchronize(m_streams[0]), "gather the tiles of other GPUs");
+    }
+    CUdeviceptr copy_of(const Buffer& buffer) const { return mirror_of(buffer); }
+    CUdevice device() const { return m_device; }
+    CUcontext context() const { return m_context; }
+    const DriverApi& driver_api() const { return m_driver; }
+
+    std::unique_ptr<core::SharedTileQueue> share_tile_queue(
+        const std::vector<core::Backend*>& devices) override;
 
     void end_launch(LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
@@ -262,6 +304,8 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuModuleLoadData(&m_module, compiled.cubin.data()), "load the megakernel");
         check(m_driver.cuModuleGetFunction(&m_kernel, m_module, "lucent_megakernel"),
               "find lucent_megakernel");
+        check(m_driver.cuModuleGetFunction(&m_gather, m_module, "lucent_gather_tiles"),
+              "find lucent_gather_tiles");
         size_t bytes = 0;
         check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
                                          "_ZN6lucent3gpu6paramsE"),
@@ -336,7 +380,7 @@ class CudaBackend final : public core::Backend {
     std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
     CUcontext m_context = nullptr;
     CUmodule m_module = nullptr;
-    CUfunction m_kernel = nullptr;
+    CUfunction m_kernel = nullptr, m_gather = nullptr;
     CUdeviceptr m_params_global = 0;
     std::string m_device_name, m_source;
     int m_sm = 0, m_sm_count = 0;
@@ -349,6 +393,92 @@ class CudaBackend final : public core::Backend {
     DeviceBuffer m_counters, m_exceptions, m_scratch;
     CUevent m_start = nullptr, m_stop = nullptr;
 };
+
+/// The tile counter and the tile owners live on the first GPU; the others reach them by
+/// peer access (the same address works on every GPU of the group).
+class GpuSharedTileQueue final : public core::SharedTileQueue {
+  public:
+    explicit GpuSharedTileQueue(std::vector<CudaBackend*> gpus) : m_gpus(std::move(gpus)) {}
+    ~GpuSharedTileQueue() override {
+        m_gpus[0]->driver_api().cuCtxSetCurrent(m_gpus[0]->context());  // frees on the first GPU
+        m_counter.reset();
+        m_owners.reset();
+    }
+
+    void run(const core::LaunchSpec& spec) override {
+        CudaBackend& first = *m_gpus[0];
+        check(first.driver_api().cuCtxSetCurrent(first.context()), "cuCtxSetCurrent");
+        const uint64_t tiles = tile_count(spec);
+        if (m_owners.size() < tiles) m_owners.alloc(tiles);
+        m_counter.alloc(sizeof(unsigned long long));
+        m_counter.fill(0);  // synchronous: done before any GPU starts
+        for (unsigned d = 0; d < m_gpus.size(); ++d)
+            m_gpus[d]->run_shared(spec.count(), m_counter.ptr(), m_owners.ptr(), d);
+    }
+
+    void gather(const core::LaunchSpec& spec,
+                const std::vector<std::shared_ptr<const Buffer>>& written,
+                std::vector<uint64_t>& indices) override {
+        const uint64_t tiles = tile_count(spec);
+        for (const auto& buffer : written) {
+            gpu::DeviceCopies copies{};
+            for (unsigned d = 0; d < m_gpus.size(); ++d) copies.base[d] = m_gpus[d]->copy_of(*buffer);
+            for (unsigned d = 0; d < m_gpus.size(); ++d)
+                m_gpus[d]->gather_tiles(*buffer, m_owners.ptr(), d, tiles, copies, spec.size);
+        }
+        for (CudaBackend* gpu : m_gpus) gpu->sync();
+        // Who ran what, for the report.
+        CudaBackend& first = *m_gpus[0];
+        check(first.driver_api().cuCtxSetCurrent(first.context()), "cuCtxSetCurrent");
+        std::vector<unsigned char> owners(tiles);
+        m_owners.download(owners.data(), tiles);
+        indices.assign(m_gpus.size(), 0);
+        const uint3 s = spec.size;
+        const uint64_t rows = uint64_t(s.y) * s.z, tiles_x = (s.x + 7) / 8;
+        for (uint64_t t = 0; t < tiles; ++t) {
+            uint64_t n;
+            if (spec.by_rows())
+                n = std::min<uint64_t>(8, s.x - (t % tiles_x) * 8) *
+                    std::min<uint64_t>(4, rows - (t / tiles_x) * 4);
+            else
+                n = std::min<uint64_t>(32, spec.count() - t * 32);
+            if (owners[t] < indices.size()) indices[owners[t]] += n;
+        }
+    }
+
+  private:
+    /// The megakernel's tiles: 8x4 over the rows of a launch of several rows, else 32.
+    static uint64_t tile_count(const core::LaunchSpec& spec) {
+        if (!spec.by_rows()) return (spec.count() + 31) / 32;
+        const uint64_t rows = uint64_t(spec.size.y) * spec.size.z;
+        return ((spec.size.x + 7) / 8) * ((rows + 3) / 4);
+    }
+
+    std::vector<CudaBackend*> m_gpus;
+    DeviceBuffer m_counter, m_owners;
+};
+
+std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
+    const std::vector<core::Backend*>& devices) {
+    std::vector<CudaBackend*> gpus;
+    for (core::Backend* b : devices) {
+        auto* gpu = dynamic_cast<CudaBackend*>(b);
+        if (!gpu) return nullptr;  // a CPU cannot take tiles from a counter in GPU memory
+        gpus.push_back(gpu);
+    }
+    // Every pair of distinct GPUs needs peer atomics (NVLink).
+    for (CudaBackend* a : gpus)
+        for (CudaBackend* b : gpus) {
+            if (a->device() == b->device()) continue;
+            int access = 0, atomics = 0;
+            m_driver.cuDeviceCanAccessPeer(&access, a->device(), b->device());
+            m_driver.cuDeviceGetP2PAttribute(
+                &atomics, CU_DEVICE_P2P_ATTRIBUTE_NATIVE_ATOMIC_SUPPORTED, a->device(), b->device());
+            if (!access || !atomics) return nullptr;
+        }
+    if (gpus.empty() || gpus[0] != this) return nullptr;
+    return std::make_unique<GpuSharedTileQueue>(std::move(gpus));
+}
 
 }  // namespace
 

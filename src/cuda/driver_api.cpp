@@ -72,6 +72,7 @@ Loaded load() {
     LUCENT_LOAD(cuMemcpyPeer, "cuMemcpyPeer")
     LUCENT_LOAD(cuDeviceCanAccessPeer, "cuDeviceCanAccessPeer")
     LUCENT_LOAD(cuCtxEnablePeerAccess, "cuCtxEnablePeerAccess")
+    LUCENT_LOAD(cuDeviceGetP2PAttribute, "cuDeviceGetP2PAttribute")
 #undef LUCENT_LOAD
     if (missing) return l;
     if (CUresult r = l.api.cuInit(0); r != CUDA_SUCCESS) {

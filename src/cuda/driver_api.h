@@ -48,6 +48,7 @@ struct DriverApi {
     LUCENT_CU_FN(cuMemcpyPeer)
     LUCENT_CU_FN(cuDeviceCanAccessPeer)
     LUCENT_CU_FN(cuCtxEnablePeerAccess)
+    LUCENT_CU_FN(cuDeviceGetP2PAttribute)
 #undef LUCENT_CU_FN
 };
 

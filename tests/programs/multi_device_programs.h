@@ -11,8 +11,9 @@ struct PatternRecord {
     Handle top;
     BufferView<float4> image;  // launch-shaped (1D, 2D or 3D like the launch)
     unsigned dims;             // of the launch: 1, 2 or 3
+    unsigned repeats;          // traces per index (more: a longer launch)
 };
-LUCENT_RECORD(PatternRecord, top, image, dims)
+LUCENT_RECORD(PatternRecord, top, image, dims, repeats)
 /// Traces a ray through each launch index at a sphere; stores the hit t, the launch index
 /// and a hash, so every element depends on the index that wrote it.
 LUCENT_RAY_GENERATION(md_pattern, PatternRecord) {
@@ -20,7 +21,10 @@ LUCENT_RAY_GENERATION(md_pattern, PatternRecord) {
     const float u = (float(i.x) + 0.5f) / float(n.x) * 2.0f - 1.0f;
     const float v = (float(i.y) + 0.5f) / float(n.y) * 2.0f - 1.0f;
     TestPayload p = make_test_payload();
-    trace(rec.top, make_ray(make_float3(u, v, -5.0f), make_float3(0, 0, 1), 0, 1e-4f), p);
+    for (unsigned r = 0; r < rec.repeats; ++r) {
+        p = make_test_payload();
+        trace(rec.top, make_ray(make_float3(u, v, -5.0f), make_float3(0, 0, 1), 0, 1e-4f), p);
+    }
     const unsigned hash = tea<4>(make_uint2(i.x, i.y * 4096u + i.z), zafar_tea_key()).x;
     const float4 value = make_float4(p.hit > 0 ? p.t : -1.0f, float(i.x), float(i.y + 1000u * i.z),
                                      float(hash >> 8));

@@ -117,4 +117,9 @@ struct LaunchParams {
 
 constexpr unsigned kGpuScratchBytes = 256;
 
+/// Base address of a buffer's copy on each GPU sharing a tile queue (gather.cuh).
+struct DeviceCopies {
+    unsigned long long base[kGpuMaxDeviceSlots];
+};
+
 }  // namespace lucent::gpu

@@ -499,10 +499,12 @@ LUCENT_HD bool report_intersection(unsigned material) {
 /// worth at a time (Aila and Laine 2009), and run the ray-generation program on each. One
 /// kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole rows
 /// (row = z * height + y) when the launch has more than one, counted by its own `counter`
-/// (two pieces may run at once, the second filling the SMs the first's tail leaves idle).
+/// (pieces may run at once, one filling the SMs another's tail leaves idle). Several GPUs
+/// may share one counter (peer atomics): each then writes `device` into `owners[tile]` for
+/// the tiles it takes, so each can gather the others' tiles (gather.cuh).
 extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
     lucent_megakernel(unsigned long long piece_first, unsigned long long piece_last,
-                      unsigned long long* counter) {
+                      unsigned long long* counter, unsigned char* owners, unsigned device) {
     using namespace lucent;
     using namespace lucent::gpu;
     ThreadState& s = self();
@@ -522,7 +524,10 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         tiled ? 32ull * tiles_x * ((end_row - first_row + 3) / 4) : piece_last - piece_first;
     for (;;) {
         unsigned long long base = 0;
-        if (lane == 0) base = atomicAdd(counter, 32ull);
+        if (lane == 0) {
+            base = atomicAdd(counter, 32ull);
+            if (owners && base < work) owners[base / 32] = (unsigned char)device;
+        }
         base = __shfl_sync(0xffffffffu, base, 0);
         if (base >= work) return;
         unsigned x, y, z;
@@ -573,3 +578,5 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         }
     }
 }
+
+#include "lucent_gpu/gather.cuh"
