@@ -403,6 +403,10 @@ class GpuSharedTileQueue final : public core::SharedTileQueue {
         m_gpus[0]->driver_api().cuCtxSetCurrent(m_gpus[0]->context());  // frees on the first GPU
         m_counter.reset();
         m_owners.reset();
+        for (unsigned d = 1; d < m_local_owners.size(); ++d) {
+            m_gpus[d]->driver_api().cuCtxSetCurrent(m_gpus[d]->context());
+            m_local_owners[d].reset();
+        }
     }
 
     void run(const core::LaunchSpec& spec) override {
@@ -420,11 +424,23 @@ class GpuSharedTileQueue final : public core::SharedTileQueue {
                 const std::vector<std::shared_ptr<const Buffer>>& written,
                 std::vector<uint64_t>& indices) override {
         const uint64_t tiles = tile_count(spec);
+        // Each GPU reads the owners from its own memory: one peer copy, not a peer read per
+        // element.
+        m_local_owners.resize(m_gpus.size());
+        for (unsigned d = 1; d < m_gpus.size() && !written.empty(); ++d) {
+            CudaBackend& gpu = *m_gpus[d];
+            check(gpu.driver_api().cuCtxSetCurrent(gpu.context()), "cuCtxSetCurrent");
+            if (m_local_owners[d].size() < tiles) m_local_owners[d].alloc(tiles);
+            check(gpu.driver_api().cuMemcpyPeer(m_local_owners[d].ptr(), gpu.context(),
+                                                m_owners.ptr(), m_gpus[0]->context(), tiles),
+                  "copy the tile owners between GPUs");
+        }
         for (const auto& buffer : written) {
             gpu::DeviceCopies copies{};
             for (unsigned d = 0; d < m_gpus.size(); ++d) copies.base[d] = m_gpus[d]->copy_of(*buffer);
             for (unsigned d = 0; d < m_gpus.size(); ++d)
-                m_gpus[d]->gather_tiles(*buffer, m_owners.ptr(), d, tiles, copies, spec.size);
+                m_gpus[d]->gather_tiles(*buffer, d ? m_local_owners[d].ptr() : m_owners.ptr(), d,
+                                        tiles, copies, spec.size);
         }
         for (CudaBackend* gpu : m_gpus) gpu->sync();
         // Who ran what, for the report.
@@ -455,7 +471,8 @@ class GpuSharedTileQueue final : public core::SharedTileQueue {
     }
 
     std::vector<CudaBackend*> m_gpus;
-    DeviceBuffer m_counter, m_owners;
+    DeviceBuffer m_counter, m_owners;        // on the first GPU
+    std::vector<DeviceBuffer> m_local_owners;  // the owners copied to each other GPU
 };
 
 std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
@@ -466,10 +483,13 @@ std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
         if (!gpu) return nullptr;  // a CPU cannot take tiles from a counter in GPU memory
         gpus.push_back(gpu);
     }
-    // Every pair of distinct GPUs needs peer atomics (NVLink).
+    // Every pair of GPUs needs peer atomics (NVLink). A GPU listed twice gains nothing from
+    // sharing: its first kernel would fill it and take every tile; its two devices take
+    // pieces from the host queue instead, and both run.
     for (CudaBackend* a : gpus)
         for (CudaBackend* b : gpus) {
-            if (a->device() == b->device()) continue;
+            if (a == b) continue;
+            if (a->device() == b->device()) return nullptr;
             int access = 0, atomics = 0;
             m_driver.cuDeviceCanAccessPeer(&access, a->device(), b->device());
             m_driver.cuDeviceGetP2PAttribute(
