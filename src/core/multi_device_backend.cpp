@@ -62,6 +62,22 @@ bool launch_shaped(const Buffer& b, uint3 size) {
     return b.dimensionality() == dims && s.x == size.x && s.y == size.y && s.z == size.z;
 }
 
+/// Per entry point and launch size: is spreading the launch worth its exchange? A small
+/// launch (IGI's passes at 1/4 resolution) can run faster whole on one device. Launch 1
+/// is spread (and warms up), launch 2 runs whole, launch 3 is spread; from then on, the
+/// faster of launches 2 and 3, each timed with its exchange.
+struct SplitChoice {
+    unsigned launches = 0;
+    double ms[2] = {0, 0};  // [whole, spread]
+    int choice = -1;
+    bool next_spread() const { return choice >= 0 ? choice == 1 : launches != 1; }
+    void record(bool spread, double launch_ms) {
+        if (choice >= 0) return;
+        if (launches >= 1) ms[spread] = launch_ms;
+        if (++launches == 3) choice = ms[1] < ms[0] ? 1 : 0;
+    }
+};
+
 class MultiDeviceBackend final : public Backend {
   public:
     MultiDeviceBackend(std::vector<std::unique_ptr<Backend>> devices,
@@ -102,21 +118,38 @@ class MultiDeviceBackend final : public Backend {
         std::vector<double>& speeds = m_speeds[{spec.entry, spec.count()}];
         speeds.resize(n, 0.0);
         PieceQueue queue(spec, speeds, m_piece_rows);
-        const bool split = n > 1 && other.empty() && queue.units() >= 2 * n * queue.min_units();
+        const bool can_split =
+            n > 1 && other.empty() && queue.units() >= 2 * n * queue.min_units();
+        // Fixed pieces (tests) always spread; else measured (SplitChoice).
+        SplitChoice& choice = m_split_choice[{spec.entry, spec.count()}];
+        const bool split = can_split && (m_piece_rows > 0 || choice.next_spread());
         const unsigned whole_on = fastest(speeds);
+        const auto t0 = Clock::now();
+        if (split && m_tile_queue)
+            run_with_shared_tiles(scene, spec, shaped, report);
+        else
+            run_in_pieces(scene, spec, shaped, other, split ? &queue : nullptr, whole_on, speeds,
+                          report);
+        if (can_split && m_piece_rows == 0) choice.record(split, ms_between(t0, Clock::now()));
+    }
 
+  private:
+    /// Devices take pieces from `queue` (or, without one, device `whole_on` runs the whole
+    /// launch); then every device's copy receives the pieces the others ran.
+    void run_in_pieces(const CompiledScene& scene, const LaunchSpec& spec,
+                       const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                       const std::vector<std::shared_ptr<const Buffer>>& other, PieceQueue* queue,
+                       unsigned whole_on, std::vector<double>& speeds, LaunchReport& report) {
+        const unsigned n = unsigned(m_devices.size());
+        const bool split = queue != nullptr;
         std::vector<LaunchReport> reports(n);
         std::vector<std::vector<LaunchPiece>> pieces(n);
         std::vector<double> busy(n, 0.0);
-        if (split && m_tile_queue) {
-            run_with_shared_tiles(scene, spec, shaped, reports, busy, report);
-            return;
-        }
         run_on_devices([&](unsigned d) {
             m_devices[d]->begin_launch(scene, spec, reports[d]);
             const auto t0 = Clock::now();
             if (split) {
-                while (auto piece = queue.take(d)) {
+                while (auto piece = queue->take(d)) {
                     m_devices[d]->run_piece(*piece);
                     pieces[d].push_back(*piece);
                 }
@@ -163,14 +196,14 @@ class MultiDeviceBackend final : public Backend {
     void run_piece(LaunchPiece) override {}
     void end_launch(LaunchReport&) override {}
 
-  private:
     /// GPUs sharing one tile counter: each runs the whole launch, taking tiles as the
     /// threads of one GPU do; then each gathers the tiles the others ran.
     void run_with_shared_tiles(const CompiledScene& scene, const LaunchSpec& spec,
                                const std::vector<std::shared_ptr<const Buffer>>& shaped,
-                               std::vector<LaunchReport>& reports, std::vector<double>& busy,
                                LaunchReport& report) {
         const unsigned n = unsigned(m_devices.size());
+        std::vector<LaunchReport> reports(n);
+        std::vector<double> busy(n, 0.0);
         const auto t_begin = Clock::now();
         run_on_devices([&](unsigned d) { m_devices[d]->begin_launch(scene, spec, reports[d]); });
         const auto t0 = Clock::now();
@@ -320,6 +353,7 @@ class MultiDeviceBackend final : public Backend {
     const CompiledScene* m_scene = nullptr;
     uint64_t m_generation = 0;
     std::map<std::pair<unsigned, uint64_t>, std::vector<double>> m_speeds;  // by entry, count
+    std::map<std::pair<unsigned, uint64_t>, SplitChoice> m_split_choice;    // by entry, count
     std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
     std::unique_ptr<SharedTileQueue> m_tile_queue;  // GPUs with peer atomics; else null
     const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;  // a line per launch
