@@ -185,6 +185,17 @@ TEST(MultiDevice, LaunchesReadWhatOtherDevicesWroteInTheLaunchBefore) {
     }
 }
 
+TEST(MultiDevice, LaunchesMeasuredSpreadAndWholeGiveTheOneDeviceImage) {
+    // Sized pieces (piece_rows 0): each entry point runs spread, then whole on one device
+    // (the others' copies fall behind and catch up when they next run), then spread.
+    for (const DeviceCase& c : device_cases()) {
+        SCOPED_TRACE(list_name(c.devices));
+        std::vector<std::vector<float>> refs;
+        for (const auto& r : c.references) refs.push_back(accumulate_and_blur(options_for(r)));
+        expect_matches(accumulate_and_blur(options_for(c.devices, 0)), refs, "spread and whole");
+    }
+}
+
 TEST(MultiDevice, ALaunchWritingABufferOfAnotherShapeRunsWholeOnOneDevice) {
     for (const DeviceCase& c : device_cases()) {
         SCOPED_TRACE(list_name(c.devices));

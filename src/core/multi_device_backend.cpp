@@ -29,15 +29,8 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
 /// The buffers a launch of `entry` may write: those not of type input that its
 /// ray-generation and exception programs, or any program a trace can reach, view through a
 /// BufferView<T> that is not BufferView<const T>.
-std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene& scene,
-                                                            unsigned entry) {
-    std::set<const Buffer*> seen;
-    std::vector<std::shared_ptr<const Buffer>> out;
-    auto add = [&](const CompiledProgram& p) {
-        for (const auto& b : p.writable_buffers)
-            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
-                out.push_back(b);
-    };
+template <class Fn>
+void for_each_program(const CompiledScene& scene, unsigned entry, const Fn& add) {
     add(scene.entries[entry].ray_generation);
     add(scene.entries[entry].exception);
     for (const CompiledProgram& p : scene.miss) add(p);
@@ -51,6 +44,30 @@ std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene&
             for (const CompiledProgram& p : m.any_hit) add(p);
         }
     }
+}
+
+std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene& scene,
+                                                            unsigned entry) {
+    std::set<const Buffer*> seen;
+    std::vector<std::shared_ptr<const Buffer>> out;
+    for_each_program(scene, entry, [&](const CompiledProgram& p) {
+        for (const auto& b : p.writable_buffers)
+            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
+                out.push_back(b);
+    });
+    return out;
+}
+
+/// Every buffer a launch of `entry` may read or write.
+std::vector<std::shared_ptr<const Buffer>> viewed_buffers(const CompiledScene& scene,
+                                                          unsigned entry) {
+    std::set<const Buffer*> seen;
+    std::vector<std::shared_ptr<const Buffer>> out;
+    for_each_program(scene, entry, [&](const CompiledProgram& p) {
+        for (const auto& b : p.buffers)
+            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
+                out.push_back(b);
+    });
     return out;
 }
 
@@ -106,7 +123,10 @@ class MultiDeviceBackend final : public Backend {
     void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report) override {
         const unsigned n = unsigned(m_devices.size());
         // What a new compile drops from the devices must reach the host first.
-        if (&scene != m_scene || scene.generation != m_generation) flush_host_copies();
+        if (&scene != m_scene || scene.generation != m_generation) {
+            bring_up_to_date(all_devices(), m_stale_list());
+            flush_host_copies();
+        }
         m_scene = &scene;
         m_generation = scene.generation;
 
@@ -124,6 +144,8 @@ class MultiDeviceBackend final : public Backend {
         SplitChoice& choice = m_split_choice[{spec.entry, spec.count()}];
         const bool split = can_split && (m_piece_rows > 0 || choice.next_spread());
         const unsigned whole_on = fastest(speeds);
+        bring_up_to_date(split ? all_devices() : std::vector<unsigned>{whole_on},
+                         viewed_buffers(scene, spec.entry));
         const auto t0 = Clock::now();
         if (split && m_tile_queue)
             run_with_shared_tiles(scene, spec, shaped, report);
@@ -146,6 +168,7 @@ class MultiDeviceBackend final : public Backend {
         std::vector<std::vector<LaunchPiece>> pieces(n);
         std::vector<double> busy(n, 0.0);
         run_on_devices([&](unsigned d) {
+            if (!split && d != whole_on) return;  // it catches up when it next runs
             m_devices[d]->begin_launch(scene, spec, reports[d]);
             const auto t0 = Clock::now();
             if (split) {
@@ -163,7 +186,10 @@ class MultiDeviceBackend final : public Backend {
         });
 
         const auto t_exchange = Clock::now();
-        exchange(shaped, other, pieces);
+        if (split)
+            exchange(shaped, other, pieces);
+        else
+            mark_behind(whole_on, shaped, other);
         report.exchange_ms = ms_between(t_exchange, Clock::now());
         merge_reports(reports, pieces, busy, spec, report);
         trace(spec, split ? "pieces" : "whole", report);
@@ -181,7 +207,13 @@ class MultiDeviceBackend final : public Backend {
 
     void fetch(const Buffer& buffer) override {
         if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
-        // Every device's copy is complete after a launch: any non-host one will do.
+        auto stale = m_behind.find(&buffer);
+        if (stale != m_behind.end() && stale->second.version == buffer.version()) {
+            m_devices[stale->second.owner]->download_range(buffer, 0,
+                                                           buffer.count() * buffer.element().size);
+            return;
+        }
+        // Every device's copy is complete after a spread launch: any non-host one will do.
         for (auto& device : m_devices)
             if (!device->uses_host_storage()) {
                 device->download_range(buffer, 0, buffer.count() * buffer.element().size);
@@ -240,6 +272,64 @@ class MultiDeviceBackend final : public Backend {
         std::fprintf(stderr, "\n");
     }
 
+    std::vector<unsigned> all_devices() const {
+        std::vector<unsigned> all(m_devices.size());
+        for (unsigned d = 0; d < all.size(); ++d) all[d] = d;
+        return all;
+    }
+    std::vector<std::shared_ptr<const Buffer>> m_stale_list() const {
+        std::vector<std::shared_ptr<const Buffer>> list;
+        for (const auto& [raw, s] : m_behind) list.push_back(s.buffer);
+        return list;
+    }
+    bool same_copy(unsigned a, unsigned b) const {
+        return a == b || (m_devices[a]->uses_host_storage() && m_devices[b]->uses_host_storage());
+    }
+
+    /// A launch ran whole on `owner`: the others' copies of what it wrote are behind; each
+    /// catches up only when a launch it runs views the buffer (bring_up_to_date), so
+    /// launches that all run whole on one device copy nothing.
+    void mark_behind(unsigned owner, const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                     const std::vector<std::shared_ptr<const Buffer>>& other) {
+        const unsigned n = unsigned(m_devices.size());
+        bool host_current = false;
+        for (unsigned d = 0; d < n; ++d)
+            host_current = host_current || (same_copy(d, owner) && m_devices[d]->uses_host_storage());
+        for (const auto* list : {&shaped, &other})
+            for (const auto& b : *list) {
+                Behind s{b, owner, b->version(), std::vector<bool>(n, false)};
+                bool any = false;
+                for (unsigned d = 0; d < n; ++d) any = any || (s.devices[d] = !same_copy(d, owner));
+                if (any) m_behind[b.get()] = std::move(s);
+            }
+        if (n == 1) m_devices[0]->publish_outputs();
+        else if (!host_current) remember_host_stale(shaped, other);
+    }
+
+    /// Before `devices` run: their copies of `buffers` that a whole launch elsewhere left
+    /// behind receive the owner's copy. New host contents (a newer version) supersede.
+    void bring_up_to_date(const std::vector<unsigned>& devices,
+                          const std::vector<std::shared_ptr<const Buffer>>& buffers) {
+        for (const auto& b : buffers) {
+            auto found = m_behind.find(b.get());
+            if (found == m_behind.end()) continue;
+            Behind& s = found->second;
+            if (s.version != b->version()) {  // the host wrote it: every device uploads that
+                m_behind.erase(found);
+                continue;
+            }
+            for (unsigned d : devices) {
+                if (!s.devices[d]) continue;
+                m_devices[s.owner]->copy_range_to(*m_devices[d], *b, 0,
+                                                  b->count() * b->element().size);
+                for (unsigned e = 0; e < s.devices.size(); ++e)
+                    if (same_copy(e, d)) s.devices[e] = false;
+            }
+            if (std::none_of(s.devices.begin(), s.devices.end(), [](bool x) { return x; }))
+                m_behind.erase(b.get());
+        }
+    }
+
     /// Runs job(d) for every device d at once, one thread each; rethrows the first error.
     template <class Job>
     void run_on_devices(const Job& job) {
@@ -274,10 +364,6 @@ class MultiDeviceBackend final : public Backend {
         int host_receiver = -1;
         for (unsigned d = 0; d < n && host_receiver < 0; ++d)
             if (m_devices[d]->uses_host_storage()) host_receiver = int(d);
-        auto same_copy = [&](unsigned a, unsigned b) {
-            return a == b ||
-                   (m_devices[a]->uses_host_storage() && m_devices[b]->uses_host_storage());
-        };
         run_on_devices([&](unsigned d) {
             if (m_devices[d]->uses_host_storage() && int(d) != host_receiver) return;
             for (unsigned owner = 0; owner < n; ++owner) {
@@ -356,6 +442,13 @@ class MultiDeviceBackend final : public Backend {
     std::map<std::pair<unsigned, uint64_t>, SplitChoice> m_split_choice;    // by entry, count
     std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
     std::unique_ptr<SharedTileQueue> m_tile_queue;  // GPUs with peer atomics; else null
+    struct Behind {
+        std::shared_ptr<const Buffer> buffer;
+        unsigned owner = 0;         // the device whose copy is current
+        uint64_t version = 0;       // of the host contents then
+        std::vector<bool> devices;  // whose copies are behind
+    };
+    std::map<const Buffer*, Behind> m_behind;
     const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;  // a line per launch
 };
 
