@@ -124,8 +124,10 @@ class MultiDeviceBackend final : public Backend {
         const unsigned n = unsigned(m_devices.size());
         // What a new compile drops from the devices must reach the host first.
         if (&scene != m_scene || scene.generation != m_generation) {
-            bring_up_to_date(all_devices(), m_stale_list());
+            // A new compile may drop an owner's copy: the host's becomes the one to catch
+            // up from.
             flush_host_copies();
+            for (auto& [raw, s] : m_behind) s.owner = kHostCopy;
         }
         m_scene = &scene;
         m_generation = scene.generation;
@@ -144,14 +146,13 @@ class MultiDeviceBackend final : public Backend {
         SplitChoice& choice = m_split_choice[{spec.entry, spec.count()}];
         const bool split = can_split && (m_piece_rows > 0 || choice.next_spread());
         const unsigned whole_on = fastest(speeds);
-        bring_up_to_date(split ? all_devices() : std::vector<unsigned>{whole_on},
-                         viewed_buffers(scene, spec.entry));
+        const auto viewed = viewed_buffers(scene, spec.entry);
         const auto t0 = Clock::now();
         if (split && m_tile_queue)
-            run_with_shared_tiles(scene, spec, shaped, report);
+            run_with_shared_tiles(scene, spec, shaped, viewed, report);
         else
-            run_in_pieces(scene, spec, shaped, other, split ? &queue : nullptr, whole_on, speeds,
-                          report);
+            run_in_pieces(scene, spec, shaped, other, viewed, split ? &queue : nullptr, whole_on,
+                          speeds, report);
         if (can_split && m_piece_rows == 0) choice.record(split, ms_between(t0, Clock::now()));
     }
 
@@ -160,16 +161,24 @@ class MultiDeviceBackend final : public Backend {
     /// launch); then every device's copy receives the pieces the others ran.
     void run_in_pieces(const CompiledScene& scene, const LaunchSpec& spec,
                        const std::vector<std::shared_ptr<const Buffer>>& shaped,
-                       const std::vector<std::shared_ptr<const Buffer>>& other, PieceQueue* queue,
+                       const std::vector<std::shared_ptr<const Buffer>>& other,
+                       const std::vector<std::shared_ptr<const Buffer>>& viewed, PieceQueue* queue,
                        unsigned whole_on, std::vector<double>& speeds, LaunchReport& report) {
         const unsigned n = unsigned(m_devices.size());
         const bool split = queue != nullptr;
         std::vector<LaunchReport> reports(n);
         std::vector<std::vector<LaunchPiece>> pieces(n);
         std::vector<double> busy(n, 0.0);
+        // The devices that run: every one, or only `whole_on` (the others catch up when
+        // they next run).
+        auto runs = [&](unsigned d) { return split || d == whole_on; };
         run_on_devices([&](unsigned d) {
-            if (!split && d != whole_on) return;  // it catches up when it next runs
-            m_devices[d]->begin_launch(scene, spec, reports[d]);
+            if (runs(d)) m_devices[d]->begin_launch(scene, spec, reports[d]);
+        });
+        for (unsigned d = 0; d < n; ++d)
+            if (runs(d)) catch_up(d, viewed);
+        run_on_devices([&](unsigned d) {
+            if (!runs(d)) return;
             const auto t0 = Clock::now();
             if (split) {
                 while (auto piece = queue->take(d)) {
@@ -209,8 +218,9 @@ class MultiDeviceBackend final : public Backend {
         if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
         auto stale = m_behind.find(&buffer);
         if (stale != m_behind.end() && stale->second.version == buffer.version()) {
-            m_devices[stale->second.owner]->download_range(buffer, 0,
-                                                           buffer.count() * buffer.element().size);
+            if (stale->second.owner != kHostCopy)  // else the host copy is current
+                m_devices[unsigned(stale->second.owner)]->download_range(
+                    buffer, 0, buffer.count() * buffer.element().size);
             return;
         }
         // Every device's copy is complete after a spread launch: any non-host one will do.
@@ -232,12 +242,14 @@ class MultiDeviceBackend final : public Backend {
     /// threads of one GPU do; then each gathers the tiles the others ran.
     void run_with_shared_tiles(const CompiledScene& scene, const LaunchSpec& spec,
                                const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                               const std::vector<std::shared_ptr<const Buffer>>& viewed,
                                LaunchReport& report) {
         const unsigned n = unsigned(m_devices.size());
         std::vector<LaunchReport> reports(n);
         std::vector<double> busy(n, 0.0);
         const auto t_begin = Clock::now();
         run_on_devices([&](unsigned d) { m_devices[d]->begin_launch(scene, spec, reports[d]); });
+        for (unsigned d = 0; d < n; ++d) catch_up(d, viewed);
         const auto t0 = Clock::now();
         m_tile_queue->run(spec);
         run_on_devices([&](unsigned d) {
@@ -277,11 +289,6 @@ class MultiDeviceBackend final : public Backend {
         for (unsigned d = 0; d < all.size(); ++d) all[d] = d;
         return all;
     }
-    std::vector<std::shared_ptr<const Buffer>> m_stale_list() const {
-        std::vector<std::shared_ptr<const Buffer>> list;
-        for (const auto& [raw, s] : m_behind) list.push_back(s.buffer);
-        return list;
-    }
     bool same_copy(unsigned a, unsigned b) const {
         return a == b || (m_devices[a]->uses_host_storage() && m_devices[b]->uses_host_storage());
     }
@@ -297,7 +304,7 @@ class MultiDeviceBackend final : public Backend {
             host_current = host_current || (same_copy(d, owner) && m_devices[d]->uses_host_storage());
         for (const auto* list : {&shaped, &other})
             for (const auto& b : *list) {
-                Behind s{b, owner, b->version(), std::vector<bool>(n, false)};
+                Behind s{b, int(owner), b->version(), std::vector<bool>(n, false)};
                 bool any = false;
                 for (unsigned d = 0; d < n; ++d) any = any || (s.devices[d] = !same_copy(d, owner));
                 if (any) m_behind[b.get()] = std::move(s);
@@ -306,27 +313,29 @@ class MultiDeviceBackend final : public Backend {
         else if (!host_current) remember_host_stale(shaped, other);
     }
 
-    /// Before `devices` run: their copies of `buffers` that a whole launch elsewhere left
-    /// behind receive the owner's copy. New host contents (a newer version) supersede.
-    void bring_up_to_date(const std::vector<unsigned>& devices,
-                          const std::vector<std::shared_ptr<const Buffer>>& buffers) {
+    /// After device d's begin_launch, before it runs: its copies of `buffers` that a whole
+    /// launch elsewhere left behind receive the owner's copy (or the host's). New host
+    /// contents (a newer version) supersede: every device has uploaded them.
+    void catch_up(unsigned d, const std::vector<std::shared_ptr<const Buffer>>& buffers) {
         for (const auto& b : buffers) {
             auto found = m_behind.find(b.get());
             if (found == m_behind.end()) continue;
             Behind& s = found->second;
-            if (s.version != b->version()) {  // the host wrote it: every device uploads that
+            if (s.version != b->version()) {
                 m_behind.erase(found);
                 continue;
             }
-            for (unsigned d : devices) {
-                if (!s.devices[d]) continue;
-                m_devices[s.owner]->copy_range_to(*m_devices[d], *b, 0,
-                                                  b->count() * b->element().size);
-                for (unsigned e = 0; e < s.devices.size(); ++e)
-                    if (same_copy(e, d)) s.devices[e] = false;
+            if (!s.devices[d]) continue;
+            const size_t bytes = b->count() * b->element().size;
+            if (s.owner == kHostCopy) {
+                if (!m_devices[d]->uses_host_storage()) m_devices[d]->upload_range(*b, 0, bytes);
+            } else {
+                m_devices[unsigned(s.owner)]->copy_range_to(*m_devices[d], *b, 0, bytes);
             }
+            for (unsigned e = 0; e < s.devices.size(); ++e)
+                if (same_copy(e, d)) s.devices[e] = false;
             if (std::none_of(s.devices.begin(), s.devices.end(), [](bool x) { return x; }))
-                m_behind.erase(b.get());
+                m_behind.erase(found);
         }
     }
 
@@ -442,9 +451,10 @@ class MultiDeviceBackend final : public Backend {
     std::map<std::pair<unsigned, uint64_t>, SplitChoice> m_split_choice;    // by entry, count
     std::map<const Buffer*, std::shared_ptr<const Buffer>> m_host_stale;
     std::unique_ptr<SharedTileQueue> m_tile_queue;  // GPUs with peer atomics; else null
+    static constexpr int kHostCopy = -1;
     struct Behind {
         std::shared_ptr<const Buffer> buffer;
-        unsigned owner = 0;         // the device whose copy is current
+        int owner = 0;              // the device whose copy is current, or kHostCopy
         uint64_t version = 0;       // of the host contents then
         std::vector<bool> devices;  // whose copies are behind
     };
