@@ -3,6 +3,7 @@
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
 # with steps: render samples tests igi pathtracer fog tea sanitizer bench sweep profile hotspots
+# multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench).
 set -uo pipefail
 out=${OUT:-gpu-out}
