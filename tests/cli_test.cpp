@@ -122,6 +122,27 @@ TEST_F(CliTest, UnknownBackendIsAUsageError) {
     EXPECT_NE(run.output.find("auto, cpu or cuda"), std::string::npos) << run.output;
 }
 
+TEST_F(CliTest, BadDeviceListNamesTheFlagAndTheItem) {
+    CliRun run = expect_render_usage_error("--devices 0,gpu1");
+    EXPECT_NE(run.output.find("--devices"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("'gpu1'"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, TwoCpuDevicesRenderTheImageOfOne) {
+    ASSERT_EQ(run_cli("render --size 48x40 --threads 1 --backend cpu --out '" + path("one.pfm") + "'")
+                  .exit_code,
+              0);
+    CliRun run = run_cli("render --size 48x40 --threads 1 --devices cpu,cpu --out '" +
+                         path("two.pfm") + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("2 devices"), std::string::npos) << run.output;
+    std::ifstream a(path("one.pfm"), std::ios::binary), b(path("two.pfm"), std::ios::binary);
+    const std::string one((std::istreambuf_iterator<char>(a)), {}),
+        two((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_FALSE(one.empty());
+    EXPECT_EQ(one, two) << "the same image, byte for byte";
+}
+
 TEST_F(CliTest, CudaBackendRendersOrSaysWhyNot) {
     CliRun run = run_cli("render --size 16x16 --backend cuda --out '" + path("out.png") + "'");
     if (run.exit_code == 0) {  // a build with CUDA on a machine with a GPU
