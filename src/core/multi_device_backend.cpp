@@ -196,7 +196,7 @@ class MultiDeviceBackend final : public Backend {
 
         const auto t_exchange = Clock::now();
         if (split)
-            exchange(shaped, other, pieces);
+            exchange(shaped, pieces);
         else
             mark_behind(whole_on, shaped, other);
         report.exchange_ms = ms_between(t_exchange, Clock::now());
@@ -363,13 +363,8 @@ class MultiDeviceBackend final : public Backend {
     /// other devices wrote. Devices whose copy is host storage (the CPU) share one copy:
     /// the first of them receives for all. Each device receives on its own thread.
     void exchange(const std::vector<std::shared_ptr<const Buffer>>& shaped,
-                  const std::vector<std::shared_ptr<const Buffer>>& other,
                   const std::vector<std::vector<LaunchPiece>>& pieces) {
         const unsigned n = unsigned(m_devices.size());
-        if (n == 1) {
-            m_devices[0]->publish_outputs();  // the device fetches for the host, as alone
-            return;
-        }
         int host_receiver = -1;
         for (unsigned d = 0; d < n && host_receiver < 0; ++d)
             if (m_devices[d]->uses_host_storage()) host_receiver = int(d);
@@ -377,20 +372,15 @@ class MultiDeviceBackend final : public Backend {
             if (m_devices[d]->uses_host_storage() && int(d) != host_receiver) return;
             for (unsigned owner = 0; owner < n; ++owner) {
                 if (same_copy(owner, d)) continue;
-                for (const LaunchPiece& piece : pieces[owner]) {
+                for (const LaunchPiece& piece : pieces[owner])
                     for (const auto& b : shaped) {
                         const size_t element = b->element().size;
                         m_devices[owner]->copy_range_to(*m_devices[d], *b, piece.first * element,
                                                         (piece.last - piece.first) * element);
                     }
-                    // A launch with other written buffers ran whole on `owner`: all of them.
-                    for (const auto& b : other)
-                        m_devices[owner]->copy_range_to(*m_devices[d], *b, 0,
-                                                        b->count() * b->element().size);
-                }
             }
         });
-        if (host_receiver < 0) remember_host_stale(shaped, other);
+        if (host_receiver < 0) remember_host_stale(shaped, {});
     }
 
     /// No device keeps its copy in host storage: the host copies are fetched when read.
