@@ -36,11 +36,15 @@ struct RenderSettings {
     bool keep_layers = false;
     /// Called as launches complete (done, total), e.g. for a progress bar; may be empty.
     std::function<void(unsigned, unsigned)> progress;
+    /// Called as bands of rows of a launch finish on the CPU (ContextOptions::on_progress),
+    /// e.g. for a viewer showing partial results; may be empty.
+    std::function<void(const LaunchProgress&)> on_launch_progress;
 
     /// The Context options these settings ask for.
     ContextOptions context_options() const {
         ContextOptions options{backend, threads, jit_check_sm};
         options.devices = devices;
+        options.on_progress = on_launch_progress;
         return options;
     }
 };

@@ -1,5 +1,6 @@
 #include "render_worker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 
@@ -12,9 +13,52 @@ RenderWorker::RenderWorker(const samples::SampleInfo& info, samples::RenderSetti
     : m_info(info), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
     m_settings.repeat = 1;
     m_settings.progress = nullptr;
+    m_settings.on_launch_progress = [this](const LaunchProgress& p) { take_rows(p); };
     m_status.sets = m_settings.sets;
     m_status.spp_limit = m_settings.spp;
     m_thread = std::thread([this] { run(); });
+}
+
+void RenderWorker::take_rows(const LaunchProgress& p) {
+    // The launch's 2D float4 output the size of the shown image (the frame's final image,
+    // or an earlier pass of it: IGI's direct light before the composition).
+    const Buffer* out = nullptr;
+    for (const Buffer* b : p.outputs)
+        if (!out && b->dimensionality() == 2 && b->element().tag == type_info_of<float4>().tag)
+            out = b;
+    if (!out || p.size.z != 1) return;
+    const unsigned w = p.size.x, h = p.size.y;
+    if (p.rows_done <= m_partial_rows) m_partial_rows = 0;  // a new launch
+    const unsigned first = m_partial_rows;
+    m_partial_rows = p.rows_done;
+    scene::Image rows;
+    rows.width = w;
+    rows.height = p.rows_done - first;
+    const auto* pixels = static_cast<const float4*>(out->raw()) + size_t(first) * w;
+    rows.pixels.resize(size_t(rows.width) * rows.height);
+    for (size_t i = 0; i < rows.pixels.size(); ++i) rows.pixels[i] = make_float3(pixels[i]);
+    const std::vector<unsigned char> rgb = scene::to_srgb8(rows);
+
+    std::lock_guard lock(m_mutex);
+    if (m_partial.number != m_latest.number + 1 || m_partial.width != w || m_partial.height != h) {
+        // A new frame in progress: over the last one where it has the same size.
+        m_partial = ShownFrame{};
+        m_partial.number = m_latest.number + 1;
+        m_partial.width = w;
+        m_partial.height = h;
+        m_partial.rgb = m_latest.width == w && m_latest.height == h
+                            ? m_latest.rgb
+                            : std::vector<unsigned char>(size_t(w) * h * 3, 0);
+    }
+    std::copy(rgb.begin(), rgb.end(), m_partial.rgb.begin() + size_t(first) * w * 3);
+    ++m_partial_version;
+}
+
+std::optional<ShownFrame> RenderWorker::partial_after(uint64_t shown, uint64_t& version) {
+    std::lock_guard lock(m_mutex);
+    if (m_partial_version == version || m_partial.number <= shown) return std::nullopt;
+    version = m_partial_version;
+    return m_partial;
 }
 
 RenderWorker::~RenderWorker() {

@@ -1,5 +1,6 @@
 // Renders on its own thread so the window stays responsive while a slow frame (the CPU
-// backend, a full IGI render) is in progress: the window shows the last finished frame.
+// backend, a full IGI render) is in progress: the window shows the last finished frame,
+// and, on the CPU, the rows of the frame in progress as they finish.
 #pragma once
 
 #include <condition_variable>
@@ -59,6 +60,9 @@ class RenderWorker {
 
     /// The newest finished frame when it is newer than `after`.
     std::optional<ShownFrame> frame_after(uint64_t after);
+    /// The frame in progress (its finished rows over the last frame) when it follows
+    /// frame `shown` and changed since `version`, which it updates.
+    std::optional<ShownFrame> partial_after(uint64_t shown, uint64_t& version);
     WorkerStatus status();
     uint64_t frames_done();
 
@@ -66,6 +70,8 @@ class RenderWorker {
     void run();
     bool has_work() const;  // under m_mutex
     void open_session();    // on the worker thread
+    /// On the worker thread, as a launch's rows finish: copies them into m_partial.
+    void take_rows(const LaunchProgress& progress);
 
     const samples::SampleInfo& m_info;
     samples::RenderSettings m_settings;  // the worker thread's copy of the options in effect
@@ -80,6 +86,9 @@ class RenderWorker {
     bool m_pending_reset = false;
     bool m_converged = false;  // a still image is up to date, or the spp limit was reached
     ShownFrame m_latest;
+    ShownFrame m_partial;  // number: the frame in progress
+    uint64_t m_partial_version = 0;
+    unsigned m_partial_rows = 0;  // rows of the current launch already copied
     WorkerStatus m_status;
     std::thread m_thread;  // last: starts after everything above exists
 };

@@ -90,6 +90,9 @@ int run_viewer(const ViewerConfig& config) {
     const Clock::time_point start = Clock::now();
     Clock::time_point last = start;
     uint64_t ui_frames = 0;
+    uint64_t partial_version = 0, partial_uploads = 0;
+    Clock::time_point last_partial = start;
+    constexpr double kPartialInterval = 0.1;  // seconds
     std::vector<double> ui_frame_ms;  // intervals between window frames, for --verbose
     int exit_code = 0;
 
@@ -158,6 +161,14 @@ int run_viewer(const ViewerConfig& config) {
             shown = std::move(*frame);
             view.upload(shown.rgb.data(), shown.width, shown.height);
             render_rate.tick(now);
+        } else if (seconds_between(last_partial, now) >= kPartialInterval) {
+            // A slow frame in progress (the CPU): its finished rows over the last frame, at
+            // most 10 times a second (a 2048x2048 upload costs the window a frame).
+            if (auto partial = worker.partial_after(shown.number, partial_version)) {
+                view.upload(partial->rgb.data(), partial->width, partial->height);
+                ++partial_uploads;
+                last_partial = now;
+            }
         }
         if (headless_check && !status.error.empty() && !status.busy) {
             std::fprintf(stderr, "lucent view: error: %s\n", status.error.c_str());
@@ -201,10 +212,10 @@ int run_viewer(const ViewerConfig& config) {
         std::printf(
             "lucent view: %s on %s; window %llu frames in %.2f s (%.1f frames/s; frame "
             "interval median %.1f ms, 95th percentile %.1f ms, slowest %.1f ms); "
-            "%llu renders\n",
+            "%llu renders, %llu partial frames shown\n",
             info.name.c_str(), status.backend.c_str(), (unsigned long long)ui_frames, elapsed,
             double(ui_frames) / std::max(elapsed, 1e-9), at(0.5), at(0.95), ui_frame_ms.back(),
-            (unsigned long long)shown.number);
+            (unsigned long long)shown.number, (unsigned long long)partial_uploads);
     }
     if (exit_code == 0 && !config.screenshot.empty())
         std::printf("wrote %s\n", config.screenshot.c_str());

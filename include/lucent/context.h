@@ -1,6 +1,7 @@
 // The Context: owns every object, the entry points and ray types, and launches.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -21,6 +22,17 @@ struct DeviceSpec {
     Kind kind = Kind::kCpu;
     int ordinal = 0;  // kCuda: the GPU's CUDA ordinal
     bool operator==(const DeviceSpec&) const = default;
+};
+
+/// How far a launch has come, for showing partial results (ContextOptions::on_progress).
+struct LaunchProgress {
+    unsigned entry = 0;
+    uint3 size{1, 1, 1};
+    unsigned rows_done = 0;  // rows (row = z * height + y) 0 .. rows_done - 1 are finished
+    unsigned rows = 1;
+    /// The entry's output buffers (type output, launch-sized): their finished rows hold
+    /// their final values and may be read now.
+    std::vector<const Buffer*> outputs;
 };
 
 /// Parses a device list: "all" (every CUDA GPU, or the CPU where there is none), or
@@ -45,6 +57,10 @@ struct ContextOptions {
     /// Multi-device launches: launch-grid rows per piece taken from the queue (1D launches:
     /// 64 x this many indices); 0 = sized by each device's measured speed. For tests.
     unsigned piece_rows = 0;
+    /// Called on the launching thread as bands of rows of a launch finish, where the
+    /// device's copy of the buffers is host memory (the CPU backend, one device); an
+    /// interactive viewer shows them while a slow frame renders. Empty: launches run whole.
+    std::function<void(const LaunchProgress&)> on_progress;
 };
 
 constexpr unsigned kMaxDevices = 16;

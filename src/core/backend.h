@@ -3,6 +3,7 @@
 // each wrote).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +21,8 @@ struct LaunchSpec {
     uint64_t count() const { return uint64_t(size.x) * size.y * size.z; }
     /// Launches of more than one row are cut into pieces of whole rows.
     bool by_rows() const { return size.y > 1 || size.z > 1; }
+    /// Called as bands of rows finish, where the device's copy is host memory; may be empty.
+    std::function<void(unsigned rows_done, unsigned rows)> on_rows;
 };
 
 /// Part of a launch: the launch indices with linear index (z * height + y) * width + x in

@@ -27,6 +27,7 @@ struct Context::Impl {
     int jit_check_sm = 0;
     unsigned device_count = 1;
     unsigned seed = 0;
+    std::function<void(const LaunchProgress&)> on_progress;
     unsigned next_id = 0;
 
     std::string next_name(const char* kind) {
@@ -59,6 +60,7 @@ std::unique_ptr<core::Backend> make_device_backend(const DeviceSpec& device, uns
 
 Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     m_impl->state.context = this;
+    m_impl->on_progress = std::move(options.on_progress);
     if (options.devices.size() > kMaxDevices)
         throw Error("Context: " + std::to_string(options.devices.size()) +
                     " devices listed; at most " + std::to_string(kMaxDevices));
@@ -393,6 +395,20 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     for (unsigned slot = 0; slot < m_impl->device_count; ++slot)
         spec.device_keys.push_back(
             generate_tea_key(zafar_tea_key(), make_uint2(slot, m_impl->seed)));
+    if (m_impl->on_progress) {
+        LaunchProgress progress;
+        progress.entry = entry;
+        progress.size = spec.size;
+        for (const Buffer* out : scene.entries[entry].output_buffers) {
+            const uint3 s = out->size();
+            if (s.x == width && s.y == height && s.z == depth) progress.outputs.push_back(out);
+        }
+        spec.on_rows = [this, progress](unsigned rows_done, unsigned rows) mutable {
+            progress.rows_done = rows_done;
+            progress.rows = rows;
+            m_impl->on_progress(progress);
+        };
+    }
     auto t1 = Clock::now();
     m_impl->backend->launch(scene, spec, report);
     report.launch_ms = ms_since(t1) - report.jit_ms;  // the kernel compile is reported apart
