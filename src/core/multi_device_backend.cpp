@@ -26,9 +26,8 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-/// The buffers a launch of `entry` may write: those not of type input that its
-/// ray-generation and exception programs, or any program a trace can reach, view through a
-/// BufferView<T> that is not BufferView<const T>.
+/// Calls add(program) for every program a launch of `entry` can run: its ray-generation
+/// and exception programs, and every program a trace can reach.
 template <class Fn>
 void for_each_program(const CompiledScene& scene, unsigned entry, const Fn& add) {
     add(scene.entries[entry].ray_generation);
@@ -46,25 +45,17 @@ void for_each_program(const CompiledScene& scene, unsigned entry, const Fn& add)
     }
 }
 
-std::vector<std::shared_ptr<const Buffer>> writable_buffers(const CompiledScene& scene,
-                                                            unsigned entry) {
-    std::set<const Buffer*> seen;
-    std::vector<std::shared_ptr<const Buffer>> out;
-    for_each_program(scene, entry, [&](const CompiledProgram& p) {
-        for (const auto& b : p.writable_buffers)
-            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
-                out.push_back(b);
-    });
-    return out;
-}
+using BufferList = std::vector<std::shared_ptr<const Buffer>> CompiledProgram::*;
 
-/// Every buffer a launch of `entry` may read or write.
-std::vector<std::shared_ptr<const Buffer>> viewed_buffers(const CompiledScene& scene,
-                                                          unsigned entry) {
+/// The buffers not of type input that a launch of `entry` views through `list`:
+/// CompiledProgram::writable_buffers (those it may write: BufferView<T>, not
+/// BufferView<const T>) or CompiledProgram::buffers (those it may read or write).
+std::vector<std::shared_ptr<const Buffer>> launch_buffers(const CompiledScene& scene,
+                                                          unsigned entry, BufferList list) {
     std::set<const Buffer*> seen;
     std::vector<std::shared_ptr<const Buffer>> out;
     for_each_program(scene, entry, [&](const CompiledProgram& p) {
-        for (const auto& b : p.buffers)
+        for (const auto& b : p.*list)
             if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
                 out.push_back(b);
     });
@@ -135,7 +126,7 @@ class MultiDeviceBackend final : public Backend {
         // Pieces of launch-shaped buffers are exchanged; any other written buffer can be
         // written anywhere by any index, so such a launch runs whole on one device.
         std::vector<std::shared_ptr<const Buffer>> shaped, other;
-        for (auto& b : writable_buffers(scene, spec.entry))
+        for (auto& b : launch_buffers(scene, spec.entry, &CompiledProgram::writable_buffers))
             (launch_shaped(*b, spec.size) ? shaped : other).push_back(b);
         std::vector<double>& speeds = m_speeds[{spec.entry, spec.count()}];
         speeds.resize(n, 0.0);
@@ -146,7 +137,7 @@ class MultiDeviceBackend final : public Backend {
         SplitChoice& choice = m_split_choice[{spec.entry, spec.count()}];
         const bool split = can_split && (m_piece_rows > 0 || choice.next_spread());
         const unsigned whole_on = fastest(speeds);
-        const auto viewed = viewed_buffers(scene, spec.entry);
+        const auto viewed = launch_buffers(scene, spec.entry, &CompiledProgram::buffers);
         const auto t0 = Clock::now();
         if (split && m_tile_queue)
             run_with_shared_tiles(scene, spec, shaped, viewed, report);
