@@ -147,6 +147,30 @@ class MultiDeviceBackend final : public Backend {
         if (can_split && m_piece_rows == 0) choice.record(split, ms_between(t0, Clock::now()));
     }
 
+    void fetch(const Buffer& buffer) override {
+        if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
+        auto stale = m_behind.find(&buffer);
+        if (stale != m_behind.end() && stale->second.version == buffer.version()) {
+            if (stale->second.owner != kHostCopy)  // else the host copy is current
+                m_devices[unsigned(stale->second.owner)]->download_range(
+                    buffer, 0, buffer.count() * buffer.element().size);
+            return;
+        }
+        // Every device's copy is complete after a spread launch: any non-host one will do.
+        for (auto& device : m_devices)
+            if (!device->uses_host_storage()) {
+                device->download_range(buffer, 0, buffer.count() * buffer.element().size);
+                return;
+            }
+    }
+
+    // A multi-device backend is not itself one of a set of devices.
+    void begin_launch(const CompiledScene&, const LaunchSpec&, LaunchReport&) override {
+        throw Error("multi-device backend: launches whole, not in pieces");
+    }
+    void run_piece(LaunchPiece) override {}
+    void end_launch(LaunchReport&) override {}
+
   private:
     /// Devices take pieces from `queue` (or, without one, device `whole_on` runs the whole
     /// launch); then every device's copy receives the pieces the others ran.
@@ -204,30 +228,6 @@ class MultiDeviceBackend final : public Backend {
             }
         }
     }
-
-    void fetch(const Buffer& buffer) override {
-        if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
-        auto stale = m_behind.find(&buffer);
-        if (stale != m_behind.end() && stale->second.version == buffer.version()) {
-            if (stale->second.owner != kHostCopy)  // else the host copy is current
-                m_devices[unsigned(stale->second.owner)]->download_range(
-                    buffer, 0, buffer.count() * buffer.element().size);
-            return;
-        }
-        // Every device's copy is complete after a spread launch: any non-host one will do.
-        for (auto& device : m_devices)
-            if (!device->uses_host_storage()) {
-                device->download_range(buffer, 0, buffer.count() * buffer.element().size);
-                return;
-            }
-    }
-
-    // A multi-device backend is not itself one of a set of devices.
-    void begin_launch(const CompiledScene&, const LaunchSpec&, LaunchReport&) override {
-        throw Error("multi-device backend: launches whole, not in pieces");
-    }
-    void run_piece(LaunchPiece) override {}
-    void end_launch(LaunchReport&) override {}
 
     /// GPUs sharing one tile counter: each runs the whole launch, taking tiles as the
     /// threads of one GPU do; then each gathers the tiles the others ran.
