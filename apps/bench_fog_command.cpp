@@ -15,6 +15,10 @@ CLI::App* add_bench_fog_command(CLI::App* bench, BenchFogArgs& args) {
     c->add_option("--backend", args.backend, "cpu, cuda or auto")
         ->type_name("KIND")
         ->capture_default_str();
+    c->add_option("--devices", args.devices,
+                  "Spread each launch over these devices: GPU numbers and cpu, or all "
+                  "(replaces --backend)")
+        ->type_name("0,1|cpu,0|all");
     c->add_option("--threads", args.threads, "CPU worker threads, 0 = one per core")
         ->type_name("N")
         ->check(CLI::Range(0u, 4096u).description(""));
@@ -34,6 +38,7 @@ CLI::App* add_bench_fog_command(CLI::App* bench, BenchFogArgs& args) {
 int run_bench_fog_command(const BenchFogArgs& args) {
     samples::FogBenchOptions options;
     options.backend = parse_backend("--backend", args.backend);
+    options.devices = parse_devices("--devices", args.devices);
     options.threads = args.threads;
     const Size size = parse_size("--size", args.size);
     options.width = size.width;

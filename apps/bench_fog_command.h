@@ -8,6 +8,7 @@ namespace lucent::cli {
 
 struct BenchFogArgs {
     std::string backend = "cpu";
+    std::string devices;
     unsigned threads = 0;
     std::string size = "1024x768";
     unsigned frames = 30;

@@ -41,8 +41,9 @@ int run_fog_bench(const FogBenchOptions& options) {
         FogOptions fog;
         fog.fog = c.fog;
         fog.step = c.step;
-        FogScene scene(fog, options.width, options.height,
-                       ContextOptions{options.backend, options.threads, 0});
+        ContextOptions context{options.backend, options.threads, 0};
+        context.devices = options.devices;
+        FogScene scene(fog, options.width, options.height, context);
         scene.render(0.0f);  // warm-up: compile, acceleration, JIT
         std::vector<double> ms;
         double sum = 0;

@@ -10,6 +10,7 @@ namespace lucent::samples {
 
 struct FogBenchOptions {
     BackendKind backend = BackendKind::kCpu;
+    std::vector<DeviceSpec> devices;  // non-empty: launches spread over these
     unsigned threads = 0;
     unsigned width = 1024, height = 768;
     unsigned frames = 30;  // along one turn of the orbit, after one warm-up frame
