@@ -143,7 +143,7 @@ TEST(MultiDevice, EveryDeviceTakesPiecesFromTheQueue) {
         // share one tile counter, and one can start tens of microseconds after another.
         bool gpu = false;
         for (const DeviceSpec& d : c.devices) gpu = gpu || d.kind == Kind::kCuda;
-        pattern(options_for(c.devices, 1), uint3{256, 2000, 0}, &report, gpu ? 256 : 4);
+        pattern(options_for(c.devices, 1), uint3{256, 2000, 0}, &report, gpu ? 256 : 32);
         expect_shares_cover(report, c.devices.size(), 256 * 2000);
         for (const auto& d : report.devices) EXPECT_GT(d.pieces, 0u) << d.device;
     }
