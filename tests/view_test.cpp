@@ -116,6 +116,23 @@ TEST_F(ViewTest, WindowShowsWhatRenderWrites) {
     EXPECT_EQ(lucent::scene::count_differing_pixels(a, b, 128), 0u);
 }
 
+TEST_F(ViewTest, TwoDevicesShowWhatOneShows) {
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
+        GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
+    if (!has_viewer()) GTEST_SKIP() << "this build has no viewer (GLFW, ImGui or OpenGL missing)";
+    const std::string one = path("one.png"), two = path("two.png");
+    const std::string view = "xvfb-run -a -s '-screen 0 1280x1024x24' '" +
+                             std::string(LUCENT_CLI) +
+                             "' view --sample whitted --size 160x120 --threads 1 --frames 3 "
+                             "--no-panel ";
+    ASSERT_EQ(run(view + "--backend cpu --screenshot '" + one + "'").exit_code, 0);
+    const CliRun spread = run(view + "--devices cpu,cpu --screenshot '" + two + "'");
+    ASSERT_EQ(spread.exit_code, 0) << spread.output;
+    const lucent::scene::Image8 a = lucent::scene::read_png8(one);
+    const lucent::scene::Image8 b = lucent::scene::read_png8(two);
+    EXPECT_EQ(lucent::scene::count_differing_pixels(a, b, 0), 0u);
+}
+
 TEST_F(ViewTest, PanelIsDrawnOverTheImage) {
     if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
         GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
