@@ -18,10 +18,7 @@ CLI::App* add_bench_igi_command(CLI::App* bench, BenchIgiArgs& args) {
     c->add_option("--backend", args.backend, "cpu, cuda or auto")
         ->type_name("KIND")
         ->capture_default_str();
-    c->add_option("--devices", args.devices,
-                  "Spread each launch over these devices: GPU numbers and cpu, or all "
-                  "(replaces --backend)")
-        ->type_name("0,1|cpu,0|all");
+    add_devices_option(c, args.devices);
     c->add_option("--threads", args.threads, "CPU worker threads, 0 = one per core")
         ->type_name("N")
         ->check(CLI::Range(0u, 4096u).description(""));

@@ -1,6 +1,8 @@
 // Value parsers of the command line (see cli_parse.h).
 #include "cli_parse.h"
 
+#include <CLI/CLI.hpp>
+
 #include "scene/exr_encoder.h"
 
 #include <algorithm>
@@ -86,6 +88,14 @@ std::vector<DeviceSpec> parse_devices(const std::string& flag, const std::string
     } catch (const Error& e) {
         throw UsageError(flag + ": " + e.what());
     }
+}
+
+void add_devices_option(CLI::App* command, std::string& devices) {
+    command
+        ->add_option("--devices", devices,
+                     "Spread each launch over these devices: GPU numbers and cpu, or all "
+                     "(replaces --backend)")
+        ->type_name("0,1|cpu,0|all");
 }
 
 int parse_sm(const std::string& flag, const std::string& text) {

@@ -7,6 +7,10 @@
 #include <utility>
 
 #include "lucent/context.h"
+
+namespace CLI {
+class App;
+}
 #include "lucent/device/vector_math.h"
 
 namespace lucent::cli {
@@ -34,6 +38,8 @@ float parse_float(const std::string& flag, const std::string& text, float lo, fl
 BackendKind parse_backend(const std::string& flag, const std::string& text);
 /// A --devices list ("0,1", "cpu,0", "all"); empty text: none (the --backend device).
 std::vector<DeviceSpec> parse_devices(const std::string& flag, const std::string& text);
+/// Adds the --devices option (its text for parse_devices) to a command that renders.
+void add_devices_option(CLI::App* command, std::string& devices);
 /// 'text', for messages that quote what the user typed.
 std::string quoted(const std::string& text);
 /// "sm_90" or "90" → 90; UsageError naming the flag otherwise.

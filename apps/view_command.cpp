@@ -31,10 +31,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
     cmd->add_option("--backend", args.backend, "auto, cpu or cuda")
         ->type_name("KIND")
         ->capture_default_str();
-    cmd->add_option("--devices", args.devices,
-                    "Spread each launch over these devices: GPU numbers and cpu, or all "
-                    "(replaces --backend)")
-        ->type_name("0,1|cpu,0|all");
+    add_devices_option(cmd, args.devices);
     cmd->add_option("--scene", args.scene,
                     "Built-in scene or scene file (default: the sample's own)")
         ->type_name("NAME|FILE");

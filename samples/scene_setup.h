@@ -34,6 +34,23 @@ std::shared_ptr<GeometryGroup> mesh_group(
     const std::vector<std::shared_ptr<Material>>& materials,
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each = {});
 
+/// The scene's lights as the input buffers "point_lights" and "area_lights" on the context,
+/// in the program module's own layouts {position, intensity} and {corner, edge1, edge2,
+/// emission} (the direct and path tracer samples).
+template <class PointLight, class AreaLight>
+void bind_lights(Context& ctx, const scene::Scene& scene) {
+    std::vector<PointLight> points;
+    for (const auto& l : scene.point_lights) points.push_back({l.position, l.intensity});
+    std::vector<AreaLight> areas;
+    for (const auto& l : scene.area_lights) areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
+    auto point_buffer = ctx.create_buffer<PointLight>(BufferType::kInput, unsigned(points.size()));
+    point_buffer->upload(points);
+    auto area_buffer = ctx.create_buffer<AreaLight>(BufferType::kInput, unsigned(areas.size()));
+    area_buffer->upload(areas);
+    ctx["point_lights"] = point_buffer;
+    ctx["area_lights"] = area_buffer;
+}
+
 /// Pinhole camera: W to the image centre, U and V half the image's width and height.
 struct PinholeFrame {
     float3 U, V, W;

@@ -37,19 +37,7 @@ RenderResult render_direct(const RenderSettings& settings) {
     ctx.set_max_recursion_depth(2);  // camera ray, then shadow rays
 
     // Lights; an emitter with no light source of its own still shows its emission.
-    std::vector<direct::PointLight> points;
-    for (const auto& l : input.point_lights) points.push_back({l.position, l.intensity});
-    std::vector<direct::AreaLight> areas;
-    for (const auto& l : input.area_lights)
-        areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
-    auto point_buffer =
-        ctx.create_buffer<direct::PointLight>(BufferType::kInput, unsigned(points.size()));
-    point_buffer->upload(points);
-    auto area_buffer =
-        ctx.create_buffer<direct::AreaLight>(BufferType::kInput, unsigned(areas.size()));
-    area_buffer->upload(areas);
-    ctx["point_lights"] = point_buffer;
-    ctx["area_lights"] = area_buffer;
+    bind_lights<direct::PointLight, direct::AreaLight>(ctx, input);
     ctx["area_samples"] = unsigned(area_samples);
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 

@@ -98,19 +98,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
                                                 /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(2);  // the path loop's rays, then shadow rays from hits
 
-    std::vector<pathtracer::PointLight> points;
-    for (const auto& l : input.point_lights) points.push_back({l.position, l.intensity});
-    std::vector<pathtracer::AreaLight> areas;
-    for (const auto& l : input.area_lights)
-        areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
-    auto point_buffer =
-        ctx.create_buffer<pathtracer::PointLight>(BufferType::kInput, unsigned(points.size()));
-    point_buffer->upload(points);
-    auto area_buffer =
-        ctx.create_buffer<pathtracer::AreaLight>(BufferType::kInput, unsigned(areas.size()));
-    area_buffer->upload(areas);
-    ctx["point_lights"] = point_buffer;
-    ctx["area_lights"] = area_buffer;
+    bind_lights<pathtracer::PointLight, pathtracer::AreaLight>(ctx, input);
     ctx["scene_epsilon"] = epsilon;
 
     std::shared_ptr<Program> closest_hits[] = {
@@ -133,23 +121,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
         materials.push_back(material);
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(pt_attributes));
-    auto top = ctx.create_geometry_group();
-    for (const auto& mesh : input.meshes) {
-        const MeshBuffers buffers = upload_mesh(ctx, mesh);
-        auto triangles = ctx.create_geometry_triangles();
-        triangles->set_name(mesh.name);
-        triangles->set_vertices(buffers.positions);
-        triangles->set_indices(buffers.triangles);
-        triangles->set_material_indices(buffers.materials);
-        triangles->set_attribute_program(attributes);
-        (*triangles)["positions"] = buffers.positions;
-        (*triangles)["triangles"] = buffers.triangles;
-        auto instance = ctx.create_geometry_instance();
-        instance->set_geometry(triangles);
-        for (const auto& material : materials) instance->add_material(material);
-        top->add_child(instance);
-    }
-    ctx["top_object"] = top;
+    ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
     PathScene out;
     out.camera = input.camera;

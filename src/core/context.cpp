@@ -27,8 +27,16 @@ struct Context::Impl {
     int jit_check_sm = 0;
     unsigned device_count = 1;
     unsigned seed = 0;
+    std::vector<uint4> device_keys;  // per device slot, from the seed (set_random_seed)
     std::function<void(const LaunchProgress&)> on_progress;
     unsigned next_id = 0;
+
+    /// Sebald's Fig. 4: one key per device slot from the slot and the seed.
+    void derive_device_keys() {
+        device_keys.clear();
+        for (unsigned slot = 0; slot < device_count; ++slot)
+            device_keys.push_back(generate_tea_key(zafar_tea_key(), make_uint2(slot, seed)));
+    }
 
     std::string next_name(const char* kind) {
         return std::string(kind) + "#" + std::to_string(++next_id);
@@ -93,6 +101,7 @@ Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     if (!m_impl->backend) m_impl->backend = core::make_cpu_backend(options.threads);
     core::Backend* backend = m_impl->backend.get();
     m_impl->shared->fetch_from_device = [backend](const Buffer& b) { backend->fetch(b); };
+    m_impl->derive_device_keys();
     if (options.jit_check_sm) {
 #if LUCENT_HAVE_CUDA
         m_impl->jit_check_sm = options.jit_check_sm;
@@ -120,6 +129,7 @@ unsigned Context::device_count() const {
 }
 void Context::set_random_seed(unsigned seed) {
     m_impl->seed = seed;
+    m_impl->derive_device_keys();
 }
 unsigned Context::random_seed() const {
     return m_impl->seed;
@@ -391,10 +401,7 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     core::LaunchSpec spec;
     spec.entry = entry;
     spec.size = uint3{width, height, depth};
-    // Sebald's Fig. 4: one key per device slot from the slot and the seed.
-    for (unsigned slot = 0; slot < m_impl->device_count; ++slot)
-        spec.device_keys.push_back(
-            generate_tea_key(zafar_tea_key(), make_uint2(slot, m_impl->seed)));
+    spec.device_keys = m_impl->device_keys;
     if (m_impl->on_progress) {
         LaunchProgress progress;
         progress.entry = entry;

@@ -21,7 +21,12 @@ PieceQueue::PieceQueue(const LaunchSpec& spec, std::vector<double> speeds, unsig
       m_min_units(spec.by_rows() ? kMinRows : kMinOneRowUnits),
       m_fixed_units(fixed_units),
       m_speeds(std::move(speeds)) {
-    if (const char* d = std::getenv("LUCENT_PIECE_DIVISOR")) m_divisor = std::max(1.0, std::atof(d));
+    // Read once: a queue is made for every launch.
+    static const double divisor = [] {
+        const char* d = std::getenv("LUCENT_PIECE_DIVISOR");
+        return d ? std::max(1.0, std::atof(d)) : 2.0;
+    }();
+    m_divisor = divisor;
 }
 
 std::optional<LaunchPiece> PieceQueue::take(unsigned device) {
