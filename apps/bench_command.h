@@ -26,6 +26,8 @@ struct BenchBuildArgs {
     bool no_peer = false;
     bool json = false;
     std::string backend = "cpu";
+    unsigned subdivide = 0;  // each triangle cut into 4, this many times
+    std::string size;        // rays of the --backend cuda comparison, WxH
 };
 
 /// `bench tea` options as typed.

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accel/triangle_accel.h"
+#include "bench/bench_camera.h"
 #include "bench/bench_commands.h"
 #include "bench/embree_peer.h"
 #include "lucent/error.h"
@@ -17,6 +18,28 @@ namespace lucent::bench {
 
 namespace {
 
+/// Cuts every triangle into four at its edge midpoints, `levels` times (4^levels as many).
+scene::ObjMesh subdivided(scene::ObjMesh mesh, unsigned levels) {
+    for (unsigned level = 0; level < levels; ++level) {
+        std::vector<uint3> indices;
+        indices.reserve(4 * mesh.indices.size());
+        for (const uint3 t : mesh.indices) {
+            const float3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+            const unsigned ab = (unsigned)mesh.positions.size();
+            mesh.positions.push_back(0.5f * (a + b));
+            mesh.positions.push_back(0.5f * (b + c));
+            mesh.positions.push_back(0.5f * (c + a));
+            const unsigned bc = ab + 1, ca = ab + 2;
+            indices.push_back(make_uint3(t.x, ab, ca));
+            indices.push_back(make_uint3(ab, t.y, bc));
+            indices.push_back(make_uint3(ca, bc, t.z));
+            indices.push_back(make_uint3(ab, bc, ca));
+        }
+        mesh.indices = std::move(indices);
+    }
+    return mesh;
+}
+
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     size_t m = v.size();
@@ -27,7 +50,7 @@ double median(std::vector<double> v) {
 
 int run_bench_build(const BuildBenchOptions& options) {
     if (options.repeat < 1) throw Error("bench build: --repeat must be at least 1");
-    const scene::ObjMesh mesh = scene::load_obj_mesh(options.scene);
+    const scene::ObjMesh mesh = subdivided(scene::load_obj_mesh(options.scene), options.subdivide);
     const unsigned threads =
         options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const size_t tris = mesh.indices.size();
@@ -39,6 +62,16 @@ int run_bench_build(const BuildBenchOptions& options) {
         in.indices = mesh.indices;
         in.repeat = options.repeat;
         in.json = options.json;
+        in.width = options.width, in.height = options.height;
+        try {
+            const Camera cam = find_camera(options.scene);
+            in.has_camera = true;
+            in.eye = cam.eye, in.look = cam.look, in.up = cam.up, in.fov = cam.fov;
+            in.light = cam.light;
+        } catch (const Error& e) {
+            // The builds are still timed; the report says no rays were traced, and why.
+            std::fprintf(stderr, "lucent bench build: no ray comparison: %s\n", e.what());
+        }
         return cuda::run_bench_build_cuda(in);
 #else
         throw Error(

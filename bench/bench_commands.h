@@ -32,7 +32,9 @@ struct BuildBenchOptions {
     unsigned threads = 0;
     bool peer = true;
     bool json = false;
-    std::string backend = "cpu";  // "cpu", or "cuda": build + convert + upload the GPU layout
+    std::string backend = "cpu";  // "cpu", or "cuda": the GPU builder against the host one
+    unsigned subdivide = 0;       // each triangle cut into 4 at its edge midpoints, N times
+    unsigned width = 3840, height = 2160;  // --backend cuda: the rays both trees trace
 };
 /// Prints build time (median), Mtris/s, SAH cost and node count, and the peer's build time.
 int run_bench_build(const BuildBenchOptions& options);

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "cuda/device_buffer.h"
 #include "cuda/driver_api.h"
 #include "cuda/embedded_sources.h"
+#include "cuda/gpu_bvh_builder.h"
 #include "cuda/gpu_triangle_bvh.h"
 #include "cuda/nvrtc_compiler.h"
 #include "lucent/error.h"
@@ -198,46 +200,39 @@ CompileResult compile_bench_kernels(int sm, bool persistent) {
     return compile_cubin(req);
 }
 
-}  // namespace
-
-int run_bench_rays_cuda(const CudaRaysInput& in) {
-    if (in.width == 0 || in.height == 0)
-        throw Error("bench rays: the image size must be at least 1x1");
-    if (in.repeat < 1) throw Error("bench rays: --repeat must be at least 1");
-    const DriverApi& api = require_driver();
-    ContextScope ctx(api);
-    const int sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
-                   ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
-    const int sm_count = ctx.attribute(CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT);
-    const unsigned threads =
-        in.threads ? in.threads : std::max(1u, std::thread::hardware_concurrency());
-
-    // Kernels.
-    BenchKernels k;
-    k.persistent = env_flag("LUCENT_BENCH_PERSISTENT", true);
-    const CompileResult compiled = compile_bench_kernels(sm, k.persistent);
-    Module module(api, compiled.cubin);
-    k.closest = module.function("lucent_bench_closest");
-    k.any = module.function("lucent_bench_any");
-    k.primary_rays = module.function("lucent_bench_primary_rays");
-    k.secondary_rays = module.function("lucent_bench_secondary_rays");
-    auto attr = [&](CUfunction f, CUfunction_attribute a) {
-        int v = 0;
-        check(api.cuFuncGetAttribute(&v, a, f), "cuFuncGetAttribute");
-        return v;
-    };
-    k.block = std::min(attr(k.closest, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK),
-                       attr(k.any, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
-    auto resident = [&](CUfunction f) {
-        int blocks = 0;
-        check(api.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, f, k.block, 0),
-              "cuOccupancyMaxActiveBlocksPerMultiprocessor");
-        return std::max(1, blocks);
-    };
-    const int res_closest = resident(k.closest), res_any = resident(k.any);
-    k.grid_closest = sm_count * res_closest;
-    k.grid_any = sm_count * res_any;
-    {
+/// The bench kernels and BENCH.md's three ray sets in device memory, traced with any BVH
+/// of the GPU layout: `lucent bench rays --backend cuda` times the host SAH tree with it,
+/// `lucent bench build --backend cuda` compares the GPU builder's tree with that one.
+class RayBench {
+  public:
+    RayBench(const DriverApi& api, const ContextScope& ctx, const CudaRaysInput& in)
+        : m_api(api), m_in(in), m_start(api), m_stop(api) {
+        sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
+             ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+        sm_count = ctx.attribute(CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT);
+        k.persistent = env_flag("LUCENT_BENCH_PERSISTENT", true);
+        const CompileResult compiled = compile_bench_kernels(sm, k.persistent);
+        m_module = std::make_unique<Module>(api, compiled.cubin);
+        k.closest = m_module->function("lucent_bench_closest");
+        k.any = m_module->function("lucent_bench_any");
+        k.primary_rays = m_module->function("lucent_bench_primary_rays");
+        k.secondary_rays = m_module->function("lucent_bench_secondary_rays");
+        auto attr = [&](CUfunction f, CUfunction_attribute a) {
+            int v = 0;
+            check(api.cuFuncGetAttribute(&v, a, f), "cuFuncGetAttribute");
+            return v;
+        };
+        k.block = std::min(attr(k.closest, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK),
+                           attr(k.any, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
+        auto resident = [&](CUfunction f) {
+            int blocks = 0;
+            check(api.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, f, k.block, 0),
+                  "cuOccupancyMaxActiveBlocksPerMultiprocessor");
+            return std::max(1, blocks);
+        };
+        const int res_closest = resident(k.closest), res_any = resident(k.any);
+        k.grid_closest = sm_count * res_closest;
+        k.grid_any = sm_count * res_any;
         char buf[512];
         std::snprintf(buf, sizeof buf,
                       "%s, %s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
@@ -250,90 +245,166 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
                       attr(k.any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_any, compiled.ms,
                       compiled.from_cache ? " (cache)" : "");
         k.describe = buf;
+        counter = DeviceBuffer(sizeof(unsigned));
     }
+
+    /// Makes the rays: primary rays from the camera (8 x 4 tiles unless LUCENT_BENCH_TILES=0),
+    /// then shadow and diffuse rays from the primary hits `view` finds, over `by_prim` (the
+    /// triangles in input order, 3 float4 each).
+    void make_rays(const gpu::GpuTriangleBvhView& view, const DeviceBuffer& by_prim) {
+        n = m_in.width * m_in.height;
+        tiled = env_flag("LUCENT_BENCH_TILES", true) ? 1 : 0;
+        ray_of_pixel.assign(n, 0);
+        for (unsigned r = 0; r < n; ++r)
+            ray_of_pixel[tiled ? gpu::gpu_tiled_pixel(r, m_in.width, m_in.height) : r] = r;
+        primary = DeviceBuffer(sizeof(float4) * 2 * n);
+        primary_hits = DeviceBuffer(sizeof(uint2) * n);
+        {
+            const float3 fwd = normalize(m_in.look - m_in.eye);
+            const float3 right = normalize(cross(fwd, m_in.up));
+            const float3 up2 = cross(right, fwd);
+            float t = std::tan(m_in.fov / 2 * kPi / 180);
+            float a = (float)m_in.width / (float)m_in.height;
+            float p[12] = {m_in.eye.x, m_in.eye.y, m_in.eye.z, fwd.x, fwd.y, fwd.z,
+                           right.x,    right.y,    right.z,    up2.x, up2.y, up2.z};
+            unsigned w = m_in.width, h = m_in.height;
+            CUdeviceptr rays = primary.ptr();
+            void* args[] = {&p[0], &p[1],  &p[2],  &p[3], &p[4], &p[5], &p[6], &p[7],  &p[8],
+                            &p[9], &p[10], &p[11], &t,    &a,    &w,    &h,    &tiled, &rays};
+            launch_1d(k.primary_rays, n, args, "primary ray generation");
+        }
+        trace(k.closest, k.grid_closest, view, primary.ptr(), n, primary_hits.ptr());
+        hits_p.resize(n);
+        primary_hits.download(hits_p.data(), sizeof(uint2) * n);
+        slot.assign(n, 0);  // primary ray -> its secondary rays
+        m = 0;
+        for (unsigned r = 0; r < n; ++r) {
+            slot[r] = m;
+            if (std::bit_cast<float>(hits_p[r].x) >= 0.0f) ++m;
+        }
+        // Shadow and diffuse rays from the primary hits, in pixel order.
+        slots.upload(std::span<const unsigned>(slot));
+        shadow = DeviceBuffer(sizeof(float4) * 2 * std::max(m, 1u));
+        diffuse = DeviceBuffer(sizeof(float4) * 2 * std::max(m, 1u));
+        {
+            CUdeviceptr a0 = primary.ptr(), a1 = primary_hits.ptr(), a2 = slots.ptr(),
+                        a3 = by_prim.ptr(), a4 = shadow.ptr(), a5 = diffuse.ptr();
+            unsigned w = m_in.width, h = m_in.height;
+            float lx = m_in.light.x, ly = m_in.light.y, lz = m_in.light.z;
+            void* args[] = {&a0, &a1, &a2, &a3, &w, &h, &tiled, &lx, &ly, &lz, &a4, &a5};
+            launch_1d(k.secondary_rays, n, args, "secondary ray generation");
+        }
+        occluded = DeviceBuffer(std::max(m, 1u));
+        diffuse_hits = DeviceBuffer(sizeof(uint2) * std::max(m, 1u));
+    }
+
+    /// Mrays/s of each ray set with `view` (trace kernel alone, CUDA events, `repeat` timed
+    /// launches after a warm-up); the results stay in primary_hits, occluded, diffuse_hits.
+    Rate time_primary(const gpu::GpuTriangleBvhView& view) {
+        return time_trace(k.closest, k.grid_closest, view, primary.ptr(), n, primary_hits.ptr());
+    }
+    Rate time_shadow(const gpu::GpuTriangleBvhView& view) {
+        return time_trace(k.any, k.grid_any, view, shadow.ptr(), m, occluded.ptr());
+    }
+    Rate time_diffuse(const gpu::GpuTriangleBvhView& view) {
+        return time_trace(k.closest, k.grid_closest, view, diffuse.ptr(), m, diffuse_hits.ptr());
+    }
+
+    int sm = 0, sm_count = 0;
+    BenchKernels k;
+    unsigned n = 0, m = 0, tiled = 1;  // primary rays; secondary rays of each kind
+    std::vector<unsigned> ray_of_pixel, slot;
+    std::vector<uint2> hits_p;  // of make_rays' trace
+    DeviceBuffer primary, primary_hits, slots, shadow, diffuse, occluded, diffuse_hits;
+
+  private:
+    /// One launch of a trace kernel; returns its time in ms (CUDA events).
+    float trace(CUfunction f, int grid_persistent, gpu::GpuTriangleBvhView view, CUdeviceptr rays,
+                unsigned count, CUdeviceptr out) {
+        CUdeviceptr counter_ptr = counter.ptr();
+        void* args[] = {&view, &rays, &count, &out, &counter_ptr};
+        const unsigned grid =
+            k.persistent ? (unsigned)grid_persistent : (count + k.block - 1) / k.block;
+        counter.fill(0);
+        check(m_api.cuEventRecord(m_start.get(), nullptr), "cuEventRecord");
+        check(m_api.cuLaunchKernel(f, grid, 1, 1, k.block, 1, 1, 0, nullptr, args, nullptr),
+              "cuLaunchKernel (trace)");
+        check(m_api.cuEventRecord(m_stop.get(), nullptr), "cuEventRecord");
+        check(m_api.cuEventSynchronize(m_stop.get()), "trace kernel");
+        float ms = 0;
+        check(m_api.cuEventElapsedTime(&ms, m_start.get(), m_stop.get()), "cuEventElapsedTime");
+        return ms;
+    }
+    Rate time_trace(CUfunction f, int grid_persistent, const gpu::GpuTriangleBvhView& view,
+                    CUdeviceptr rays, unsigned count, CUdeviceptr out) {
+        std::vector<double> mrays;
+        if (count == 0) return Rate{};
+        for (int run = -1; run < m_in.repeat; ++run) {
+            const float ms = trace(f, grid_persistent, view, rays, count, out);
+            if (run >= 0) mrays.push_back(count / (ms * 1e-3) * 1e-6);
+        }
+        return rate_of(mrays);
+    }
+    void launch_1d(CUfunction f, unsigned count, void** args, const char* what) {
+        if (count == 0) return;
+        check(m_api.cuLaunchKernel(f, (count + 255) / 256, 1, 1, 256, 1, 1, 0, nullptr, args,
+                                   nullptr),
+              what);
+        check(m_api.cuCtxSynchronize(), what);
+    }
+
+    const DriverApi& m_api;
+    const CudaRaysInput& m_in;
+    std::unique_ptr<Module> m_module;
+    DeviceBuffer counter;
+    Event m_start, m_stop;
+};
+
+/// The triangles of `bvh` in input order (3 float4 each), for the secondary ray kernel.
+DeviceBuffer triangles_by_prim(const GpuTriangleBvh& bvh) {
+    const size_t tri_count = bvh.triangle_ids.size();
+    std::vector<float4> by_prim(3 * tri_count);
+    for (size_t i = 0; i < tri_count; ++i)
+        for (int v = 0; v < 3; ++v) by_prim[3 * bvh.triangle_ids[i] + v] = bvh.triangles[3 * i + v];
+    DeviceBuffer out;
+    out.upload(std::span<const float4>(by_prim));
+    return out;
+}
+
+}  // namespace
+
+int run_bench_rays_cuda(const CudaRaysInput& in) {
+    if (in.width == 0 || in.height == 0)
+        throw Error("bench rays: the image size must be at least 1x1");
+    if (in.repeat < 1) throw Error("bench rays: --repeat must be at least 1");
+    const DriverApi& api = require_driver();
+    ContextScope ctx(api);
+    const unsigned threads =
+        in.threads ? in.threads : std::max(1u, std::thread::hardware_concurrency());
+    RayBench bench(api, ctx, in);
+    const int sm = bench.sm, sm_count = bench.sm_count;
+    const BenchKernels& k = bench.k;
 
     // The BVH.
     const GpuTriangleBvh bvh =
         build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
     GpuTriangleBvhDevice dbvh;
     upload_gpu_triangle_bvh(bvh, dbvh);
-    gpu::GpuTriangleBvhView view = dbvh.view();
+    const gpu::GpuTriangleBvhView view = dbvh.view();
     const size_t tri_count = bvh.triangle_ids.size();
-    std::vector<float4> by_prim(3 * tri_count);
-    for (size_t i = 0; i < tri_count; ++i)
-        for (int v = 0; v < 3; ++v) by_prim[3 * bvh.triangle_ids[i] + v] = bvh.triangles[3 * i + v];
-    DeviceBuffer tris_by_prim;
-    tris_by_prim.upload(std::span<const float4>(by_prim));
+    const DeviceBuffer tris_by_prim = triangles_by_prim(bvh);
 
-    DeviceBuffer counter(sizeof(unsigned));
-    Event start(api), stop(api);
-
-    // Launches a trace kernel `repeat` + 1 times (the first is the warm-up) and returns
-    // the Mrays/s of the timed ones (trace kernel alone, CUDA events).
-    auto time_trace = [&](CUfunction f, int grid_persistent, CUdeviceptr rays, unsigned count,
-                          CUdeviceptr out) {
-        std::vector<double> mrays;
-        if (count == 0) return Rate{};
-        CUdeviceptr counter_ptr = counter.ptr();
-        void* args[] = {&view, &rays, &count, &out, &counter_ptr};
-        const unsigned grid =
-            k.persistent ? (unsigned)grid_persistent : (count + k.block - 1) / k.block;
-        for (int run = -1; run < in.repeat; ++run) {
-            counter.fill(0);
-            check(api.cuEventRecord(start.get(), nullptr), "cuEventRecord");
-            check(api.cuLaunchKernel(f, grid, 1, 1, k.block, 1, 1, 0, nullptr, args, nullptr),
-                  "cuLaunchKernel (trace)");
-            check(api.cuEventRecord(stop.get(), nullptr), "cuEventRecord");
-            check(api.cuEventSynchronize(stop.get()), "trace kernel");
-            float ms = 0;
-            check(api.cuEventElapsedTime(&ms, start.get(), stop.get()), "cuEventElapsedTime");
-            if (run >= 0) mrays.push_back(count / (ms * 1e-3) * 1e-6);
-        }
-        return rate_of(mrays);
-    };
-    auto launch_1d = [&](CUfunction f, unsigned count, void** args, const char* what) {
-        if (count == 0) return;
-        check(
-            api.cuLaunchKernel(f, (count + 255) / 256, 1, 1, 256, 1, 1, 0, nullptr, args, nullptr),
-            what);
-        check(api.cuCtxSynchronize(), what);
-    };
-
-    // Primary rays (BENCH.md), generated on the GPU, in 8 x 4 tiles unless
-    // LUCENT_BENCH_TILES=0. Checksums are summed in pixel order, as the CPU bench does.
-    const unsigned n = in.width * in.height;
-    unsigned tiled = env_flag("LUCENT_BENCH_TILES", true) ? 1 : 0;
-    std::vector<unsigned> ray_of_pixel(n);
-    for (unsigned r = 0; r < n; ++r)
-        ray_of_pixel[tiled ? gpu::gpu_tiled_pixel(r, in.width, in.height) : r] = r;
-    DeviceBuffer primary(sizeof(float4) * 2 * n), primary_hits(sizeof(uint2) * n);
-    {
-        const float3 fwd = normalize(in.look - in.eye);
-        const float3 right = normalize(cross(fwd, in.up));
-        const float3 up2 = cross(right, fwd);
-        float t = std::tan(in.fov / 2 * kPi / 180);
-        float a = (float)in.width / (float)in.height;
-        float p[12] = {in.eye.x, in.eye.y, in.eye.z, fwd.x, fwd.y, fwd.z,
-                       right.x,  right.y,  right.z,  up2.x, up2.y, up2.z};
-        unsigned w = in.width, h = in.height;
-        CUdeviceptr rays = primary.ptr();
-        void* args[] = {&p[0], &p[1],  &p[2],  &p[3], &p[4], &p[5], &p[6], &p[7],  &p[8],
-                        &p[9], &p[10], &p[11], &t,    &a,    &w,    &h,    &tiled, &rays};
-        launch_1d(k.primary_rays, n, args, "primary ray generation");
-    }
-    // The reference below traces the very rays the GPU made, so the comparison is exact
-    // even where the host compiler contracts the ray formulas differently.
+    // The rays (BENCH.md), generated on the GPU. Checksums are summed in pixel order, as the
+    // CPU bench does. The reference below traces the very rays the GPU made, so the
+    // comparison is exact even where the host compiler contracts the ray formulas differently.
+    bench.make_rays(view, tris_by_prim);
+    const unsigned n = bench.n, m = bench.m;
+    const std::vector<unsigned>& ray_of_pixel = bench.ray_of_pixel;
+    const std::vector<unsigned>& slot = bench.slot;
     Checksums gpu;
-    const Rate rate_primary =
-        time_trace(k.closest, k.grid_closest, primary.ptr(), n, primary_hits.ptr());
+    const Rate rate_primary = bench.time_primary(view);
     std::vector<uint2> hits_p(n);
-    primary_hits.download(hits_p.data(), sizeof(uint2) * n);
-    std::vector<unsigned> slot(n);  // primary ray -> its secondary rays
-    unsigned m = 0;
-    for (unsigned r = 0; r < n; ++r) {
-        slot[r] = m;
-        if (std::bit_cast<float>(hits_p[r].x) >= 0.0f) ++m;
-    }
+    bench.primary_hits.download(hits_p.data(), sizeof(uint2) * n);
     for (unsigned p = 0; p < n; ++p) {
         const float t = std::bit_cast<float>(hits_p[ray_of_pixel[p]].x);
         if (t >= 0.0f) ++gpu.primary_hits, gpu.primary_sum_t += t;
@@ -345,27 +416,12 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
             if (std::bit_cast<float>(hits_p[r].x) >= 0.0f) visit(slot[r]);
         }
     };
-
-    // Shadow and diffuse rays from the GPU's primary hits, in pixel order.
-    DeviceBuffer slots, shadow(sizeof(float4) * 2 * std::max(m, 1u)),
-        diffuse(sizeof(float4) * 2 * std::max(m, 1u));
-    slots.upload(std::span<const unsigned>(slot));
-    {
-        CUdeviceptr a0 = primary.ptr(), a1 = primary_hits.ptr(), a2 = slots.ptr(),
-                    a3 = tris_by_prim.ptr(), a4 = shadow.ptr(), a5 = diffuse.ptr();
-        unsigned w = in.width, h = in.height;
-        float lx = in.light.x, ly = in.light.y, lz = in.light.z;
-        void* args[] = {&a0, &a1, &a2, &a3, &w, &h, &tiled, &lx, &ly, &lz, &a4, &a5};
-        launch_1d(k.secondary_rays, n, args, "secondary ray generation");
-    }
-    DeviceBuffer occluded(std::max(m, 1u)), diffuse_hits(sizeof(uint2) * std::max(m, 1u));
-    const Rate rate_shadow = time_trace(k.any, k.grid_any, shadow.ptr(), m, occluded.ptr());
-    const Rate rate_diffuse =
-        time_trace(k.closest, k.grid_closest, diffuse.ptr(), m, diffuse_hits.ptr());
+    const Rate rate_shadow = bench.time_shadow(view);
+    const Rate rate_diffuse = bench.time_diffuse(view);
     std::vector<unsigned char> occ(m);
     std::vector<uint2> hits_d(m);
-    occluded.download(occ.data(), m);
-    diffuse_hits.download(hits_d.data(), sizeof(uint2) * m);
+    bench.occluded.download(occ.data(), m);
+    bench.diffuse_hits.download(hits_d.data(), sizeof(uint2) * m);
     gpu.shadow_rays = gpu.diffuse_rays = m;
     for (unsigned char b : occ) gpu.occluded += b;
     for_secondary_in_pixel_order([&](unsigned s) {
@@ -375,9 +431,9 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
 
     // The CPU backend (TriangleAccel, all threads) on the same rays.
     std::vector<float4> rays_p(2 * (size_t)n), rays_s(2 * (size_t)m), rays_d(2 * (size_t)m);
-    primary.download(rays_p.data(), rays_p.size() * sizeof(float4));
-    shadow.download(rays_s.data(), rays_s.size() * sizeof(float4));
-    diffuse.download(rays_d.data(), rays_d.size() * sizeof(float4));
+    bench.primary.download(rays_p.data(), rays_p.size() * sizeof(float4));
+    bench.shadow.download(rays_s.data(), rays_s.size() * sizeof(float4));
+    bench.diffuse.download(rays_d.data(), rays_d.size() * sizeof(float4));
     accel::TriangleAccel cpu_accel;
     cpu_accel.build(in.positions, in.indices);
     auto cpu_closest = [&](const std::vector<float4>& rays, size_t count) {
@@ -479,50 +535,146 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
 
 int run_bench_build_cuda(const CudaBuildInput& in) {
     if (in.repeat < 1) throw Error("bench build: --repeat must be at least 1");
+    if (in.width == 0 || in.height == 0)
+        throw Error("bench build: the image size must be at least 1x1");
     const DriverApi& api = require_driver();
     ContextScope ctx(api);
+    const int sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
+                   ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+    const size_t tris = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
     const GpuBvhBuildOptions options = gpu_build_options();
-    std::vector<double> total, build, convert, upload;
-    GpuBvhStats stats;
+
+    // The GPU builder, on triangles already in device memory (as for geometry that moves
+    // every frame): the GPU time of its kernels.
+    GpuBvhBuilder builder(sm);
+    DeviceBuffer positions, indices;
+    const auto u0 = std::chrono::steady_clock::now();
+    positions.upload(in.positions);
+    indices.upload(in.indices);
+    const double mesh_upload_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - u0).count();
+    DeviceTriangles device_tris;
+    device_tris.positions = positions.ptr();
+    device_tris.vertex_count = unsigned(in.positions.size());
+    device_tris.indices = in.indices.empty() ? 0 : indices.ptr();
+    device_tris.triangle_count = unsigned(tris);
+    GpuTriangleBvhDevice hploc;
+    GpuBvhStats hploc_stats;
+    std::vector<double> gpu_ms, refit_ms;
+    for (int run = -1; run < in.repeat; ++run) {
+        hploc_stats = builder.build(device_tris, hploc, options);
+        if (run >= 0) gpu_ms.push_back(hploc_stats.build_ms);
+    }
+    for (int run = -1; run < in.repeat; ++run) {
+        const double ms = builder.refit(device_tris, hploc);
+        if (run >= 0) refit_ms.push_back(ms);
+    }
+
+    // The host binned-SAH build, its conversion to the layout and the upload.
+    std::vector<double> host_ms;
+    GpuTriangleBvh sah_bvh;
+    GpuTriangleBvhDevice sah;
     for (int run = -1; run < in.repeat; ++run) {
         const auto t0 = std::chrono::steady_clock::now();
-        GpuTriangleBvh bvh = build_gpu_triangle_bvh(in.positions, in.indices, options);
-        const auto t1 = std::chrono::steady_clock::now();
+        sah_bvh = build_gpu_triangle_bvh(in.positions, in.indices, options);
         GpuTriangleBvhDevice fresh;  // allocation is part of the cost, as for a new scene
-        upload_gpu_triangle_bvh(bvh, fresh);
+        upload_gpu_triangle_bvh(sah_bvh, fresh);
         check(api.cuCtxSynchronize(), "upload");
-        const auto t2 = std::chrono::steady_clock::now();
-        stats = bvh.stats;
-        if (run < 0) continue;
-        total.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
-        build.push_back(bvh.stats.build_ms);
-        convert.push_back(bvh.stats.convert_ms);
-        upload.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+        const auto t1 = std::chrono::steady_clock::now();
+        if (run >= 0) host_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        sah = std::move(fresh);
     }
-    const size_t tris = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
-    const double ms = median_of(total);
-    const double lo = *std::min_element(total.begin(), total.end());
-    const double hi = *std::max_element(total.begin(), total.end());
+
+    // Both trees on the same rays; every hit compared.
+    struct Rates {
+        Rate primary, shadow, diffuse;
+    } rates_sah, rates_hploc;
+    size_t differ_p = 0, differ_s = 0, differ_d = 0, ray_count = 0;
+    if (in.has_camera && tris > 0) {
+        CudaRaysInput rin;
+        rin.eye = in.eye, rin.look = in.look, rin.up = in.up, rin.fov = in.fov;
+        rin.light = in.light;
+        rin.width = in.width, rin.height = in.height, rin.repeat = in.repeat;
+        RayBench bench(api, ctx, rin);
+        const DeviceBuffer by_prim = triangles_by_prim(sah_bvh);
+        bench.make_rays(sah.view(), by_prim);
+        auto run_all = [&](const gpu::GpuTriangleBvhView& view, Rates& r, std::vector<uint2>& hp,
+                           std::vector<unsigned char>& occ, std::vector<uint2>& hd) {
+            r.primary = bench.time_primary(view);
+            r.shadow = bench.time_shadow(view);
+            r.diffuse = bench.time_diffuse(view);
+            hp.resize(bench.n), occ.resize(bench.m), hd.resize(bench.m);
+            bench.primary_hits.download(hp.data(), sizeof(uint2) * hp.size());
+            bench.occluded.download(occ.data(), occ.size());
+            bench.diffuse_hits.download(hd.data(), sizeof(uint2) * hd.size());
+        };
+        std::vector<uint2> hp_a, hd_a, hp_b, hd_b;
+        std::vector<unsigned char> occ_a, occ_b;
+        run_all(sah.view(), rates_sah, hp_a, occ_a, hd_a);
+        run_all(hploc.view(), rates_hploc, hp_b, occ_b, hd_b);
+        for (size_t i = 0; i < hp_a.size(); ++i) differ_p += hp_a[i].x != hp_b[i].x;
+        for (size_t i = 0; i < occ_a.size(); ++i) differ_s += occ_a[i] != occ_b[i];
+        for (size_t i = 0; i < hd_a.size(); ++i) differ_d += hd_a[i].x != hd_b[i].x;
+        ray_count = bench.n + 2 * size_t(bench.m);
+    }
+
+    const double ms = median_of(gpu_ms);
+    const double lo = *std::min_element(gpu_ms.begin(), gpu_ms.end());
+    const double hi = *std::max_element(gpu_ms.begin(), gpu_ms.end());
+    const double host = median_of(host_ms);
+    auto ratio = [](const Rate& a, const Rate& b) {
+        return b.median > 0 ? a.median / b.median : 0.0;
+    };
     if (in.json) {
         std::printf(
             "{\"scene\": \"%s\", \"backend\": \"cuda\", \"device\": \"%s\", \"triangles\": %zu, "
-            "\"build_ms\": %.3f, \"min_ms\": %.3f, \"max_ms\": %.3f, \"sah_build_ms\": %.3f, "
-            "\"convert_ms\": %.3f, \"upload_ms\": %.3f, \"mtris_per_s\": %.3f, \"sah_cost\": %.4f, "
-            "\"nodes\": %zu, \"leaves\": %zu, \"depth\": %u}\n",
-            in.scene.c_str(), ctx.name().c_str(), tris, ms, lo, hi, median_of(build),
-            median_of(convert), median_of(upload), tris / ms * 1e-3, stats.sah_cost,
-            stats.node_count, stats.leaf_count, stats.depth);
+            "\"builder\": \"%s\", \"build_ms\": %.4f, \"min_ms\": %.4f, \"max_ms\": %.4f, "
+            "\"mtris_per_s\": %.3f, \"sah_cost\": %.4f, \"nodes\": %zu, \"depth\": %u, "
+            "\"refit_ms\": %.4f, \"mesh_upload_ms\": %.3f, \"host_sah_ms\": %.3f, "
+            "\"host_sah_cost\": %.4f",
+            in.scene.c_str(), ctx.name().c_str(), tris, hploc_stats.builder, ms, lo, hi,
+            tris / ms * 1e-3, hploc_stats.sah_cost, hploc_stats.node_count, hploc_stats.depth,
+            median_of(refit_ms), mesh_upload_ms, host, sah_bvh.stats.sah_cost);
+        if (ray_count)
+            std::printf(
+                ", \"width\": %u, \"height\": %u, \"mrays\": {\"primary\": %.2f, \"shadow\": "
+                "%.2f, \"diffuse\": %.2f}, \"host_sah_mrays\": {\"primary\": %.2f, \"shadow\": "
+                "%.2f, \"diffuse\": %.2f}, \"rays_differing\": %zu",
+                in.width, in.height, rates_hploc.primary.median, rates_hploc.shadow.median,
+                rates_hploc.diffuse.median, rates_sah.primary.median, rates_sah.shadow.median,
+                rates_sah.diffuse.median, differ_p + differ_s + differ_d);
+        std::printf("}\n");
         return 0;
     }
+    std::printf("scene %s: %zu triangles, GPU %s, median of %d builds\n", in.scene.c_str(), tris,
+                ctx.name().c_str(), in.repeat);
     std::printf(
-        "scene %s: %zu triangles, GPU %s, median of %d builds (host build + convert + "
-        "upload)\n",
-        in.scene.c_str(), tris, ctx.name().c_str(), in.repeat);
+        "GPU build (%s) %.3f ms (min %.3f, max %.3f) %.1f Mtris/s sah=%.3f nodes=%zu depth=%u "
+        "(GPU time of its kernels; the mesh upload %.2f ms is apart)\n",
+        hploc_stats.builder, ms, lo, hi, tris / ms * 1e-3, hploc_stats.sah_cost,
+        hploc_stats.node_count, hploc_stats.depth, mesh_upload_ms);
+    std::printf("GPU refit %.3f ms\n", median_of(refit_ms));
     std::printf(
-        "build %.2f ms (min %.2f, max %.2f) %.2f Mtris/s sah=%.3f nodes=%zu leaves=%zu depth=%u "
-        "(sah build %.2f ms, convert %.2f ms, upload %.2f ms)\n",
-        ms, lo, hi, tris / ms * 1e-3, stats.sah_cost, stats.node_count, stats.leaf_count,
-        stats.depth, median_of(build), median_of(convert), median_of(upload));
+        "host build (binned SAH + layout + upload) %.2f ms %.2f Mtris/s sah=%.3f nodes=%zu "
+        "depth=%u\n",
+        host, tris / host * 1e-3, sah_bvh.stats.sah_cost, sah_bvh.stats.node_count,
+        sah_bvh.stats.depth);
+    if (ray_count) {
+        std::printf("rays %ux%u (BENCH.md sets), Mrays/s, GPU-built tree / host SAH tree:\n",
+                    in.width, in.height);
+        std::printf("primary %.2f / %.2f (%.3fx)\n", rates_hploc.primary.median,
+                    rates_sah.primary.median, ratio(rates_hploc.primary, rates_sah.primary));
+        std::printf("shadow %.2f / %.2f (%.3fx)\n", rates_hploc.shadow.median,
+                    rates_sah.shadow.median, ratio(rates_hploc.shadow, rates_sah.shadow));
+        std::printf("diffuse %.2f / %.2f (%.3fx)\n", rates_hploc.diffuse.median,
+                    rates_sah.diffuse.median, ratio(rates_hploc.diffuse, rates_sah.diffuse));
+        std::printf(
+            "hits: %zu of %zu rays differ between the trees (primary %zu, shadow %zu, "
+            "diffuse %zu)\n",
+            differ_p + differ_s + differ_d, ray_count, differ_p, differ_s, differ_d);
+    } else {
+        std::printf("no rays traced: no viewpoint for this scene (cameras.txt)\n");
+    }
     return 0;
 }
 

@@ -39,9 +39,17 @@ struct CudaBuildInput {
     std::span<const uint3> indices;
     int repeat = 5;
     bool json = false;
+    // The ray sets both trees are timed on; no rays are traced without a camera.
+    bool has_camera = false;
+    float3 eye, look, up;
+    float fov = 60;
+    float3 light;
+    unsigned width = 3840, height = 2160;
 };
 
-/// Times build + conversion + upload of the GPU layout (median), prints Mtris/s and SAH.
+/// Times the GPU builder (H-PLOC, GPU time of its kernels, median) and its refit, and the
+/// host binned-SAH build + conversion + upload; prints Mtris/s and SAH cost of both, and the
+/// Mrays/s each tree gives on BENCH.md's ray sets (with hits compared ray by ray).
 int run_bench_build_cuda(const CudaBuildInput& input);
 
 }  // namespace lucent::cuda

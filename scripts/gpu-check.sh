@@ -2,8 +2,8 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render samples tests igi pathtracer fog tea sanitizer bench sweep profile hotspots
-# multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
+# with steps: render samples tests igi pathtracer fog tea sanitizer bench builder sweep profile
+# hotspots multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench).
 set -uo pipefail
 out=${OUT:-gpu-out}
@@ -186,6 +186,21 @@ bench)
         $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj
     done
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj
+    ;;
+builder)
+    echo "== the GPU BVH builder (H-PLOC) and refit: layouts against brute force"
+    $R $B/bin/gpu_bvh_builder_test
+    echo "== compute-sanitizer memcheck and racecheck on the builder tests"
+    compute-sanitizer --tool memcheck --leak-check full $R $B/bin/gpu_bvh_builder_test --gtest_filter='*Small*:*Refit*:*Index*' 2>&1 | tail -4
+    compute-sanitizer --tool racecheck $R $B/bin/gpu_bvh_builder_test --gtest_filter='*Small*' 2>&1 | tail -4
+    for s in sponza sibenik dragon bunny; do
+        echo "== bench build --backend cuda $s"
+        $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
+    done
+    echo "== bench build --backend cuda: sponza cut twice (1.06M triangles)"
+    $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj --subdivide 2 --repeat 9
+    echo "== bench build --backend cuda: dragon cut twice (1.6M triangles)"
+    $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/dragon.obj --subdivide 2 --repeat 9
     ;;
 esac
 done

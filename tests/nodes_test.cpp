@@ -478,15 +478,18 @@ class RefitTest : public NodesTest {
             for (int b = 0; b < 8; ++b)
                 r.push_back(along_z(0.23f + 0.45f * a, 0.21f + 0.45f * b, 0));
         return r;
-    }
+    }    void refit_and_rebuild(Builder builder);
 };
 
-TEST_F(RefitTest, RefitAfterMovingVerticesGivesTheSameHitsAsARebuild) {
+/// Traces the grid, moves it, and traces it refitted and rebuilt, with `builder` for the
+/// grid's GeometryGroup.
+void RefitTest::refit_and_rebuild(Builder builder) {
     auto triangles = make_triangles(ctx, grid_vertices());
     auto gg = make_geometry_group(
         ctx,
         {make_instance(ctx, triangles,
                        make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1))});
+    gg->acceleration()->set_builder(builder);
     auto top = ctx.create_group();
     top->add_child(gg);
     const auto ray_list = rays();
@@ -526,6 +529,16 @@ TEST_F(RefitTest, RefitAfterMovingVerticesGivesTheSameHitsAsARebuild) {
         EXPECT_NEAR(rebuilt[r].t, 4 + 0.25f * y, 1e-3f) << "rebuild, ray at " << x << ", " << y;
         EXPECT_EQ(refitted[r].prim, rebuilt[r].prim);
     }
+}
+
+TEST_F(RefitTest, RefitAfterMovingVerticesGivesTheSameHitsAsARebuild) {
+    refit_and_rebuild(Builder::kBinnedSah);
+}
+
+TEST_F(RefitTest, GpuBuilderAndItsRefitGiveTheSameHits) {
+    // On the CUDA backend the grid's BVH is built (H-PLOC) and refitted on the GPU; on the
+    // CPU, Builder::kGpuHploc builds binned SAH.
+    refit_and_rebuild(Builder::kGpuHploc);
 }
 
 TEST_F(RefitTest, MixedTrianglesAndSpheresHitTheSameWithAndWithoutAHierarchy) {

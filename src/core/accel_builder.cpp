@@ -101,8 +101,11 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     const bool same_structure = ga.structure_signature == structure.h;
     const bool same_content = ga.content_signature == content.h;
     node.geometry = cached;
-    if (same_structure && same_content && !accel.dirty()) return;
-    const bool refit = same_structure && accel.refit() && !node.brute_force;
+    // A BVH built on the GPU needs no host copy unless the host traverses too.
+    const bool host_triangles = m_host_traversal || accel.builder() != Builder::kGpuHploc;
+    const bool host_current = ga.host_triangles || !host_triangles || !ga.triangles_only;
+    if (same_structure && same_content && !accel.dirty() && host_current) return;
+    const bool refit = same_structure && accel.refit() && !node.brute_force && host_current;
 
     // Gather primitives: global reference = prim_first[instance] + local index.
     ga.triangles_only = triangles_only && !node.brute_force;
@@ -128,11 +131,19 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
                 ga.tri_instance.push_back(k);
             }
         }
-        if (refit)
-            ga.triangles.refit(ga.vertices, ga.indices);
-        else
-            ga.triangles.build(ga.vertices, ga.indices);
-        ga.bounds = ga.triangles.triangle_count() ? ga.triangles.bounds() : empty_box();
+        if (!host_triangles) {
+            ga.triangles = accel::TriangleAccel();
+            ga.bounds = empty_box();
+            for (const uint3 t : ga.indices)
+                for (unsigned v : {t.x, t.y, t.z}) grow(ga.bounds, ga.vertices[v]);
+        } else {
+            if (refit)
+                ga.triangles.refit(ga.vertices, ga.indices);
+            else
+                ga.triangles.build(ga.vertices, ga.indices);
+            ga.bounds = ga.triangles.triangle_count() ? ga.triangles.bounds() : empty_box();
+        }
+        ga.host_triangles = host_triangles;
     } else {
         std::vector<Aabb> boxes;
         boxes.reserve(total);

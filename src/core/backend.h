@@ -73,6 +73,9 @@ class Backend {
     // ---- copies between the devices' copies of a buffer -----------------------------------
     /// True when this device's copy of a buffer is the Buffer's host storage (the CPU).
     virtual bool uses_host_storage() const { return false; }
+    /// Whether this backend traverses the scene on the host (then every triangle
+    /// acceleration needs its host BVH, whatever its Builder).
+    virtual bool traces_on_host() const { return uses_host_storage(); }
     /// Host storage, bytes [offset, offset + bytes) → this device's copy.
     virtual void upload_range(const Buffer& /*buffer*/, size_t /*offset*/, size_t /*bytes*/) {}
     /// This device's copy → host storage.

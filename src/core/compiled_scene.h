@@ -71,6 +71,7 @@ struct GeometryAccel {
     uint64_t content_signature = 0;    // vertex buffer versions, bounding-box records
     bool triangles_only = false;
     accel::TriangleAccel triangles;      // triangles_only: all instances' triangles together
+    bool host_triangles = false;         // `triangles` is built (kGpuHploc on a GPU needs none)
     std::vector<float3> vertices;        // the concatenated vertices
     std::vector<uint3> indices;          // concatenated, rebased indices
     std::vector<uint32_t> tri_instance;  // triangle → position in CompiledNode::instances

@@ -368,7 +368,8 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     }
     if (stale) {
         m_impl->compiled.reset();  // a failed compile must not leave a stale scene behind
-        core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache);
+        core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache,
+                                     m_impl->backend->traces_on_host());
         m_impl->compiled = compiler.compile();
         m_impl->compiled->generation = m_impl->shared->generation;
         m_impl->compiled->data_generation = m_impl->shared->data_generation;

@@ -111,6 +111,12 @@ class MultiDeviceBackend final : public Backend {
         return s;
     }
 
+    bool traces_on_host() const override {
+        for (const auto& d : m_devices)
+            if (d->traces_on_host()) return true;
+        return false;
+    }
+
     void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report) override {
         const unsigned n = unsigned(m_devices.size());
         // What a new compile drops from the devices must reach the host first.

@@ -26,7 +26,10 @@ struct ScopeChain {
 
 class SceneCompiler {
   public:
-    SceneCompiler(const ContextState& state, AccelCache& cache) : m_state(state), m_cache(cache) {}
+    /// host_traversal: the backend traverses on the host, so GeometryGroups with
+    /// Builder::kGpuHploc need their host BVH too (else only their bounds).
+    SceneCompiler(const ContextState& state, AccelCache& cache, bool host_traversal = true)
+        : m_state(state), m_cache(cache), m_host_traversal(host_traversal) {}
 
     /// Full compile for a launch.
     std::unique_ptr<CompiledScene> compile();
@@ -59,6 +62,7 @@ class SceneCompiler {
 
     const ContextState& m_state;
     AccelCache& m_cache;
+    bool m_host_traversal = true;
     std::vector<const Buffer*> m_rebuild_inputs;  // see CompiledScene::rebuild_inputs
     std::unique_ptr<CompiledScene> m_scene;
     std::map<const Node*, unsigned> m_node_ids;

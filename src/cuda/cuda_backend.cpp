@@ -107,7 +107,7 @@ class CudaBackend final : public core::Backend {
                       LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
-            if (!m_scene) m_scene = std::make_unique<GpuScene>();
+            if (!m_scene) m_scene = std::make_unique<GpuScene>(m_sm);
             m_scene->update(scene);
             m_last_scene = &scene;
             m_last_generation = scene.generation;

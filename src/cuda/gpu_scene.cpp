@@ -22,6 +22,10 @@ const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
                           : nullptr;
 }
 
+const Acceleration& acceleration_of(const core::CompiledNode& node) {
+    return *static_cast<const GeometryGroup*>(node.source)->acceleration();
+}
+
 void append_bvh(const accel::Bvh& bvh, std::vector<gpu::GpuBvhNode>& nodes,
                 std::vector<unsigned>& order, gpu::GpuBvh& out) {
     if (bvh.empty()) {
@@ -205,14 +209,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
                 // rebuilt only when they change.
                 GeometryMirror& mirror = m_geometry[&ga];
                 used_geometry.insert(&ga);
-                if (mirror.structure != ga.structure_signature ||
-                    mirror.content != ga.content_signature) {
-                    GpuTriangleBvh bvh = build_gpu_triangle_bvh(ga.vertices, ga.indices);
-                    mirror.empty = ga.indices.empty();
-                    upload_gpu_triangle_bvh(bvh, mirror.bvh);
-                    mirror.structure = ga.structure_signature;
-                    mirror.content = ga.content_signature;
-                }
+                update_triangle_bvh(n, mirror);
                 a.triangles = mirror.bvh.view();
                 a.bvh = {~0u, 0};
                 if (mirror.empty) a.triangles_only = 0, a.prim_total = 0;  // nothing to hit
@@ -303,6 +300,29 @@ CUdeviceptr GpuScene::mirror(const Buffer& buffer) const {
 void GpuScene::fetch(const Buffer& buffer) {
     auto found = m_buffers.find(&buffer);
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);
+}
+
+/// Rebuilds (or refits) the GPU layout of a GeometryGroup's triangles when they changed:
+/// on the host with binned SAH, or on the GPU for Builder::kGpuHploc.
+void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror) {
+    const core::GeometryAccel& ga = *node.geometry;
+    if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
+        return;
+    const Acceleration& accel = acceleration_of(node);
+    if (accel.builder() == Builder::kGpuHploc) {
+        if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
+        const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
+                           mirror.bvh.triangle_count == ga.indices.size();
+        if (refit)
+            m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
+        else
+            m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh);
+    } else {
+        upload_gpu_triangle_bvh(build_gpu_triangle_bvh(ga.vertices, ga.indices), mirror.bvh);
+    }
+    mirror.empty = ga.indices.empty();
+    mirror.structure = ga.structure_signature;
+    mirror.content = ga.content_signature;
 }
 
 }  // namespace lucent::cuda

@@ -8,6 +8,7 @@
 
 #include "core/compiled_scene.h"
 #include "cuda/device_buffer.h"
+#include "cuda/gpu_bvh_builder.h"
 #include "cuda/gpu_triangle_bvh.h"
 #include "cuda/megakernel_generator.h"
 #include "lucent_gpu/launch_params.cuh"
@@ -16,6 +17,9 @@ namespace lucent::cuda {
 
 class GpuScene {
   public:
+    /// For the device of the current context, of compute capability `sm` (x10).
+    explicit GpuScene(int sm) : m_sm(sm) {}
+
     /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
     /// buffers whose host contents changed.
     void update(const core::CompiledScene& scene);
@@ -54,7 +58,10 @@ class GpuScene {
     void write_record(unsigned offset, const core::CompiledProgram& program);
     void fetch_mirror(BufferMirror& mirror);
     void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
+    void update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror);
 
+    int m_sm;
+    std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a Builder::kGpuHploc needs it
     ProgramTable m_programs;
     std::vector<unsigned char> m_records;
     std::unordered_map<const void*, gpu::ProgramRef> m_callable_slots;  // by host record

@@ -12,6 +12,7 @@ namespace lucent::cuda {
 namespace {
 
 constexpr float kEmptyLo = 3.0e38f, kEmptyHi = -3.0e38f;  // a box no ray enters
+constexpr uint32_t kNoParent = 0xffffffffu;
 
 uint3 triangle(std::span<const uint3> indices, size_t i) {
     return indices.empty() ? make_uint3(3 * (unsigned)i, 3 * (unsigned)i + 1, 3 * (unsigned)i + 2)
@@ -98,11 +99,15 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
         if (n.count > 0) return emit_leaf(n);
         const size_t at = out.nodes.size();
         out.nodes.resize(at + gpu::kGpuNodeFloat4s);
+        out.parents.push_back(kNoParent);  // set by the parent below
         const accel::BvhNode& c0 = nodes[n.first];
         const accel::BvhNode& c1 = nodes[n.first + 1];
         set_boxes(&out.nodes[at], c0.lo, c0.hi, c1.lo, c1.hi);
         const int r0 = self(self, n.first);
         const int r1 = self(self, n.first + 1);
+        const uint32_t me = uint32_t(at / gpu::kGpuNodeFloat4s);
+        if (r0 >= 0) out.parents[r0 / gpu::kGpuNodeFloat4s] = me << 1;
+        if (r1 >= 0) out.parents[r1 / gpu::kGpuNodeFloat4s] = me << 1 | 1u;
         set_children(&out.nodes[at], r0, r1);
         return (int)at;
     };
@@ -111,11 +116,13 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
     if (nodes.empty()) {
         // No triangles: a root whose two boxes are empty.
         out.nodes.resize(gpu::kGpuNodeFloat4s);
+        out.parents.assign(1, kNoParent);
         set_boxes(out.nodes.data(), empty_lo, empty_hi, empty_lo, empty_hi);
         set_children(out.nodes.data(), gpu::gpu_make_leaf(0, 1), gpu::gpu_make_leaf(0, 1));
     } else if (nodes[0].count > 0) {
         // The whole mesh is one leaf: the root is inner, its second box is empty.
         out.nodes.resize(gpu::kGpuNodeFloat4s);
+        out.parents.assign(1, kNoParent);
         set_boxes(out.nodes.data(), nodes[0].lo, nodes[0].hi, empty_lo, empty_hi);
         const int leaf = emit_leaf(nodes[0]);
         set_children(out.nodes.data(), leaf, leaf);
@@ -133,6 +140,9 @@ void upload_gpu_triangle_bvh(const GpuTriangleBvh& bvh, GpuTriangleBvhDevice& de
     device.nodes.upload(std::span<const float4>(bvh.nodes));
     device.triangles.upload(std::span<const float4>(bvh.triangles));
     device.triangle_ids.upload(std::span<const uint32_t>(bvh.triangle_ids));
+    device.parents.upload(std::span<const uint32_t>(bvh.parents));
+    device.node_count = bvh.nodes.size() / gpu::kGpuNodeFloat4s;
+    device.triangle_count = bvh.triangle_ids.size();
 }
 
 }  // namespace lucent::cuda

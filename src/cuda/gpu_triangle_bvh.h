@@ -22,7 +22,8 @@ struct GpuBvhBuildOptions {
 };
 
 struct GpuBvhStats {
-    double build_ms = 0;    // binned-SAH build (lucent::accel::Bvh)
+    const char* builder = "binned SAH (host)";
+    double build_ms = 0;    // binned-SAH build (lucent::accel::Bvh), or the GPU build kernels
     double convert_ms = 0;  // conversion to the GPU layout
     double sah_cost = 0;
     size_t node_count = 0;  // inner nodes of the GPU layout
@@ -35,6 +36,7 @@ struct GpuTriangleBvh {
     std::vector<float4> nodes;           // 4 per inner node, root first
     std::vector<float4> triangles;       // 3 per triangle, leaf order
     std::vector<uint32_t> triangle_ids;  // leaf order -> input order
+    std::vector<uint32_t> parents;       // per node: parent << 1 | slot (~0u at the root), for refit
     GpuBvhStats stats;
 
     /// A view over these host arrays: lets the host run the GPU traversal (tests).
@@ -51,7 +53,8 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
 
 /// A GpuTriangleBvh in device memory.
 struct GpuTriangleBvhDevice {
-    DeviceBuffer nodes, triangles, triangle_ids;
+    DeviceBuffer nodes, triangles, triangle_ids, parents;
+    size_t node_count = 0, triangle_count = 0;  // in use (the buffers may be larger)
     /// Device pointers, to pass to kernels by value.
     gpu::GpuTriangleBvhView view() const {
         return {nodes.as<float4>(), triangles.as<float4>(), triangle_ids.as<unsigned>()};
