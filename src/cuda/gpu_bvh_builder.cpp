@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,11 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     req.options = {"--std=c++17"};
     if (const char* debug = std::getenv("LUCENT_GPU_BUILD_DEBUG"); debug && *debug)
         req.options.push_back("-DLUCENT_BUILD_DEBUG=1");  // the kernels print what they do
+    // Experiments: e.g. "-DLUCENT_PLOC_RADIUS=8 -DLUCENT_MORTON_CUBE=1".
+    if (const char* extra = std::getenv("LUCENT_GPU_BUILD_NVRTC_OPTIONS")) {
+        std::istringstream words(extra);
+        for (std::string w; words >> w;) req.options.push_back(w);
+    }
     req.sm = sm;
     const CompileResult compiled = compile_cubin(req);
     const DriverApi& d = api();

@@ -34,7 +34,17 @@ namespace lucent::gpu {
 
 constexpr unsigned kBuildInvalid = 0xffffffffu;
 constexpr int kPlocClusters = 16;  // clusters a subtree keeps: two halves fill a warp
-constexpr int kPlocRadius = 16;    // neighbours searched on each side, in warp order
+#ifndef LUCENT_PLOC_RADIUS
+#define LUCENT_PLOC_RADIUS 16
+#endif
+// Morton cells: cubes (one scale for the three axes, the largest extent), or 0 for boxes
+// stretched to the scene's extent on each axis. Cubes keep the code order spatially even in
+// long scenes (Sponza, Sibenik): on the H200, the worst of 18 trace ratios against the host
+// SAH tree rose from 0.825x to 0.852x (docs/performance.md).
+#ifndef LUCENT_MORTON_CUBE
+#define LUCENT_MORTON_CUBE 1
+#endif
+constexpr int kPlocRadius = LUCENT_PLOC_RADIUS;  // neighbours searched on each side
 
 /// Words of GpuBuildParams::counters.
 enum GpuBuildCounter : int {
@@ -200,7 +210,12 @@ __device__ inline void kernel_build_morton(GpuBuildParams p) {
     float3 blo, bhi;
     triangle_box(p, i, blo, bhi);
     const float3 c = 0.5f * (blo + bhi);
+#if LUCENT_MORTON_CUBE
+    const float e = fmaxf(hi.x - lo.x, fmaxf(hi.y - lo.y, hi.z - lo.z));
+    const float3 extent = make_float3(e, e, e);
+#else
     const float3 extent = hi - lo;
+#endif
     auto unit = [](float v, float l, float e) { return e > 0.0f ? (v - l) / e : 0.0f; };
     const unsigned x = quantize(unit(c.x, lo.x, extent.x));
     const unsigned y = quantize(unit(c.y, lo.y, extent.y));
