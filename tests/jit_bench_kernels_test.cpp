@@ -25,17 +25,24 @@ using cuda::GpuTriangleBvh;
 using gpu::GpuHit;
 using namespace test_meshes;
 
-std::string compile_log_or_skip(int sm, const std::vector<std::string>& extra,
-                                cuda::CompileResult& out) {
+/// A request for `source` with the embedded device headers, for sm_90.
+cuda::CompileRequest embedded_request(const char* name, const char* source,
+                                      std::vector<std::string> options) {
     cuda::CompileRequest req;
-    req.name = "lucent_bench_kernels.cu";
-    req.source = "#include \"lucent_gpu/bench_kernels.cuh\"\n";
+    req.name = name;
+    req.source = source;
     for (const cuda::EmbeddedSource& s : cuda::embedded_sources())
         req.headers.emplace_back(std::string(s.name), std::string(s.text));
-    req.options = {"--std=c++17", "--fmad=false"};
-    req.options.insert(req.options.end(), extra.begin(), extra.end());
-    req.sm = sm;
-    out = cuda::compile_cubin(req);
+    req.options = std::move(options);
+    req.sm = 90;
+    return req;
+}
+
+std::string compile_log_or_skip(const std::vector<std::string>& extra, cuda::CompileResult& out) {
+    std::vector<std::string> options = {"--std=c++17", "--fmad=false"};
+    options.insert(options.end(), extra.begin(), extra.end());
+    out = cuda::compile_cubin(embedded_request(
+        "lucent_bench_kernels.cu", "#include \"lucent_gpu/bench_kernels.cuh\"\n", options));
     return out.log;
 }
 
@@ -47,7 +54,7 @@ TEST(jit, bench_kernels) {
     setenv("LUCENT_CACHE_DIR", "off", 1);
     for (const char* persistent : {"-DLUCENT_BENCH_PERSISTENT=1", "-DLUCENT_BENCH_PERSISTENT=0"}) {
         cuda::CompileResult result;
-        const std::string log = compile_log_or_skip(90, {persistent, "--ptxas-options=-v"}, result);
+        const std::string log = compile_log_or_skip({persistent, "--ptxas-options=-v"}, result);
         EXPECT_FALSE(result.cubin.empty()) << persistent;
         EXPECT_FALSE(result.from_cache);
         // Registers and spills of each kernel, for the record.
@@ -63,19 +70,15 @@ TEST(jit, gpu_bvh_builder_kernels) {
     std::string why;
     if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
     setenv("LUCENT_CACHE_DIR", "off", 1);
-    cuda::CompileRequest req;
-    req.name = "lucent_bvh_build.cu";
-    req.source = "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n";
-    for (const cuda::EmbeddedSource& s : cuda::embedded_sources())
-        req.headers.emplace_back(std::string(s.name), std::string(s.text));
-    req.options = {"--std=c++17", "--ptxas-options=-v"};
-    req.sm = 90;
-    const cuda::CompileResult result = cuda::compile_cubin(req);
+    const cuda::CompileResult result = cuda::compile_cubin(embedded_request(
+        "lucent_bvh_build.cu",
+        "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n",
+        {"--std=c++17", "--ptxas-options=-v"}));
     EXPECT_FALSE(result.cubin.empty());
     std::printf("%zu-byte cubin, NVRTC log:\n%s\n", result.cubin.size(), result.log.c_str());
     EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;
-    for (const char* kernel : {"lucent_build_hploc", "lucent_build_emit", "lucent_radix_scatter",
-                               "lucent_refit_nodes"})
+    for (const char* kernel :
+         {"lucent_build_hploc", "lucent_build_emit", "lucent_radix_scatter", "lucent_refit_nodes"})
         EXPECT_NE(result.log.find(kernel), std::string::npos) << kernel;
 }
 

@@ -71,6 +71,17 @@ struct GpuBvhBuilder::Impl {
         return ms;
     }
     void sort(unsigned n);
+    /// Copies host triangles to the device (host_positions, host_indices).
+    DeviceTriangles upload(std::span<const float3> positions, std::span<const uint3> indices) {
+        host_positions.upload(positions);
+        host_indices.upload(indices);
+        DeviceTriangles tris;
+        tris.positions = host_positions.ptr();
+        tris.vertex_count = unsigned(positions.size());
+        tris.indices = indices.empty() ? 0 : host_indices.ptr();
+        tris.triangle_count = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
+        return tris;
+    }
 };
 
 GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
@@ -246,14 +257,7 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
 
 GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<const uint3> indices,
                                  GpuTriangleBvhDevice& out, const GpuBvhBuildOptions& options) {
-    DeviceTriangles tris;
-    m->host_positions.upload(positions);
-    m->host_indices.upload(indices);
-    tris.positions = m->host_positions.ptr();
-    tris.vertex_count = unsigned(positions.size());
-    tris.indices = indices.empty() ? 0 : m->host_indices.ptr();
-    tris.triangle_count = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
-    return build(tris, out, options);
+    return build(m->upload(positions, indices), out, options);
 }
 
 double GpuBvhBuilder::refit(const DeviceTriangles& tris, GpuTriangleBvhDevice& bvh) {
@@ -292,14 +296,7 @@ double GpuBvhBuilder::refit(std::span<const float3> positions, std::span<const u
             throw Error("GPU BVH refit: triangle " + std::to_string(i) +
                         " has a vertex index out of range");
     }
-    m->host_positions.upload(positions);
-    m->host_indices.upload(indices);
-    DeviceTriangles tris;
-    tris.positions = m->host_positions.ptr();
-    tris.vertex_count = unsigned(positions.size());
-    tris.indices = indices.empty() ? 0 : m->host_indices.ptr();
-    tris.triangle_count = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
-    return refit(tris, bvh);
+    return refit(m->upload(positions, indices), bvh);
 }
 
 }  // namespace lucent::cuda
