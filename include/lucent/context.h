@@ -89,7 +89,7 @@ struct LaunchReport {
     };
     std::map<int, ExceptionSummary> exceptions;
     double compile_ms = 0;  // validation, variable resolution, record packing
-    double accel_ms = 0;    // acceleration builds and refits
+    double accel_ms = 0;    // acceleration builds and refits (CUDA: with the GPU layouts')
     double launch_ms = 0;   // running the programs
     bool recompiled = false;
     double jit_ms = 0;  // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)

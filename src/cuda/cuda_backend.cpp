@@ -109,6 +109,7 @@ class CudaBackend final : public core::Backend {
         if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
             if (!m_scene) m_scene = std::make_unique<GpuScene>(m_sm);
             m_scene->update(scene);
+            report.accel_ms += m_scene->accel_ms();  // the GPU layouts (GPU or host builds)
             m_last_scene = &scene;
             m_last_generation = scene.generation;
             prepare_kernel(scene, report);

@@ -1,5 +1,6 @@
 #include "cuda/gpu_scene.h"
 
+#include <chrono>
 #include <cstring>
 #include <set>
 
@@ -126,6 +127,7 @@ gpu::ProgramRef GpuScene::add_program(const core::CompiledProgram& program) {
 }
 
 void GpuScene::update(const core::CompiledScene& scene) {
+    m_accel_ms = 0;
     // Only buffers this compile uses stay mirrored: others may no longer exist.
     m_previous_buffers = std::move(m_buffers);
     m_buffers.clear();
@@ -308,6 +310,7 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
     const core::GeometryAccel& ga = *node.geometry;
     if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
         return;
+    const auto start = std::chrono::steady_clock::now();
     const Acceleration& accel = acceleration_of(node);
     if (accel.builder() == Builder::kGpuHploc) {
         if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
@@ -323,6 +326,8 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
     mirror.empty = ga.indices.empty();
     mirror.structure = ga.structure_signature;
     mirror.content = ga.content_signature;
+    m_accel_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace lucent::cuda

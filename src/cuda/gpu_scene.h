@@ -23,6 +23,8 @@ class GpuScene {
     /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
     /// buffers whose host contents changed.
     void update(const core::CompiledScene& scene);
+    /// Time the last update() spent building or refitting GPU triangle layouts, in ms.
+    double accel_ms() const { return m_accel_ms; }
     /// Uploads buffers changed by the host since the last launch (same compile).
     void sync_buffers();
     /// After a launch: buffers programs may write (output, input-output) are newer on the
@@ -61,6 +63,7 @@ class GpuScene {
     void update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror);
 
     int m_sm;
+    double m_accel_ms = 0;
     std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a Builder::kGpuHploc needs it
     ProgramTable m_programs;
     std::vector<unsigned char> m_records;
