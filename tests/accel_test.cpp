@@ -297,6 +297,22 @@ TEST(TriangleAccel, ClosestAndAnyHitEqualBruteForce) {
     }
 }
 
+TEST(TriangleAccel, FarFromTheOriginEqualsBruteForce) {
+    // The slab test computes plane/d - o/d, whose rounding grows with |o|: a soup (with its
+    // axis-aligned triangles and rays) moved far out must still lose no hit.
+    const float3 offset = make_float3(1.0e5f, -2.0e5f, 3.0e4f);
+    Mesh m = random_soup(21, 2000);
+    for (float3& p : m.positions) p = p + offset;
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices);
+    for (TestRay r : random_rays(77, 1500)) {
+        r.o = r.o + offset;
+        expect_same_closest(m, accel, r);
+        EXPECT_EQ(accel.occluded(r.o, r.d, r.tmin, r.tmax),
+                  brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
+    }
+}
+
 TEST(TriangleAccel, NonIndexedInputAndSmallMeshes) {
     for (int count : {1, 2, 3, 4, 5, 9, 33}) {
         Mesh m = random_soup(50 + count, count);

@@ -24,7 +24,9 @@ namespace {
 // Box far distances are scaled up by 2 ulp so that rounding never culls a box the ray
 // touches (Ize 2013, "Robust BVH ray traversal").
 constexpr float kFarScale = 1.00000024f;
-constexpr int kStackSize = 512;  // 7 pushes per level; wide depth <= binary depth <= 60
+constexpr int kStackSize = 512;
+// The largest |1/d| of the fused slab test: o * (1/d) stays finite for |o| < 3e18.
+constexpr float kMaxInverse = 1e20f;  // 7 pushes per level; wide depth <= binary depth <= 60
 
 float safe_inverse(float d) {
     return d != 0.0f ? 1.0f / d : (std::signbit(d) ? -kInfinity * 1e8f : kInfinity * 1e8f);
@@ -38,7 +40,12 @@ struct RayState {
     WatertightRay wt;
     float tmin;
 #if LUCENT_ACCEL_SIMD
-    __m256 org8[3], rdir8[3], tmin8;
+    // The slab test in its fused form, t = plane * (1/d) - o * (1/d): one FMA per plane.
+    // o * (1/d) is rounded, an absolute error the (plane - o) * (1/d) form does not have,
+    // so near planes subtract o/d + err and far planes o/d - err, err bounding that
+    // rounding with room to spare: the interval only widens (Ize 2013 covers the rest
+    // with kFarScale). 1/d is kept finite (|1/d| <= kMaxInverse) so that o/d is.
+    __m256 rdir8[3], org_rdir_near8[3], org_rdir_far8[3], tmin8;
     __m128 ox4, oy4, oz4, sx4, sy4, sz4, tmin4;
 #endif
     int vx, vy, vz;  // offsets of the permuted axes in TriangleBlock::vertex[v]
@@ -55,8 +62,12 @@ struct RayState {
         vx = 4 * wt.kx, vy = 4 * wt.ky, vz = 4 * wt.kz;
 #if LUCENT_ACCEL_SIMD
         for (int k = 0; k < 3; ++k) {
-            org8[k] = _mm256_set1_ps(org[k]);
-            rdir8[k] = _mm256_set1_ps(rdir[k]);
+            const float r = std::clamp(rdir[k], -kMaxInverse, kMaxInverse);
+            const float od = org[k] * r;
+            const float err = std::fabs(od) * 0x1p-21f;
+            rdir8[k] = _mm256_set1_ps(r);
+            org_rdir_near8[k] = _mm256_set1_ps(od + err);
+            org_rdir_far8[k] = _mm256_set1_ps(od - err);
         }
         tmin8 = _mm256_set1_ps(t0);
         ox4 = _mm_set1_ps(org[wt.kx]);
@@ -76,13 +87,10 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
 #if LUCENT_ACCEL_SIMD
     __m256 tn[3], tf[3];
     for (int k = 0; k < 3; ++k) {
-        // (plane - o) * (1/d), not the fused plane/d - o/d: the fused form's error is absolute
-        // and lets rays through shared vertices on box faces slip past (kFarScale covers
-        // only this form's relative error).
-        tn[k] = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p + r.near_plane[k]), r.org8[k]),
-                              r.rdir8[k]);
-        tf[k] =
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(p + r.far_plane[k]), r.org8[k]), r.rdir8[k]);
+        tn[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir8[k],
+                                r.org_rdir_near8[k]);
+        tf[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir8[k],
+                                r.org_rdir_far8[k]);
     }
     __m256 t_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), _mm256_max_ps(tn[2], r.tmin8));
     __m256 t_far =
