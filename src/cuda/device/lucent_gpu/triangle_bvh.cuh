@@ -12,9 +12,10 @@
 //    loop when too few lanes are still busy and hand the finished lanes new rays.
 //
 // The triangle test is the watertight one of the CPU backend
-// (lucent/device/triangle_intersect.h) and the box test is the CPU's: (plane - o) * (1/d)
-// with the far distance scaled up by 2 ulp (Ize 2013, "Robust BVH ray traversal"), so the
-// GPU finds the same hits as TriangleAccel, bit for bit.
+// (lucent/device/triangle_intersect.h), so the GPU finds the same hits as TriangleAccel, bit
+// for bit. The box test is the CPU's too: plane * (1/d) - o/d in one FMA, o/d widened by a
+// bound on its rounding, the far distance scaled up by 2 ulp (Ize 2013, "Robust BVH ray
+// traversal"): boxes are only ever entered too often, never missed.
 //
 // The file compiles with g++ (host: the layout constants, and the same traversal run on
 // the CPU to check the layout, ARCHITECTURE "one CPU traversal per layout") and with NVRTC.
@@ -48,6 +49,7 @@ constexpr int kGpuMaxLeafSize = 8;
 constexpr int kGpuStackSize = 64;                   // entries; the CPU builder caps depth at 60
 constexpr int kGpuEntrypointSentinel = 0x76543210;  // bottom of the stack (Aila-Laine)
 constexpr float kGpuFarScale = 1.00000024f;         // 1 + 2 ulp, as TriangleAccel (Ize 2013)
+constexpr float kGpuMaxInverse = 1e20f;             // |1/d| at most: o/d stays finite
 
 /// Dynamic fetch (Kepler addendum): a persistent kernel leaves the traversal loop when
 /// fewer lanes than this are still traversing, to refill the finished ones.
@@ -135,8 +137,12 @@ struct GpuBvhStack {
 /// The state of one ray's traversal, all scalars so that it stays in registers. run() may
 /// return before the ray is finished when kDynamicFetch is set; done() says whether it is.
 struct GpuBvhTraversal {
-    float ox, oy, oz;     // origin
-    float idx, idy, idz;  // 1 / direction (signed infinities for zero components)
+    // The slab test in its fused form, as TriangleAccel's: t = plane * (1/d) - o/d, one FMA
+    // per plane. o/d is rounded, so the plane that may be the nearer one subtracts o/d + err
+    // and the farther one o/d - err (err bounds that rounding): boxes only grow.
+    float idx, idy, idz;        // 1 / direction, clamped to +-kGpuMaxInverse
+    float olox, oloy, oloz;     // o/d -+ err for the lo planes
+    float ohix, ohiy, ohiz;     // o/d -+ err for the hi planes
     float tmin, tmax;     // tmax shrinks to the closest accepted hit
     WatertightRay wt;
     int node;  // inner node offset, a leaf (< 0), or the sentinel when done
@@ -145,9 +151,20 @@ struct GpuBvhTraversal {
     int hit_index;  // leaf-order index of the closest accepted hit, -1 for none
     float hit_u, hit_v;
 
+    /// Clamped 1/d, and the o/d terms of the lo and hi planes of one axis.
+    LUCENT_HD static void axis_terms(float o, float d, float& id, float& olo, float& ohi) {
+        id = fminf(fmaxf(1.0f / d, -kGpuMaxInverse), kGpuMaxInverse);  // 1/+-0: +-inf
+        const float od = o * id;
+        const float err = fabsf(od) * 0x1p-21f;  // > the rounding of o * id
+        // A lo plane is the near one when the direction is positive.
+        olo = id >= 0.0f ? od + err : od - err;
+        ohi = id >= 0.0f ? od - err : od + err;
+    }
+
     LUCENT_HD void start(float3 origin, float3 dir, float t0, float t1, GpuBvhStack& stack) {
-        ox = origin.x, oy = origin.y, oz = origin.z;
-        idx = 1.0f / dir.x, idy = 1.0f / dir.y, idz = 1.0f / dir.z;
+        axis_terms(origin.x, dir.x, idx, olox, ohix);
+        axis_terms(origin.y, dir.y, idy, oloy, ohiy);
+        axis_terms(origin.z, dir.z, idz, oloz, ohiz);
         tmin = t0;
         tmax = t1;
         wt = make_watertight_ray(origin, dir);
@@ -170,9 +187,9 @@ struct GpuBvhTraversal {
     /// never entered.
     LUCENT_HD static void slab(float lox, float hix, float loy, float hiy, float loz, float hiz,
                                const GpuBvhTraversal& r, float& t_near, float& t_far) {
-        const float tlx = (lox - r.ox) * r.idx, thx = (hix - r.ox) * r.idx;
-        const float tly = (loy - r.oy) * r.idy, thy = (hiy - r.oy) * r.idy;
-        const float tlz = (loz - r.oz) * r.idz, thz = (hiz - r.oz) * r.idz;
+        const float tlx = fmaf(lox, r.idx, -r.olox), thx = fmaf(hix, r.idx, -r.ohix);
+        const float tly = fmaf(loy, r.idy, -r.oloy), thy = fmaf(hiy, r.idy, -r.ohiy);
+        const float tlz = fmaf(loz, r.idz, -r.oloz), thz = fmaf(hiz, r.idz, -r.ohiz);
         const bool px = r.idx >= 0.0f, py = r.idy >= 0.0f, pz = r.idz >= 0.0f;
         const float nx = px ? tlx : thx, fx = px ? thx : tlx;
         const float ny = py ? tly : thy, fy = py ? thy : tly;
