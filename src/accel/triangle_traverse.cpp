@@ -202,12 +202,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
               float tmax, TriangleHit* hit, HitDecision (*thunk)(void*, const TriangleHit&),
               void* filter) {
     const RayState r(origin, direction, tmin);
-    // Page-aligned, so that where the traversal's locals fall within a page no longer
-    // depends on where the OS put the thread's stack: with some placements the stores to
-    // these arrays alias (4K aliasing) with the loads of the traversal, and occlusion
-    // queries ran 40 % slower in about half of all processes (disabling address
-    // randomization made it go away; docs/performance.md).
-    alignas(4096) uint32_t stack_ref[kStackSize];
+    uint32_t stack_ref[kStackSize];
     float stack_dist[kStackSize];
     int sp = 0;
     uint32_t ref = 0;
