@@ -180,6 +180,8 @@ int run_bench_rays_command(const BenchRaysArgs& args) {
 }
 
 int run_bench_build_command(const BenchBuildArgs& args) {
+    // Flags first (usage errors), then the file (a runtime error).
+    const Size size = parse_size("--size", args.size.empty() ? "3840x2160" : args.size);
     check_scene_file(args.scene);
     bench::BuildBenchOptions options;
     options.scene = args.scene;
@@ -189,7 +191,6 @@ int run_bench_build_command(const BenchBuildArgs& args) {
     options.json = args.json;
     options.backend = bench_backend(args.backend);
     options.subdivide = args.subdivide;
-    const Size size = parse_size("--size", args.size.empty() ? "3840x2160" : args.size);
     options.width = size.width;
     options.height = size.height;
     return bench::run_bench_build(options);

@@ -239,3 +239,25 @@ TEST(CliBenchIgi, BadVplCountNamesTheFlagAndRange) {
 }
 
 }  // namespace
+
+TEST_F(CliTest, BenchBuildSubdivideCutsEveryTriangleIntoFourPerLevel) {
+    {
+        std::ofstream obj(path("quad.obj"));
+        obj << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+    }
+    CliRun run = run_cli("bench build --scene '" + path("quad.obj") +
+                         "' --subdivide 2 --repeat 1 --no-peer --json");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("\"triangles\": 32"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, BenchBuildBadSubdivideOrSizeNamesTheFlag) {
+    CliRun run = run_cli("bench build --scene '" + path("scene.obj") + "' --subdivide 9");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--subdivide"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("0 to 5"), std::string::npos) << run.output;
+    run = run_cli("bench build --scene '" + path("scene.obj") + "' --size 0x5");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
+    EXPECT_TRUE(dir_is_empty());
+}
