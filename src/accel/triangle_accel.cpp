@@ -1,6 +1,7 @@
 // TriangleAccel: build (binned SAH over triangle boxes), collapse of the binary tree into
 // 8-wide nodes with SoA leaves, and refit. The queries are in triangle_traverse.cpp.
 #include <algorithm>
+#include <array>
 #include <chrono>
 
 #include "accel/triangle_accel.h"
@@ -36,9 +37,11 @@ float half_area(float3 lo, float3 hi) {
     return d.x * d.y + d.y * d.z + d.z * d.x;
 }
 
-/// Depth-first emission of the wide tree: each node takes the two children of a binary
-/// node and repeatedly opens its largest internal child until it has kWideArity children
-/// (the collapse of Wald, Benthin and Boulos 2008, "Getting rid of packets").
+/// Depth-first emission of the wide tree. Which binary nodes become the children of a wide
+/// node is chosen to minimise the SAH cost of the wide tree, by dynamic programming over the
+/// binary tree (the optimal collapse of Ylitie, Karras and Laine 2017, Sec. 3.1, without its
+/// leaf formation: the binary leaves stay the leaves): cover[n][k] is the least cost of
+/// standing in for binary node n with at most k subtrees, each a leaf or a wide node.
 struct Collapser {
     const Bvh& binary;
     std::span<const float3> vertices;
@@ -46,6 +49,63 @@ struct Collapser {
     std::vector<WideNode>& nodes;
     std::vector<TriangleBlock>& blocks;
     unsigned max_depth = 0;
+    // cover[n][k], k = 1..kWideArity; split[n][k]: subtrees given to n's first child, or 0
+    // when n stands as one subtree itself.
+    std::vector<std::array<float, kWideArity + 1>> cover;
+    std::vector<std::array<uint8_t, kWideArity + 1>> split;
+
+    /// The least cost of a wide node over binary node n: its children split among n's two.
+    float best_children(uint32_t n, int& left_share) const {
+        const BvhNode& b = binary.nodes()[n];
+        float best = kInfinity;
+        left_share = 1;
+        for (int j = 1; j < kWideArity; ++j) {
+            const float c = cover[b.first][j] + cover[b.first + 1][kWideArity - j];
+            if (c < best) best = c, left_share = j;
+        }
+        return best;
+    }
+
+    /// Fills cover and split bottom-up (children have larger indices than their parent).
+    /// Costs: 1 per wide node entered, 1 per block of four triangles, times the area.
+    void plan() {
+        const auto& bn = binary.nodes();
+        cover.assign(bn.size(), {});
+        split.assign(bn.size(), {});
+        for (size_t i = bn.size(); i-- > 0;) {
+            const BvhNode& b = bn[i];
+            const float area = std::max(half_area(b.lo, b.hi), 0.0f);
+            if (b.count > 0) {
+                const float leaf =
+                    area * float((b.count + kMaxBlockTriangles - 1) / kMaxBlockTriangles);
+                cover[i].fill(leaf);
+                continue;
+            }
+            int share;
+            const float self = area + best_children(uint32_t(i), share);
+            cover[i][1] = self;
+            for (int k = 2; k <= kWideArity; ++k) {
+                cover[i][k] = self;
+                split[i][k] = 0;
+                for (int j = 1; j < k; ++j) {
+                    const float c = cover[b.first][j] + cover[b.first + 1][k - j];
+                    if (c < cover[i][k]) cover[i][k] = c, split[i][k] = uint8_t(j);
+                }
+            }
+        }
+    }
+
+    /// The subtrees that stand in for binary node n with at most k of them.
+    void collect(uint32_t n, int k, uint32_t* kids, int& count) const {
+        const int j = split[n][k];
+        if (j == 0) {
+            kids[count++] = n;
+            return;
+        }
+        const uint32_t first = binary.nodes()[n].first;
+        collect(first, j, kids, count);
+        collect(first + 1, k - j, kids, count);
+    }
 
     uint32_t emit_leaf(const BvhNode& leaf) {
         uint32_t index = (uint32_t)blocks.size();
@@ -71,24 +131,12 @@ struct Collapser {
         uint32_t kids[kWideArity];
         int n = 0;
         if (bn[bnode].count > 0) {
-            kids[n++] = bnode;
+            kids[n++] = bnode;  // a tree of one leaf
         } else {
-            kids[n++] = bn[bnode].first;
-            kids[n++] = bn[bnode].first + 1;
-        }
-        while (n < kWideArity) {
-            int best = -1;
-            float best_area = -1.0f;
-            for (int i = 0; i < n; ++i) {
-                const BvhNode& c = bn[kids[i]];
-                if (c.count > 0) continue;
-                float a = half_area(c.lo, c.hi);
-                if (a > best_area) best_area = a, best = i;
-            }
-            if (best < 0) break;
-            uint32_t first = bn[kids[best]].first;
-            kids[best] = first;
-            kids[n++] = first + 1;
+            int share;
+            best_children(bnode, share);
+            collect(bn[bnode].first, share, kids, n);
+            collect(bn[bnode].first + 1, kWideArity - share, kids, n);
         }
         const uint32_t me = (uint32_t)nodes.size();
         nodes.emplace_back();
@@ -134,6 +182,7 @@ void TriangleAccel::Impl::collapse(std::span<const float3> vertices,
     nodes.reserve(binary.nodes().size() / 4 + 1);
     blocks.reserve(binary.nodes().size() / 2 + 1);
     Collapser c{binary, vertices, indices, nodes, blocks};
+    c.plan();
     c.emit_node(0, 1);
     wide_depth = c.max_depth;
 }
