@@ -541,6 +541,31 @@ TEST_F(RefitTest, GpuBuilderAndItsRefitGiveTheSameHits) {
     refit_and_rebuild(Builder::kGpuHploc);
 }
 
+TEST_F(RefitTest, GpuBuilderTakesAChainOfTriangles) {
+    // Triangles in a geometric progression make agglomerative builds chain: the GPU build
+    // must stay within the traversal stack, or the CUDA backend fall back to its host build
+    // (GpuBvhTooDeep); either way every triangle is found.
+    std::vector<float3> vertices;
+    std::vector<CastRay> rays;
+    for (int i = 0; i < 150; ++i) {
+        const float x = std::pow(1.2f, float(i)), s = 0.1f * x;
+        vertices.insert(vertices.end(), {make_float3(x, 0, 0), make_float3(x + s, 0, 0),
+                                         make_float3(x, s, 0)});
+        rays.push_back(along_z(x + 0.02f * x, 0.02f * x));
+    }
+    auto gg = make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, vertices),
+                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)),
+                                          1))});
+    gg->acceleration()->set_builder(Builder::kGpuHploc);
+    const auto hits = cast(gg, rays);
+    for (size_t r = 0; r < rays.size(); ++r) {
+        ASSERT_EQ(hits[r].hit, 1) << "ray " << r;
+        EXPECT_EQ(hits[r].prim, unsigned(r)) << "ray " << r;
+        EXPECT_NEAR(hits[r].t, 20.0f, 1e-3f) << "ray " << r;
+    }
+}
+
 TEST_F(RefitTest, MixedTrianglesAndSpheresHitTheSameWithAndWithoutAHierarchy) {
     // One geometry group holding a triangle grid and a row of spheres (the generic path
     // that mixes built-in and custom primitives), traced with Builder::kBinnedSah and kNone.

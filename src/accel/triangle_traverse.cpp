@@ -25,8 +25,10 @@ namespace {
 // touches (Ize 2013, "Robust BVH ray traversal").
 constexpr float kFarScale = 1.00000024f;
 constexpr int kStackSize = 512;
-// The largest |1/d| of the fused slab test: o * (1/d) stays finite for |o| < 3e18.
-constexpr float kMaxInverse = 1e20f;  // 7 pushes per level; wide depth <= binary depth <= 60
+// The largest |1/d| of the fused slab test, and the largest |o * (1/d)|: 1/d is clamped to
+// both, so o/d stays finite wherever the origin is (far beyond any t a ray asks about).
+constexpr float kMaxInverse = 1e20f;
+constexpr float kMaxOverInverse = 1e37f;  // 7 pushes per level; wide depth <= binary depth <= 60
 
 float safe_inverse(float d) {
     return d != 0.0f ? 1.0f / d : (std::signbit(d) ? -kInfinity * 1e8f : kInfinity * 1e8f);
@@ -62,7 +64,9 @@ struct RayState {
         vx = 4 * wt.kx, vy = 4 * wt.ky, vz = 4 * wt.kz;
 #if LUCENT_ACCEL_SIMD
         for (int k = 0; k < 3; ++k) {
-            const float r = std::clamp(rdir[k], -kMaxInverse, kMaxInverse);
+            const float limit =
+                std::min(kMaxInverse, kMaxOverInverse / std::max(std::fabs(org[k]), 1.0f));
+            const float r = std::clamp(rdir[k], -limit, limit);
             const float od = org[k] * r;
             const float err = std::fabs(od) * 0x1p-21f;
             rdir8[k] = _mm256_set1_ps(r);
@@ -87,10 +91,9 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
 #if LUCENT_ACCEL_SIMD
     __m256 tn[3], tf[3];
     for (int k = 0; k < 3; ++k) {
-        tn[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir8[k],
-                                r.org_rdir_near8[k]);
-        tf[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir8[k],
-                                r.org_rdir_far8[k]);
+        tn[k] =
+            _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir8[k], r.org_rdir_near8[k]);
+        tf[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir8[k], r.org_rdir_far8[k]);
     }
     __m256 t_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), _mm256_max_ps(tn[2], r.tmin8));
     __m256 t_far =

@@ -228,6 +228,13 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
         throw Error("GPU BVH builder: triangle " + std::to_string(counters[gpu::kCounterBadIndex]) +
                     " has a vertex index out of range (" + std::to_string(tris.vertex_count) +
                     " vertices)");
+    const auto too_deep = [&](const std::string& depth) {
+        return GpuBvhTooDeep(
+            "GPU BVH builder: a tree " + depth + " levels deep for " + std::to_string(n) +
+            " triangles, more than the traversal stack holds (" +
+            std::to_string(gpu::kGpuStackSize) + "); build this mesh with the host SAH builder");
+    };
+    if (counters[gpu::kCounterFault] == gpu::kFaultDeepTree) throw too_deep("at least 64");
     if (counters[gpu::kCounterFault] != gpu::kFaultNone)
         throw Error("GPU BVH builder: internal error " +
                     std::to_string(counters[gpu::kCounterFault]) + " (GpuBuildFault) for " +
@@ -239,9 +246,7 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
                     std::to_string(n) + " triangles");
     stats.depth = counters[gpu::kCounterDepth];
     if (stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)
-        throw Error("GPU BVH builder: depth " + std::to_string(stats.depth) +
-                    " exceeds the traversal stack (" + std::to_string(gpu::kGpuStackSize) +
-                    "); build this mesh with the host SAH builder");
+        throw too_deep(std::to_string(stats.depth));
     stats.node_count = counters[gpu::kCounterInner];
     if (stats.node_count > out_nodes)
         throw Error("GPU BVH builder: internal error, " + std::to_string(stats.node_count) +

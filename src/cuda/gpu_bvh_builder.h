@@ -10,6 +10,7 @@
 #include <span>
 
 #include "cuda/gpu_triangle_bvh.h"
+#include "lucent/error.h"
 
 namespace lucent::cuda {
 
@@ -20,6 +21,13 @@ struct DeviceTriangles {
     unsigned vertex_count = 0;
     CUdeviceptr indices = 0;
     unsigned triangle_count = 0;
+};
+
+/// A tree deeper than the GPU traversal stack: agglomerative builds can chain (triangles in a
+/// geometric progression do); the host SAH builder bounds its depth and can take the mesh.
+class GpuBvhTooDeep : public Error {
+  public:
+    using Error::Error;
 };
 
 /// One builder per CUDA context (it holds that context's module and scratch memory); use it
@@ -34,8 +42,8 @@ class GpuBvhBuilder {
 
     /// Builds over triangles already on the device, into `out` (its buffers are reused when
     /// big enough). stats.build_ms is the GPU time of the build kernels (CUDA events).
-    /// Throws lucent::Error for an index out of range (naming the triangle) or a tree too
-    /// deep for the traversal stack.
+    /// Throws lucent::Error for an index out of range (naming the triangle), GpuBvhTooDeep for
+    /// a tree too deep for the traversal stack.
     GpuBvhStats build(const DeviceTriangles& triangles, GpuTriangleBvhDevice& out,
                       const GpuBvhBuildOptions& options = {});
     /// Uploads host triangles (indices may be empty), then builds as above.

@@ -316,10 +316,18 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
         if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
                            mirror.bvh.triangle_count == ga.indices.size();
-        if (refit)
+        if (refit) {
             m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
-        else
-            m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh);
+        } else {
+            try {
+                m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh);
+            } catch (const GpuBvhTooDeep&) {
+                // A chain of clusters deeper than the traversal stack: the host SAH build
+                // bounds its depth (refits keep that tree's topology).
+                upload_gpu_triangle_bvh(build_gpu_triangle_bvh(ga.vertices, ga.indices),
+                                        mirror.bvh);
+            }
+        }
     } else {
         upload_gpu_triangle_bvh(build_gpu_triangle_bvh(ga.vertices, ga.indices), mirror.bvh);
     }

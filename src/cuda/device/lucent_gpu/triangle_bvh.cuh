@@ -49,7 +49,8 @@ constexpr int kGpuMaxLeafSize = 8;
 constexpr int kGpuStackSize = 64;                   // entries; the CPU builder caps depth at 60
 constexpr int kGpuEntrypointSentinel = 0x76543210;  // bottom of the stack (Aila-Laine)
 constexpr float kGpuFarScale = 1.00000024f;         // 1 + 2 ulp, as TriangleAccel (Ize 2013)
-constexpr float kGpuMaxInverse = 1e20f;             // |1/d| at most: o/d stays finite
+constexpr float kGpuMaxInverse = 1e20f;             // |1/d| at most
+constexpr float kGpuMaxOverInverse = 1e37f;         // |o/d| at most
 
 /// Dynamic fetch (Kepler addendum): a persistent kernel leaves the traversal loop when
 /// fewer lanes than this are still traversing, to refill the finished ones.
@@ -140,10 +141,10 @@ struct GpuBvhTraversal {
     // The slab test in its fused form, as TriangleAccel's: t = plane * (1/d) - o/d, one FMA
     // per plane. o/d is rounded, so the plane that may be the nearer one subtracts o/d + err
     // and the farther one o/d - err (err bounds that rounding): boxes only grow.
-    float idx, idy, idz;        // 1 / direction, clamped to +-kGpuMaxInverse
-    float olox, oloy, oloz;     // o/d -+ err for the lo planes
-    float ohix, ohiy, ohiz;     // o/d -+ err for the hi planes
-    float tmin, tmax;     // tmax shrinks to the closest accepted hit
+    float idx, idy, idz;     // 1 / direction, clamped to +-kGpuMaxInverse
+    float olox, oloy, oloz;  // o/d -+ err for the lo planes
+    float ohix, ohiy, ohiz;  // o/d -+ err for the hi planes
+    float tmin, tmax;        // tmax shrinks to the closest accepted hit
     WatertightRay wt;
     int node;  // inner node offset, a leaf (< 0), or the sentinel when done
     int leaf;  // a postponed leaf (< 0), or >= 0 for none
@@ -153,7 +154,9 @@ struct GpuBvhTraversal {
 
     /// Clamped 1/d, and the o/d terms of the lo and hi planes of one axis.
     LUCENT_HD static void axis_terms(float o, float d, float& id, float& olo, float& ohi) {
-        id = fminf(fmaxf(1.0f / d, -kGpuMaxInverse), kGpuMaxInverse);  // 1/+-0: +-inf
+        // 1/+-0 is +-inf: clamped so that o/d stays finite wherever the origin is.
+        const float limit = fminf(kGpuMaxInverse, kGpuMaxOverInverse / fmaxf(fabsf(o), 1.0f));
+        id = fminf(fmaxf(1.0f / d, -limit), limit);
         const float od = o * id;
         const float err = fabsf(od) * 0x1p-21f;  // > the rounding of o * id
         // A lo plane is the near one when the direction is positive.
