@@ -351,6 +351,73 @@ TEST(TriangleAccel, FilterIgnoringOddPrimitivesEqualsBruteForceWithoutThem) {
     }
 }
 
+/// A floor of two big triangles under many small ones: the floor overlaps everything, so
+/// object splits cannot separate it and spatial splits pay (the case of Sponza's floors).
+Mesh floor_and_clutter(uint32_t seed, int count) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    Mesh m;
+    m.positions = {make_float3(0, 0, 0), make_float3(10, 0, 0), make_float3(10, 10, 0),
+                   make_float3(0, 10, 0)};
+    m.indices = {make_uint3(0, 1, 2), make_uint3(0, 2, 3)};
+    for (int i = 0; i < count; ++i) {
+        const float3 a = make_float3(10 * uni(rng), 10 * uni(rng), 0.5f * uni(rng));
+        const uint32_t base = (uint32_t)m.positions.size();
+        m.positions.insert(m.positions.end(), {a, a + make_float3(0.2f * uni(rng), 0.1f, 0.0f),
+                                               a + make_float3(0.0f, 0.2f * uni(rng), 0.2f)});
+        m.indices.push_back(make_uint3(base, base + 1, base + 2));
+    }
+    return m;
+}
+
+TEST(Bvh, SpatialSplitsDuplicateReferencesWithinTheBudgetAndBoundTheirTriangles) {
+    const Mesh m = floor_and_clutter(5, 600);
+    std::vector<Aabb> boxes;
+    for (const uint3 t : m.indices) {
+        const float3 a = m.positions[t.x], b = m.positions[t.y], c = m.positions[t.z];
+        boxes.push_back({fminf(a, fminf(b, c)), fmaxf(a, fmaxf(b, c))});
+    }
+    const SplitTriangles split{m.positions, m.indices};
+    Bvh bvh;
+    bvh.build(boxes, {}, nullptr, &split);
+    size_t references = 0;
+    std::vector<int> seen(m.indices.size(), 0);
+    for (const BvhNode& node : bvh.nodes()) {
+        if (node.count == 0) continue;
+        references += node.count;
+        for (uint32_t k = 0; k < node.count; ++k) ++seen[bvh.prim_order()[node.first + k]];
+    }
+    EXPECT_GT(references, m.indices.size()) << "no reference was split";
+    EXPECT_LE(references, m.indices.size() + size_t(split.budget * m.indices.size()));
+    for (int count : seen) EXPECT_GE(count, 1);  // every triangle is somewhere
+}
+
+TEST(TriangleAccel, WithoutSpatialSplitsAFilterSeesEachTriangleOnce) {
+    // Spatial splits may offer a triangle twice; groups with any-hit programs build without.
+    const Mesh m = floor_and_clutter(6, 800);
+    BuildOptions options;
+    options.spatial_splits = false;
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices, options);
+    for (const TestRay& r : random_rays(8, 500)) {
+        std::vector<int> offered(m.indices.size(), 0);
+        TriangleHit hit;
+        accel.intersect_filtered(r.o, r.d, r.tmin, r.tmax, hit, [&](const TriangleHit& c) {
+            ++offered[c.prim];
+            return HitDecision::kIgnore;
+        });
+        for (int n : offered) ASSERT_LE(n, 1);
+    }
+    // With them (the default), every hit is still brute force's.
+    TriangleAccel split;
+    split.build(m.positions, m.indices);
+    for (const TestRay& r : random_rays(9, 500)) {
+        expect_same_closest(m, split, r);
+        EXPECT_EQ(split.occluded(r.o, r.d, r.tmin, r.tmax),
+                  brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
+    }
+}
+
 TEST(TriangleAccel, AcceptAndStopEndsTheSearch) {
     Mesh m = random_soup(31, 2500);
     TriangleAccel accel;

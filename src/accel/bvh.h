@@ -16,6 +16,19 @@ struct BuildOptions {
     int max_leaf_size = 4;  // primitives per leaf at most
     float traversal_cost = 1.0f;
     float intersection_cost = 1.0f;
+    // TriangleAccel: split space too, not only the triangles (see SplitTriangles). Off where
+    // an any-hit program must see each triangle once per ray.
+    bool spatial_splits = true;
+};
+
+/// Triangles behind the boxes of a build, for spatial splits (Stich, Friedrich and Dietrich
+/// 2009, "Spatial splits in bounding volume hierarchies"): box i is triangle i (indices may
+/// be empty: then triangle i is vertices 3i .. 3i + 2). A triangle may then sit in several
+/// leaves, so a filtered traversal may offer it more than once.
+struct SplitTriangles {
+    std::span<const float3> vertices;
+    std::span<const uint3> indices;
+    float budget = 0.25f;  // at most this many references more than triangles, per triangle
 };
 
 struct BuildStats {
@@ -37,9 +50,10 @@ struct BvhNode {
 
 class Bvh {
   public:
-    /// Builds over one box per primitive. Empty input gives an empty tree.
+    /// Builds over one box per primitive. Empty input gives an empty tree. With `split`,
+    /// the boxes are triangles' and nodes may also split space, duplicating references.
     void build(std::span<const Aabb> boxes, const BuildOptions& options = {},
-               BuildStats* stats = nullptr);
+               BuildStats* stats = nullptr, const SplitTriangles* split = nullptr);
     /// Recomputes node boxes bottom-up for moved primitives (same count, same order).
     void refit(std::span<const Aabb> boxes);
 

@@ -206,7 +206,8 @@ void TriangleAccel::build(std::span<const float3> vertices, std::span<const uint
     opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, (int)kMaxBlockTriangles);
     BuildStats binary_stats;
     m_impl->binary.m_block_size = kMaxBlockTriangles;
-    m_impl->binary.build(boxes, opt, &binary_stats);
+    const SplitTriangles split{vertices, indices};
+    m_impl->binary.build(boxes, opt, &binary_stats, opt.spatial_splits ? &split : nullptr);
     m_impl->sah_cost = binary_stats.sah_cost;
     m_impl->collapse(vertices, indices);
     if (stats) {

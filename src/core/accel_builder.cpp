@@ -98,6 +98,11 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         }
     }
     structure.add(accel.builder());
+    // Spatial splits may put a triangle in several leaves, and an any-hit program would then
+    // be offered it more than once per ray: only groups without any-hit programs get them.
+    bool any_hit = false;
+    for (bool a : node.any_hit_for_ray_type) any_hit = any_hit || a;
+    structure.add(any_hit);
     const bool same_structure = ga.structure_signature == structure.h;
     const bool same_content = ga.content_signature == content.h;
     node.geometry = cached;
@@ -137,10 +142,12 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
             for (const uint3 t : ga.indices)
                 for (unsigned v : {t.x, t.y, t.z}) grow(ga.bounds, ga.vertices[v]);
         } else {
+            accel::BuildOptions options;
+            options.spatial_splits = !any_hit;
             if (refit)
                 ga.triangles.refit(ga.vertices, ga.indices);
             else
-                ga.triangles.build(ga.vertices, ga.indices);
+                ga.triangles.build(ga.vertices, ga.indices, options);
             ga.bounds = ga.triangles.triangle_count() ? ga.triangles.bounds() : empty_box();
         }
         ga.host_triangles = host_triangles;
