@@ -1,9 +1,9 @@
 // The GPU triangle BVH builder: H-PLOC (Benthin, Meister, Barczak, Mehalwal, Tsakok and
 // Kensler 2024, "H-PLOC: Hierarchical Parallel Locally-Ordered Clustering for Bounding
 // Volume Hierarchy Construction", HPG 2024), writing the layout of triangle_bvh.cuh
-// directly, and its refit. Compiled by NVRTC (src/cuda/gpu_bvh_builder.cpp launches it).
+// directly. Compiled by NVRTC (src/cuda/gpu_bvh_builder.cpp launches it).
 //
-// The passes, one kernel each:
+// The passes, one kernel each (after lucent_build_reset, which clears the counters):
 //  1. lucent_build_bounds:  the box of the triangle centroids (ordered-integer atomics).
 //  2. lucent_build_morton:  a 30-bit Morton code per triangle (Karras 2012, Sec. 4).
 //  3. lucent_radix_*:       a stable LSD radix sort of (code, triangle), 8 bits a pass.
@@ -40,7 +40,7 @@ constexpr int kPlocClusters = 16;  // clusters a subtree keeps: two halves fill 
 // Morton cells: cubes (one scale for the three axes, the largest extent), or 0 for boxes
 // stretched to the scene's extent on each axis. Cubes keep the code order spatially even in
 // long scenes (Sponza, Sibenik): on the H200, the worst of 18 trace ratios against the host
-// SAH tree rose from 0.825x to 0.852x (docs/performance.md).
+// SAH tree rose from 0.825x to 0.845x-0.852x (docs/performance.md).
 #ifndef LUCENT_MORTON_CUBE
 #define LUCENT_MORTON_CUBE 1
 #endif
@@ -55,7 +55,7 @@ enum GpuBuildCounter : int {
     kCounterBounds = 4,    // 6 words: centroid lo.xyz, hi.xyz as ordered integers
     kCounterSah = 10,      // SAH cost of the emitted tree, as float bits
     kCounterInner = 11,    // inner nodes emitted
-    kCounterFault = 12,    // 0, or the first GpuBuildFault a kernel met (a bug, never input)
+    kCounterFault = 12,    // 0, or the first GpuBuildFault a kernel met
     kCounterCount = 13
 };
 
@@ -64,7 +64,8 @@ enum GpuBuildFault : unsigned {
     kFaultNone = 0,
     kFaultNoMutualPair = 1,  // PLOC found no pair to merge
     kFaultNodeOverflow = 2,  // more than N - 1 inner nodes
-    kFaultDeepTree = 3,      // a walk to the root longer than the traversal stack
+    kFaultDeepTree = 3,      // a walk to the root longer than the traversal stack (input
+                             // can do this: GpuBvhTooDeep, the host builds it instead)
     kFaultLeafTooBig = 4,    // a leaf subtree with more than kGpuMaxLeafSize triangles
 };
 
