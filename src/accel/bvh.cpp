@@ -167,16 +167,21 @@ struct Builder {
         uint32_t left_count = 0, right_count = 0;
     };
 
-    /// The best spatial split of refs[begin, end) within `bounds`: 16 bins per axis, a
+    /// The best spatial split of refs[begin, end) within `bounds`: 16 bins, a
     /// reference counted where it enters and where it leaves, its clipped part in each bin.
     SpatialSplit find_spatial_split(uint32_t begin, uint32_t end, const BvhNode& bounds) const {
         constexpr int kBins = 16;
         SpatialSplit best;
         const float lo3[3] = {bounds.lo.x, bounds.lo.y, bounds.lo.z};
         const float hi3[3] = {bounds.hi.x, bounds.hi.y, bounds.hi.z};
+        // Along the longest axis only: the other two cost twice the build time and, over
+        // four interleaved A/B rounds on Sponza and Sibenik, bought no measurable speed.
+        int longest = 0;
+        for (int j = 1; j < 3; ++j)
+            if (hi3[j] - lo3[j] > hi3[longest] - lo3[longest]) longest = j;
         for (int k = 0; k < 3; ++k) {
             const float extent = hi3[k] - lo3[k];
-            if (!(extent > 0.0f)) continue;
+            if (!(extent > 0.0f) || k != longest) continue;
             const float width = extent / kBins, inv = kBins / extent;
             Box box[kBins];
             uint32_t enter[kBins] = {}, leave[kBins] = {};
