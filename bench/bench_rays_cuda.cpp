@@ -13,7 +13,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
-#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -21,7 +20,6 @@
 #include "cuda/device/lucent_gpu/ray_order.cuh"
 #include "cuda/device_buffer.h"
 #include "cuda/driver_api.h"
-#include "cuda/embedded_sources.h"
 #include "cuda/gpu_bvh_builder.h"
 #include "cuda/gpu_triangle_bvh.h"
 #include "cuda/nvrtc_compiler.h"
@@ -106,14 +104,6 @@ class Event {
     CUevent m_event = nullptr;
 };
 
-std::vector<std::string> split_options(const char* text) {
-    std::vector<std::string> out;
-    if (!text) return out;
-    std::istringstream in(text);
-    for (std::string word; in >> word;) out.push_back(word);
-    return out;
-}
-
 bool env_flag(const char* name, bool fallback) {
     const char* v = std::getenv(name);
     if (!v || !*v) return fallback;
@@ -185,18 +175,14 @@ struct BenchKernels {
 };
 
 CompileResult compile_bench_kernels(int sm, bool persistent) {
-    CompileRequest req;
-    req.name = "lucent_bench_kernels.cu";
-    req.source = "#include \"lucent_gpu/bench_kernels.cuh\"\n";
-    for (const EmbeddedSource& s : embedded_sources())
-        req.headers.emplace_back(std::string(s.name), std::string(s.text));
     // --fmad=false: ray generation rounds each operation as the host does; traversal and the
     // watertight test already spell out every fused multiply-add they use (fmaf).
-    req.options = {"--std=c++17", "--fmad=false",
-                   "-DLUCENT_BENCH_PERSISTENT=" + std::string(persistent ? "1" : "0")};
-    for (std::string& o : split_options(std::getenv("LUCENT_BENCH_NVRTC_OPTIONS")))
-        req.options.push_back(std::move(o));
-    req.sm = sm;
+    CompileRequest req =
+        embedded_request("lucent_bench_kernels.cu", "#include \"lucent_gpu/bench_kernels.cuh\"\n",
+                         {"--std=c++17", "--fmad=false",
+                          "-DLUCENT_BENCH_PERSISTENT=" + std::string(persistent ? "1" : "0")},
+                         sm);
+    add_options_from_env(req, "LUCENT_BENCH_NVRTC_OPTIONS");
     return compile_cubin(req);
 }
 

@@ -11,7 +11,6 @@
 
 #include "accel/triangle_accel.h"
 #include "cuda/device/lucent_gpu/ray_order.cuh"
-#include "cuda/embedded_sources.h"
 #include "cuda/gpu_triangle_bvh.h"
 #include "cuda/nvrtc_compiler.h"
 #include "lucent/device/triangle_intersect.h"
@@ -25,24 +24,11 @@ using cuda::GpuTriangleBvh;
 using gpu::GpuHit;
 using namespace test_meshes;
 
-/// A request for `source` with the embedded device headers, for sm_90.
-cuda::CompileRequest embedded_request(const char* name, const char* source,
-                                      std::vector<std::string> options) {
-    cuda::CompileRequest req;
-    req.name = name;
-    req.source = source;
-    for (const cuda::EmbeddedSource& s : cuda::embedded_sources())
-        req.headers.emplace_back(std::string(s.name), std::string(s.text));
-    req.options = std::move(options);
-    req.sm = 90;
-    return req;
-}
-
 std::string compile_log_or_skip(const std::vector<std::string>& extra, cuda::CompileResult& out) {
     std::vector<std::string> options = {"--std=c++17", "--fmad=false"};
     options.insert(options.end(), extra.begin(), extra.end());
-    out = cuda::compile_cubin(embedded_request(
-        "lucent_bench_kernels.cu", "#include \"lucent_gpu/bench_kernels.cuh\"\n", options));
+    out = cuda::compile_cubin(cuda::embedded_request(
+        "lucent_bench_kernels.cu", "#include \"lucent_gpu/bench_kernels.cuh\"\n", options, 90));
     return out.log;
 }
 
@@ -70,10 +56,10 @@ TEST(jit, gpu_bvh_builder_kernels) {
     std::string why;
     if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
     setenv("LUCENT_CACHE_DIR", "off", 1);
-    const cuda::CompileResult result = cuda::compile_cubin(embedded_request(
+    const cuda::CompileResult result = cuda::compile_cubin(cuda::embedded_request(
         "lucent_bvh_build.cu",
         "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n",
-        {"--std=c++17", "--ptxas-options=-v"}));
+        {"--std=c++17", "--ptxas-options=-v"}, 90));
     EXPECT_FALSE(result.cubin.empty());
     std::printf("%zu-byte cubin, NVRTC log:\n%s\n", result.cubin.size(), result.log.c_str());
     EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;

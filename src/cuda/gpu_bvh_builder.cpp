@@ -4,14 +4,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <sstream>
 #include <string>
-#include <vector>
 
 #include "cuda/device/lucent_gpu/bvh_build.cuh"
 #include "cuda/device/lucent_gpu/bvh_refit.cuh"
 #include "cuda/driver_api.h"
-#include "cuda/embedded_sources.h"
 #include "cuda/nvrtc_compiler.h"
 #include "lucent/error.h"
 
@@ -85,20 +82,14 @@ struct GpuBvhBuilder::Impl {
 };
 
 GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
-    CompileRequest req;
-    req.name = "lucent_bvh_build.cu";
-    req.source = "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n";
-    for (const EmbeddedSource& s : embedded_sources())
-        req.headers.emplace_back(std::string(s.name), std::string(s.text));
-    req.options = {"--std=c++17"};
+    CompileRequest req = embedded_request(
+        "lucent_bvh_build.cu",
+        "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n",
+        {"--std=c++17"}, sm);
     if (const char* debug = std::getenv("LUCENT_GPU_BUILD_DEBUG"); debug && *debug)
         req.options.push_back("-DLUCENT_BUILD_DEBUG=1");  // the kernels print what they do
     // Experiments: e.g. "-DLUCENT_PLOC_RADIUS=8 -DLUCENT_MORTON_CUBE=1".
-    if (const char* extra = std::getenv("LUCENT_GPU_BUILD_NVRTC_OPTIONS")) {
-        std::istringstream words(extra);
-        for (std::string w; words >> w;) req.options.push_back(w);
-    }
-    req.sm = sm;
+    add_options_from_env(req, "LUCENT_GPU_BUILD_NVRTC_OPTIONS");
     const CompileResult compiled = compile_cubin(req);
     const DriverApi& d = api();
     check(d.cuModuleLoadData(&m->module, compiled.cubin.data()), "cuModuleLoadData (BVH builder)");

@@ -2,9 +2,7 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 
-#include "cuda/embedded_sources.h"
 
 namespace lucent::cuda {
 
@@ -42,18 +40,11 @@ Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTa
 }
 
 void compile_megakernel(Megakernel& k, int sm) {
-    CompileRequest request;
-    request.name = "lucent_megakernel.cu";
-    request.source = k.source;
-    for (const EmbeddedSource& s : embedded_sources())
-        request.headers.emplace_back(std::string(s.name), std::string(s.text));
-    request.options = {"--std=c++20", "-default-device", "--use_fast_math"};
+    CompileRequest request =
+        embedded_request("lucent_megakernel.cu", k.source,
+                         {"--std=c++20", "-default-device", "--use_fast_math"}, sm);
     // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
-    if (const char* extra = std::getenv("LUCENT_NVRTC_OPTIONS")) {
-        std::istringstream words(extra);
-        for (std::string w; words >> w;) request.options.push_back(w);
-    }
-    request.sm = sm;
+    add_options_from_env(request, "LUCENT_NVRTC_OPTIONS");
     k.binary = compile_cubin(request);
 }
 

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "cuda/embedded_sources.h"
 #include "lucent/error.h"
 
 namespace lucent::cuda {
@@ -152,6 +153,25 @@ std::string kernel_cache_dir() {
     if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lucent";
     if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/lucent";
     return "";
+}
+
+CompileRequest embedded_request(std::string name, std::string source,
+                                std::vector<std::string> options, int sm) {
+    CompileRequest request;
+    request.name = std::move(name);
+    request.source = std::move(source);
+    for (const EmbeddedSource& s : embedded_sources())
+        request.headers.emplace_back(std::string(s.name), std::string(s.text));
+    request.options = std::move(options);
+    request.sm = sm;
+    return request;
+}
+
+void add_options_from_env(CompileRequest& request, const char* variable) {
+    const char* text = std::getenv(variable);
+    if (!text) return;
+    std::istringstream words(text);
+    for (std::string w; words >> w;) request.options.push_back(w);
 }
 
 CompileResult compile_cubin(const CompileRequest& request) {

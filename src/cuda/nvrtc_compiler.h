@@ -23,6 +23,15 @@ struct CompileResult {
     std::string log;  // NVRTC's log, even on success
 };
 
+/// A request for `source`, which may include any of Lucent's embedded device headers
+/// (embedded_sources.h).
+CompileRequest embedded_request(std::string name, std::string source,
+                                std::vector<std::string> options, int sm);
+
+/// Appends the whitespace-separated words of environment variable `variable`, when set, to
+/// the request's options (tuning experiments: e.g. "-DLUCENT_GPU_MIN_BLOCKS=8").
+void add_options_from_env(CompileRequest& request, const char* variable);
+
 /// Compiles (or loads from the cache) a CUBIN. Throws lucent::Error with NVRTC's log on
 /// failure. Cache directory: $LUCENT_CACHE_DIR, else $XDG_CACHE_HOME/lucent, else
 /// ~/.cache/lucent; LUCENT_CACHE_DIR=off disables it.
