@@ -7,6 +7,7 @@
 #include "bench_command.h"
 #include "bench_fog_command.h"
 #include "bench_igi_command.h"
+#include "bench_present_command.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "noise_command.h"
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
     BenchTeaArgs bench_tea_args;
     BenchIgiArgs bench_igi_args;
     BenchFogArgs bench_fog_args;
+    BenchPresentArgs bench_present_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     std::string where = "lucent";
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
         BenchCommands bench = add_bench_commands(app, rays_args, build_args, bench_tea_args);
         CLI::App* bench_igi = add_bench_igi_command(bench.bench, bench_igi_args);
         CLI::App* bench_fog = add_bench_fog_command(bench.bench, bench_fog_args);
+        CLI::App* bench_present = add_bench_present_command(bench.bench, bench_present_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         try {
@@ -87,6 +90,10 @@ int main(int argc, char** argv) {
         if (bench_fog->parsed()) {
             where = "lucent bench fog";
             return run_bench_fog_command(bench_fog_args);
+        }
+        if (bench_present->parsed()) {
+            where = "lucent bench present";
+            return run_bench_present_command(bench_present_args);
         }
         if (bench_igi->parsed()) {
             where = "lucent bench igi";

@@ -34,6 +34,9 @@ struct RenderSettings {
     unsigned spp = 0;      // --spp: progressive samples' samples per pixel; 0 = their default
     /// Also return the sample's intermediate images (RenderResult::layers), for tests.
     bool keep_layers = false;
+    /// Interactive sessions return each frame as FrameResult::display (8-bit sRGB, left
+    /// on the GPU where the CUDA backend rendered it) instead of a linear host image.
+    bool display_frames = false;
     /// Called as launches complete (done, total), e.g. for a progress bar; may be empty.
     std::function<void(unsigned, unsigned)> progress;
     /// Called as bands of rows of a launch finish on the CPU (ContextOptions::on_progress),
@@ -68,7 +71,8 @@ struct RenderResult {
 
 /// One frame of an interactive session.
 struct FrameResult {
-    scene::Image image;               // linear RGB
+    scene::Image image;  // linear RGB; empty with RenderSettings::display_frames
+    std::shared_ptr<const DisplayFrame> display;  // with RenderSettings::display_frames
     std::vector<StageTiming> stages;  // of this frame only (a recompile shows here)
     unsigned samples = 1;             // frames accumulated into the image (progressive samples)
     LaunchReport report;              // exceptions of this frame's last launch
@@ -128,6 +132,11 @@ bool option_range(const SampleOption& option, double& lo, double& hi);
 /// A viewer frame's stages from its launch report: "compile + accel" and "megakernel JIT"
 /// when that launch recompiled, then "launch".
 void add_launch_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
+
+/// The frame's pixels from a session's 2D float4 output: `out.display` made where the
+/// launch left them (`display_frame`: RenderSettings::display_frames), else `out.image` on
+/// the host. The display frame's encoding shows as the stage "display frame".
+void take_frame_pixels(Context& ctx, const Buffer& output, bool display_frame, FrameResult& out);
 
 /// Appends the stages a launch that compiled the scene reports: "compile + accel", and
 /// "megakernel JIT" (cold compile or cache load) when the CUDA backend ran it.

@@ -37,8 +37,14 @@ class StillSession final : public InteractiveSession {
         m_backend = r.backend;
         m_notice = r.backend_notice;
         FrameResult out;
-        out.image = std::move(r.image);
         out.stages = std::move(r.stages);
+        if (m_settings.display_frames) {
+            std::vector<float4> linear(r.image.pixels.size());
+            for (size_t i = 0; i < linear.size(); ++i) linear[i] = make_float4(r.image.pixels[i], 1.f);
+            out.display = DisplayFrame::from_linear(r.image.width, r.image.height, linear.data());
+        } else {
+            out.image = std::move(r.image);
+        }
         out.report = r.report;
         return out;
     }

@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "lucent/display.h"
 #include "lucent/error.h"
 
 namespace lucent::scene {
@@ -35,12 +36,6 @@ std::string lower_extension(const std::string& path) {
     return ext;
 }
 
-float linear_to_srgb(float v) {
-    if (!(v > 0.f)) return 0.f;  // also maps NaN to black
-    if (v >= 1.f) return 1.f;
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
-}
-
 void check_image(const std::string& path, const Image& image) {
     if (image.width == 0 || image.height == 0)
         throw Error("cannot write '" + path + "': the image is empty (" +
@@ -51,18 +46,21 @@ void check_image(const std::string& path, const Image& image) {
                     std::to_string(image.pixels.size()) + " pixels");
 }
 
-std::vector<unsigned char> encode_png(const std::string& path, const Image& image) {
-    std::vector<unsigned char> rgb = to_srgb8(image);
+std::vector<unsigned char> encode_png_rgb(const std::string& path, unsigned width,
+                                          unsigned height, const unsigned char* rgb) {
     std::vector<unsigned char> bytes;
     auto append = [](void* context, void* data, int size) {
         auto* out = static_cast<std::vector<unsigned char>*>(context);
         auto* begin = static_cast<unsigned char*>(data);
         out->insert(out->end(), begin, begin + size);
     };
-    if (!stbi_write_png_to_func(append, &bytes, int(image.width), int(image.height), 3, rgb.data(),
-                                int(image.width) * 3))
+    if (!stbi_write_png_to_func(append, &bytes, int(width), int(height), 3, rgb, int(width) * 3))
         throw Error("cannot write '" + path + "': PNG encoding failed");
     return bytes;
+}
+
+std::vector<unsigned char> encode_png(const std::string& path, const Image& image) {
+    return encode_png_rgb(path, image.width, image.height, to_srgb8(image).data());
 }
 
 // Portable float map: header "PF", size, scale (negative = little-endian), then rows from
@@ -143,9 +141,9 @@ std::vector<unsigned char> to_srgb8(const Image& image) {
     std::vector<unsigned char> rgb(image.pixels.size() * 3);
     for (size_t i = 0; i < image.pixels.size(); ++i) {
         const float3& p = image.pixels[i];
-        rgb[3 * i + 0] = (unsigned char)std::lround(linear_to_srgb(p.x) * 255.f);
-        rgb[3 * i + 1] = (unsigned char)std::lround(linear_to_srgb(p.y) * 255.f);
-        rgb[3 * i + 2] = (unsigned char)std::lround(linear_to_srgb(p.z) * 255.f);
+        rgb[3 * i + 0] = srgb8_from_linear(p.x);
+        rgb[3 * i + 1] = srgb8_from_linear(p.y);
+        rgb[3 * i + 2] = srgb8_from_linear(p.z);
     }
     return rgb;
 }
@@ -164,6 +162,20 @@ void write_image(const std::string& path, const Image& image) {
                                                        : encode_pfm(image);
     TempFile file(path);
     file.write(bytes);
+    file.commit();
+}
+
+void write_png_rgba8(const std::string& path, unsigned width, unsigned height,
+                     const std::vector<unsigned char>& rgba) {
+    if (width == 0 || height == 0 || rgba.size() != size_t(width) * height * 4)
+        throw Error("cannot write '" + path + "': " + std::to_string(rgba.size()) +
+                    " bytes are not a " + std::to_string(width) + "x" + std::to_string(height) +
+                    " RGBA image");
+    std::vector<unsigned char> rgb(size_t(width) * height * 3);
+    for (size_t i = 0; i < size_t(width) * height; ++i)
+        std::copy_n(rgba.data() + 4 * i, 3, rgb.data() + 3 * i);
+    TempFile file(path);
+    file.write(encode_png_rgb(path, width, height, rgb.data()));
     file.commit();
 }
 

@@ -14,13 +14,19 @@ struct Image {
     std::vector<float3> pixels;
 };
 
-/// Linear [0,1] to 8-bit sRGB (clamped), RGB interleaved, row 0 first.
+/// Linear [0,1] to 8-bit sRGB (clamped; lucent::srgb8_from_linear), RGB interleaved, row 0
+/// first.
 std::vector<unsigned char> to_srgb8(const Image& image);
 
 /// Writes .png (8-bit sRGB) or .pfm (32-bit float, linear) by extension. Writes to a
 /// temporary file beside `path` and renames it, so a failure never leaves a partial file.
 /// Throws lucent::Error naming the path and the reason.
 void write_image(const std::string& path, const Image& image);
+
+/// Writes 8-bit RGBA pixels (row 0 at the top, e.g. a lucent::DisplayFrame's) as an RGB PNG,
+/// through a temporary file like write_image. Throws lucent::Error naming the path.
+void write_png_rgba8(const std::string& path, unsigned width, unsigned height,
+                     const std::vector<unsigned char>& rgba);
 
 /// An 8-bit RGB PNG as stored (no colour conversion), for golden-image comparisons.
 struct Image8 {

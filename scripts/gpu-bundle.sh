@@ -4,7 +4,8 @@
 # (run through the bundled loader, so the machine's own glibc does not matter) and the
 # benchmark scenes. On that machine: `.gpu-bundle/run .gpu-bundle/bin/lucent ...`.
 # Embree is left out (the GPU benchmark compares against Lucent's CPU backend), and so is the
-# viewer (the GPU machine has no display; its GL libraries would not fit the 64 MiB carry).
+# viewer (the GPU machine has no display). `lucent bench present` is in: it needs only glvnd's
+# OpenGL and EGL, whose NVIDIA vendor library the GPU machine has.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=.gpu-bundle
@@ -17,7 +18,7 @@ rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 # Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
 for t in programs nodes variables exceptions validation occlusion whitted backend igi radiosity \
-         fog pathtracer multi_device gpu_bvh_builder; do
+         fog pathtracer multi_device gpu_bvh_builder display; do
   cp "$build/tests/${t}_test" "$out/bin/"
 done
 cp "$build/lucent" "$out/bin/"

@@ -2,7 +2,7 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render samples tests igi pathtracer fog tea sanitizer bench builder sweep profile
+# with steps: render samples tests igi pathtracer fog tea sanitizer bench builder present sweep profile
 # hotspots multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench).
 set -uo pipefail
@@ -201,6 +201,15 @@ builder)
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj --subdivide 2 --repeat 9
     echo "== bench build --backend cuda: dragon cut twice (1.6M triangles)"
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/dragon.obj --subdivide 2 --repeat 9
+    ;;
+present)
+    echo "== display frames on the GPU: bit for bit the host's encoding"
+    LUCENT_TEST_BACKEND=cuda $R $B/bin/display_test
+    compute-sanitizer --tool memcheck --leak-check full $R $B/bin/display_test --gtest_filter='DisplayFrame.*' 2>&1 | tail -3
+    echo "== the viewer's presentation path at 1920x1080 in a headless EGL context"
+    $R $B/bin/lucent bench present --backend cuda --frames 200
+    $R $B/bin/lucent bench present --backend cuda --frames 200 --json > "$out/present_cuda.json"
+    $R $B/bin/lucent bench present --backend cuda --sample pathtracer --frames 200
     ;;
 esac
 done

@@ -7,7 +7,8 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libgtest-dev libembree-dev libtinyobjloader-dev libstb-dev libcli11-dev nlohmann-json3-dev
   libfftw3-dev libopenexr-dev clang libclang-rt-14-dev
-  libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
+  libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
+  xvfb xauth
 )
 
 missing=()

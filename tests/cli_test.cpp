@@ -261,3 +261,29 @@ TEST_F(CliTest, BenchBuildBadSubdivideOrSizeNamesTheFlag) {
     EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
     EXPECT_TRUE(dir_is_empty());
 }
+
+namespace {
+
+// `lucent bench present` opens OpenGL through EGL without a window (Mesa's software device
+// here), shows frames the way `lucent view` does and reads the framebuffer back.
+TEST(CliBenchPresent, ShowsExactlyWhatWasRenderedInAHeadlessContext) {
+    CliRun run = run_cli("bench present --backend cpu --threads 2 --size 48x32 --frames 2 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("\"path\": \"host upload\""), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("\"shown_equals_rendered\": true"), std::string::npos)
+        << run.output;
+    EXPECT_EQ(run.output.find("\"shown_equals_rendered\": false"), std::string::npos)
+        << run.output;
+}
+
+TEST(CliBenchPresent, BadFlagsNameTheFlag) {
+    CliRun run = run_cli("bench present --size 0x5");
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
+    run = run_cli("bench present --sample nosuch");
+    EXPECT_NE(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("nosuch"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("whitted"), std::string::npos) << run.output;
+}
+
+}  // namespace

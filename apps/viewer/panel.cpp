@@ -85,6 +85,8 @@ PanelChanges draw_panel(const samples::SampleInfo& info, const WorkerStatus& sta
         if (status.progressive) ImGui::Text("%u samples per pixel", f->samples);
         for (const samples::StageTiming& stage : f->stages)
             ImGui::Text("  %-18s %9.2f ms", stage.name.c_str(), stage.ms);
+        ImGui::Text("  %-18s %9.2f ms", "present", state.present_ms);
+        ImGui::TextWrapped("shown by %s", state.presentation.c_str());
     } else if (status.opened) {
         ImGui::Text("rendering the first frame...");
     } else if (status.error.empty()) {

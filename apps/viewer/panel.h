@@ -16,6 +16,8 @@ struct PanelState {
     double ui_fps = 0;      // window frames/s
     double render_fps = 0;  // finished renders/s (smoothed)
     const ShownFrame* frame = nullptr;
+    std::string presentation;  // how frames reach the window (ImageView::presentation)
+    double present_ms = 0;     // what showing the last frame cost the window's thread
     std::string message;  // the last key's effect ("saved lucent-view-1.png")
 };
 

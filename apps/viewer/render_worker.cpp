@@ -12,6 +12,7 @@ RenderWorker::RenderWorker(const samples::SampleInfo& info, samples::RenderSetti
                            uint64_t frame_limit)
     : m_info(info), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
     m_settings.repeat = 1;
+    m_settings.display_frames = true;  // GPU frames stay on the GPU until shown
     m_settings.progress = nullptr;
     m_settings.on_launch_progress = [this](const LaunchProgress& p) { take_rows(p); };
     m_status.sets = m_settings.sets;
@@ -31,30 +32,26 @@ void RenderWorker::take_rows(const LaunchProgress& p) {
     if (p.rows_done <= m_partial_rows) m_partial_rows = 0;  // a new launch
     const unsigned first = m_partial_rows;
     m_partial_rows = p.rows_done;
-    scene::Image rows;
-    rows.width = w;
-    rows.height = p.rows_done - first;
-    const auto* pixels = static_cast<const float4*>(out->raw()) + size_t(first) * w;
-    rows.pixels.resize(size_t(rows.width) * rows.height);
-    for (size_t i = 0; i < rows.pixels.size(); ++i) rows.pixels[i] = make_float3(pixels[i]);
-    const std::vector<unsigned char> rgb = scene::to_srgb8(rows);
+    std::vector<unsigned char> rgba(size_t(w) * (p.rows_done - first) * 4);
+    encode_srgb8_rgba(static_cast<const float4*>(out->raw()) + size_t(first) * w,
+                      size_t(w) * (p.rows_done - first), rgba.data());
 
     std::lock_guard lock(m_mutex);
     if (m_partial.number != m_latest.number + 1 || m_partial.width != w || m_partial.height != h) {
         // A new frame in progress: over the last one where it has the same size.
-        m_partial = ShownFrame{};
+        m_partial = PartialFrame{};
         m_partial.number = m_latest.number + 1;
         m_partial.width = w;
         m_partial.height = h;
-        m_partial.rgb = m_latest.width == w && m_latest.height == h
-                            ? m_latest.rgb
-                            : std::vector<unsigned char>(size_t(w) * h * 3, 0);
+        m_partial.rgba = m_latest.display && m_latest.width == w && m_latest.height == h
+                             ? m_latest.display->rgba()
+                             : std::vector<unsigned char>(size_t(w) * h * 4, 0);
     }
-    std::copy(rgb.begin(), rgb.end(), m_partial.rgb.begin() + size_t(first) * w * 3);
+    std::copy(rgba.begin(), rgba.end(), m_partial.rgba.begin() + size_t(first) * w * 4);
     ++m_partial_version;
 }
 
-std::optional<ShownFrame> RenderWorker::partial_after(uint64_t shown, uint64_t& version) {
+std::optional<PartialFrame> RenderWorker::partial_after(uint64_t shown, uint64_t& version) {
     std::lock_guard lock(m_mutex);
     if (m_partial_version == version || m_partial.number <= shown) return std::nullopt;
     version = m_partial_version;
@@ -184,10 +181,9 @@ void RenderWorker::run() {
             }
             if (reset) m_session->reset();
             samples::FrameResult frame = m_session->frame();
-            shown.width = frame.image.width;
-            shown.height = frame.image.height;
-            shown.rgb = scene::to_srgb8(frame.image);
-            shown.linear = std::move(frame.image);
+            shown.width = frame.display->width();
+            shown.height = frame.display->height();
+            shown.display = std::move(frame.display);
             shown.stages = std::move(frame.stages);
             shown.samples = frame.samples;
         } catch (const std::exception& e) {

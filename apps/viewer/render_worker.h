@@ -17,16 +17,24 @@
 
 namespace lucent::viewer {
 
-/// A finished frame, ready to show: 8-bit sRGB (scene::to_srgb8, the same conversion as
-/// `lucent render`'s PNGs) and what it cost.
+/// A finished frame, ready to show (a display frame: 8-bit sRGB by the same encoding as
+/// `lucent render`'s PNGs, left on the GPU where the CUDA backend rendered it), and what it
+/// cost.
 struct ShownFrame {
     uint64_t number = 0;  // 1, 2, ... in the order frames finished; 0: none yet
     unsigned width = 0, height = 0;
-    std::vector<unsigned char> rgb;
-    scene::Image linear;  // for P (screenshot of the render)
+    std::shared_ptr<const DisplayFrame> display;
     std::vector<samples::StageTiming> stages;
     double frame_ms = 0;   // wall clock of the whole frame on the worker
     unsigned samples = 1;  // accumulated (progressive sessions)
+};
+
+/// The frame in progress on the CPU: its finished rows over the last frame, RGBA8 in host
+/// memory.
+struct PartialFrame {
+    uint64_t number = 0;  // the frame it will become
+    unsigned width = 0, height = 0;
+    std::vector<unsigned char> rgba;
 };
 
 /// What the panel shows about the worker.
@@ -62,7 +70,7 @@ class RenderWorker {
     std::optional<ShownFrame> frame_after(uint64_t after);
     /// The frame in progress (its finished rows over the last frame) when it follows
     /// frame `shown` and changed since `version`, which it updates.
-    std::optional<ShownFrame> partial_after(uint64_t shown, uint64_t& version);
+    std::optional<PartialFrame> partial_after(uint64_t shown, uint64_t& version);
     WorkerStatus status();
     uint64_t frames_done();
 
@@ -86,7 +94,7 @@ class RenderWorker {
     bool m_pending_reset = false;
     bool m_converged = false;  // a still image is up to date, or the spp limit was reached
     ShownFrame m_latest;
-    ShownFrame m_partial;  // number: the frame in progress
+    PartialFrame m_partial;
     uint64_t m_partial_version = 0;
     unsigned m_partial_rows = 0;  // rows of the current launch already copied
     WorkerStatus m_status;

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "gl.h"
+#include "present/gl.h"
 #include "lucent/error.h"
 
 namespace lucent::viewer {

@@ -13,8 +13,8 @@
 #include <filesystem>
 #include <optional>
 
-#include "gl.h"
-#include "image_view.h"
+#include "present/gl.h"
+#include "present/image_view.h"
 #include "input.h"
 #include "panel.h"
 #include "render_worker.h"
@@ -130,7 +130,8 @@ int run_viewer(const ViewerConfig& config) {
                 } else {
                     const std::string name = next_screenshot_name(info.name);
                     try {
-                        scene::write_image(name, shown.linear);
+                        scene::write_png_rgba8(name, shown.width, shown.height,
+                                               shown.display->rgba());
                         panel.message = "saved " + name;
                     } catch (const std::exception& e) {
                         panel.message = e.what();
@@ -159,13 +160,16 @@ int run_viewer(const ViewerConfig& config) {
 
         if (std::optional<ShownFrame> frame = worker.frame_after(shown.number)) {
             shown = std::move(*frame);
-            view.upload(shown.rgb.data(), shown.width, shown.height);
+            const Clock::time_point before = Clock::now();
+            view.show(*shown.display);
+            panel.present_ms = 1000.0 * seconds_between(before, Clock::now());
+            panel.presentation = view.presentation();
             render_rate.tick(now);
         } else if (seconds_between(last_partial, now) >= kPartialInterval) {
             // A slow frame in progress (the CPU): its finished rows over the last frame, at
             // most 10 times a second (a 2048x2048 upload costs the window a frame).
             if (auto partial = worker.partial_after(shown.number, partial_version)) {
-                view.upload(partial->rgb.data(), partial->width, partial->height);
+                view.upload(partial->rgba.data(), partial->width, partial->height);
                 ++partial_uploads;
                 last_partial = now;
             }

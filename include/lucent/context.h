@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "lucent/buffer.h"
+#include "lucent/display.h"
 #include "lucent/nodes.h"
 #include "lucent/program.h"
 #include "lucent/variables.h"
@@ -196,6 +197,10 @@ class Context : public VariableScope {
     void launch(unsigned entry, unsigned width, unsigned height, unsigned depth);
     /// Exceptions and timings of the most recent launch.
     const LaunchReport& last_launch() const;
+    /// `output` (a 2D float4 buffer of linear RGB, e.g. what the last launch wrote) as an
+    /// 8-bit sRGB frame to show (lucent/display.h), encoded where the launch left it: on
+    /// the GPU for a one-GPU CUDA context (the pixels stay there), else on the host.
+    std::shared_ptr<DisplayFrame> display_frame(const Buffer& output);
 
     struct Impl;
 

@@ -14,7 +14,8 @@ namespace {
 class FogSession final : public InteractiveSession {
   public:
     FogSession(const RenderSettings& settings, const FogOptions& options)
-        : m_scene(options, settings.width, settings.height, settings.context_options()),
+        : m_display_frames(settings.display_frames),
+          m_scene(options, settings.width, settings.height, settings.context_options()),
           m_initial(m_scene.orbit_camera(options.orbit_degrees)),
           m_camera(m_initial) {}
 
@@ -28,11 +29,12 @@ class FogSession final : public InteractiveSession {
         FrameResult out;
         out.report = m_scene.render(m_camera);
         add_launch_stages(out.report, out.stages);
-        out.image = image_from_output(m_scene.output());
+        take_frame_pixels(m_scene.context(), m_scene.output(), m_display_frames, out);
         return out;
     }
 
   private:
+    bool m_display_frames;
     mutable FogScene m_scene;  // context() is not const
     scene::Camera m_initial, m_camera;
 };

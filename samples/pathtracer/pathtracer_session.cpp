@@ -66,7 +66,7 @@ class PathSession final : public InteractiveSession {
         m_ctx.launch(0, m_settings.width, m_settings.height);
         out.report = m_ctx.last_launch();
         add_launch_stages(out.report, out.stages);
-        out.image = image_from_output(*m_scene.output);
+        take_frame_pixels(m_ctx, *m_scene.output, m_settings.display_frames, out);
         out.samples = ++m_samples;
         return out;
     }

@@ -67,7 +67,7 @@ class WhittedSession final : public InteractiveSession {
         m_ctx.launch(0, m_settings.width, m_settings.height);
         out.report = m_ctx.last_launch();
         add_launch_stages(out.report, out.stages);
-        out.image = image_from_output(*m_output);
+        take_frame_pixels(m_ctx, *m_output, m_settings.display_frames, out);
         return out;
     }
 

@@ -24,6 +24,11 @@ void Backend::launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchR
     publish_outputs();
 }
 
+std::shared_ptr<DisplayFrame> Backend::display_frame(const Buffer& output) {
+    const uint3 size = output.size();
+    return DisplayFrame::from_linear(size.x, size.y, output.data<float4>());  // data() fetches
+}
+
 void Backend::copy_range_to(Backend& target, const Buffer& buffer, size_t offset, size_t bytes) {
     if (!uses_host_storage()) download_range(buffer, offset, bytes);
     if (!target.uses_host_storage()) target.upload_range(buffer, offset, bytes);

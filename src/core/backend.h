@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/compiled_scene.h"
+#include "lucent/display.h"
 
 namespace lucent::core {
 
@@ -56,6 +57,9 @@ class Backend {
     virtual void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report);
     /// Brings the host copy of a buffer that the last launch wrote on a device up to date.
     virtual void fetch(const Buffer& /*buffer*/) {}
+    /// A 2D float4 buffer as an 8-bit sRGB frame (Context::display_frame): by default
+    /// encoded on the host from the host copy; a GPU encodes its own copy in place.
+    virtual std::shared_ptr<DisplayFrame> display_frame(const Buffer& output);
 
     // ---- a launch in pieces ----------------------------------------------------------------
     /// Brings this device's copy of the scene up to date (compiling its kernel if need be)

@@ -427,6 +427,17 @@ const LaunchReport& Context::last_launch() const {
     return m_impl->last;
 }
 
+std::shared_ptr<DisplayFrame> Context::display_frame(const Buffer& output) {
+    if (output.owner() != m_impl->shared)
+        throw Error("Context::display_frame: " + output.describe() +
+                    " belongs to another Context; pass a buffer this Context created");
+    if (output.dimensionality() != 2 || output.element().tag != type_info_of<float4>().tag)
+        throw Error("Context::display_frame: " + output.describe() +
+                    " is not a 2D buffer of float4; display frames are made from linear RGB "
+                    "images such as a launch's float4 output");
+    return m_impl->backend->display_frame(output);
+}
+
 // ---- reports ------------------------------------------------------------------------------
 uint64_t LaunchReport::exception_count() const {
     uint64_t n = 0;

@@ -153,6 +153,11 @@ class MultiDeviceBackend final : public Backend {
         if (can_split && m_piece_rows == 0) choice.record(split, ms_between(t0, Clock::now()));
     }
 
+    std::shared_ptr<DisplayFrame> display_frame(const Buffer& output) override {
+        if (m_devices.size() == 1) return m_devices[0]->display_frame(output);
+        return Backend::display_frame(output);  // gathered on the host
+    }
+
     void fetch(const Buffer& buffer) override {
         if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
         auto stale = m_behind.find(&buffer);

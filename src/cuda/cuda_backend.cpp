@@ -11,6 +11,7 @@
 
 #include "core/backend.h"
 #include "cuda/cuda_backend.h"
+#include "cuda/display_frame.h"
 #include "cuda/driver_api.h"
 #include "cuda/gpu_scene.h"
 #include "cuda/megakernel_compiler.h"
@@ -89,6 +90,7 @@ class CudaBackend final : public core::Backend {
     ~CudaBackend() override {
         m_driver.cuCtxSetCurrent(m_context);
         m_scene.reset();
+        m_display.reset();
         for (CUevent e : m_piece_done) m_driver.cuEventDestroy(e);
         for (CUstream s : m_streams)
             if (s) m_driver.cuStreamDestroy(s);
@@ -285,6 +287,14 @@ class CudaBackend final : public core::Backend {
                          name().c_str(), gpu->name().c_str());
     }
 
+    std::shared_ptr<DisplayFrame> display_frame(const Buffer& output) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        const CUdeviceptr linear = m_scene ? m_scene->current_mirror(output) : 0;
+        if (!linear) return core::Backend::display_frame(output);  // the host copy is newer
+        if (!m_display) m_display = std::make_unique<DisplayEncoder>(m_device, m_sm);
+        return m_display->encode(linear, output.size().x, output.size().y);
+    }
+
     void fetch(const Buffer& buffer) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         if (m_scene) m_scene->fetch(buffer);
@@ -386,6 +396,7 @@ class CudaBackend final : public core::Backend {
     std::string m_device_name, m_source;
     int m_sm = 0, m_sm_count = 0;
     std::unique_ptr<GpuScene> m_scene;
+    std::unique_ptr<DisplayEncoder> m_display;  // made by the first display_frame
     LaunchShape m_shapes[2], m_applied{-1, 0};
     bool m_fixed_shape = false;
     std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count

@@ -73,6 +73,14 @@ Loaded load() {
     LUCENT_LOAD(cuDeviceCanAccessPeer, "cuDeviceCanAccessPeer")
     LUCENT_LOAD(cuCtxEnablePeerAccess, "cuCtxEnablePeerAccess")
     LUCENT_LOAD(cuDeviceGetP2PAttribute, "cuDeviceGetP2PAttribute")
+    LUCENT_LOAD(cuMemcpyDtoD, "cuMemcpyDtoD_v2")
+    LUCENT_LOAD(cuCtxPushCurrent, "cuCtxPushCurrent_v2")
+    LUCENT_LOAD(cuCtxPopCurrent, "cuCtxPopCurrent_v2")
+    LUCENT_LOAD(cuGraphicsUnregisterResource, "cuGraphicsUnregisterResource")
+    LUCENT_LOAD(cuGraphicsMapResources, "cuGraphicsMapResources")
+    LUCENT_LOAD(cuGraphicsUnmapResources, "cuGraphicsUnmapResources")
+    LUCENT_LOAD(cuGraphicsResourceGetMappedPointer, "cuGraphicsResourceGetMappedPointer_v2")
+    LUCENT_LOAD(cuGraphicsGLRegisterBuffer, "cuGraphicsGLRegisterBuffer")
 #undef LUCENT_LOAD
     if (missing) return l;
     if (CUresult r = l.api.cuInit(0); r != CUDA_SUCCESS) {

@@ -299,6 +299,15 @@ CUdeviceptr GpuScene::mirror(const Buffer& buffer) const {
     return found == m_buffers.end() ? 0 : found->second.memory.ptr();
 }
 
+CUdeviceptr GpuScene::current_mirror(const Buffer& buffer) const {
+    auto found = m_buffers.find(&buffer);
+    if (found == m_buffers.end()) return 0;
+    const BufferMirror& m = found->second;
+    const bool current = m.device_newer || m.version == buffer.version();
+    return current && m.memory.size() == buffer.count() * buffer.element().size ? m.memory.ptr()
+                                                                                : 0;
+}
+
 void GpuScene::fetch(const Buffer& buffer) {
     auto found = m_buffers.find(&buffer);
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);

@@ -34,6 +34,9 @@ class GpuScene {
     void fetch(const Buffer& buffer);
     /// The device copy of a buffer this compile uses, or 0.
     CUdeviceptr mirror(const Buffer& buffer) const;
+    /// The device copy when it holds the buffer's newest contents (a launch wrote it, or
+    /// the host has not changed it since the upload), else 0.
+    CUdeviceptr current_mirror(const Buffer& buffer) const;
 
     /// The scene part of the launch parameters (per-launch fields left for the caller).
     const gpu::LaunchParams& params() const { return m_params; }

@@ -1,8 +1,9 @@
-#include "image_view.h"
+#include "present/image_view.h"
 
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "lucent/error.h"
 
@@ -65,42 +66,91 @@ ImageView::ImageView() {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glGenBuffers(1, &m_pbo);
+    glGenBuffers(1, &m_upload_pbo);
+    glGenBuffers(1, &m_interop_pbo);
 }
 
 ImageView::~ImageView() {
-    glDeleteBuffers(1, &m_pbo);
+    m_interop.reset();  // unregistered from CUDA before the buffer goes
+    GLuint buffers[] = {m_upload_pbo, m_interop_pbo};
+    glDeleteBuffers(2, buffers);
     glDeleteTextures(1, &m_texture);
     glDeleteVertexArrays(1, &m_vao);
     glDeleteProgram(m_program);
 }
 
-void ImageView::upload(const unsigned char* rgb, unsigned width, unsigned height) {
-    const GLsizeiptr bytes = GLsizeiptr(width) * height * 3;
-    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_pbo);
+void ImageView::size_texture(unsigned width, unsigned height) {
+    if (width == m_width && height == m_height) return;
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, GLsizei(width), GLsizei(height), 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, nullptr);
+    m_width = width;
+    m_height = height;
+}
+
+void ImageView::texture_from_bound_buffer() {
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    // From the pixel-buffer object: the pointer 0 stands for its start.
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, GLsizei(m_width), GLsizei(m_height), GL_RGBA,
+                    GL_UNSIGNED_BYTE, nullptr);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+}
+
+void ImageView::upload(const unsigned char* rgba, unsigned width, unsigned height) {
+    size_texture(width, height);
+    const GLsizeiptr bytes = GLsizeiptr(width) * height * 4;
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_upload_pbo);
     // Orphan the old storage so the driver need not wait for the previous upload to finish.
     glBufferData(GL_PIXEL_UNPACK_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
     void* mapped = glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, bytes,
                                     GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
     if (mapped) {
-        std::memcpy(mapped, rgb, size_t(bytes));
+        std::memcpy(mapped, rgba, size_t(bytes));
         glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
+        texture_from_bound_buffer();
+        return;
     }
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // a driver that cannot map: straight from memory
     glBindTexture(GL_TEXTURE_2D, m_texture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);  // RGB rows are not 4-byte aligned
-    if (width != m_width || height != m_height) {
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, GLsizei(width), GLsizei(height), 0, GL_RGB,
-                     GL_UNSIGNED_BYTE, nullptr);
-        m_width = width;
-        m_height = height;
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGBA,
+                    GL_UNSIGNED_BYTE, rgba);
+}
+
+void ImageView::disable_interop(const std::string& why) {
+    m_interop.reset();
+    m_interop_failed = true;
+    m_presentation = "host upload (" + why + ")";
+}
+
+bool ImageView::show_through_interop(const DisplayFrame& frame) {
+    try {
+        if (!m_interop) m_interop = std::make_unique<GlPixelBuffer>(m_interop_pbo);
+        if (m_interop_bytes != frame.bytes()) {
+            m_interop->release();  // a registered buffer must not change its storage
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_interop_pbo);
+            glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(frame.bytes()), nullptr,
+                         GL_STREAM_DRAW);
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+            m_interop_bytes = frame.bytes();
+        }
+        m_interop->copy_from(frame);  // GPU to GPU; done when it returns
+    } catch (const std::exception& e) {
+        disable_interop(e.what());
+        return false;
     }
-    if (mapped)  // from the pixel-buffer object: the offset 0 stands for its start
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGB,
-                        GL_UNSIGNED_BYTE, nullptr);
-    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
-    if (!mapped)  // a driver that cannot map: straight from memory
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGB,
-                        GL_UNSIGNED_BYTE, rgb);
+    size_texture(frame.width(), frame.height());
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_interop_pbo);
+    texture_from_bound_buffer();
+    m_presentation = "CUDA-OpenGL interop";
+    return true;
+}
+
+void ImageView::show(const DisplayFrame& frame) {
+    if (frame.on_device() && !m_interop_failed && show_through_interop(frame)) return;
+    const std::vector<unsigned char> rgba = frame.rgba();
+    upload(rgba.data(), frame.width(), frame.height());
+    if (!m_interop_failed) m_presentation = "host upload";
 }
 
 void ImageView::draw(int framebuffer_width, int framebuffer_height) {

@@ -1,0 +1,139 @@
+#include "present/present_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+#include "present/headless_gl.h"
+#include "present/image_view.h"
+#include "samples/sample.h"
+
+namespace lucent::viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct Spread {
+    double median = 0, min = 0, max = 0;
+};
+
+Spread spread_of(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return {v[v.size() / 2], v.front(), v.back()};
+}
+
+struct PathResult {
+    std::string path;  // how the frames reached the texture (ImageView::presentation)
+    Spread encode, present;
+    bool shown_equals_rendered = false;
+};
+
+/// Whether the framebuffer (drawn 1:1) holds the frame's pixels: RGB, row 0 at the top.
+bool framebuffer_equals(const DisplayFrame& frame) {
+    const unsigned w = frame.width(), h = frame.height();
+    std::vector<unsigned char> read(size_t(w) * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, GLsizei(w), GLsizei(h), GL_RGBA, GL_UNSIGNED_BYTE, read.data());
+    const std::vector<unsigned char> rendered = frame.rgba();
+    for (unsigned y = 0; y < h; ++y)
+        for (unsigned x = 0; x < w; ++x)
+            for (unsigned c = 0; c < 3; ++c)  // OpenGL's rows start at the bottom
+                if (read[(size_t(h - 1 - y) * w + x) * 4 + c] != rendered[(size_t(y) * w + x) * 4 + c])
+                    return false;
+    return true;
+}
+
+double stage_ms(const samples::FrameResult& frame, const char* name) {
+    for (const samples::StageTiming& s : frame.stages)
+        if (s.name == name) return s.ms;
+    return 0;
+}
+
+}  // namespace
+
+int run_present_bench(const PresentBenchOptions& options) {
+    const samples::SampleInfo& info = samples::find_sample(options.sample);
+    HeadlessGl gl(int(options.width), int(options.height),
+                  options.backend != BackendKind::kCpu);
+    samples::RenderSettings settings;
+    settings.width = options.width;
+    settings.height = options.height;
+    settings.backend = options.backend;
+    settings.threads = options.threads;
+    settings.display_frames = true;
+    std::unique_ptr<samples::InteractiveSession> session = samples::open_session(info, settings);
+    const std::string backend = session->backend();
+
+    // The interop path first (it falls back to the host path by itself where interop does
+    // not work), then the host path on purpose.
+    constexpr const char* kInterop = "CUDA-OpenGL interop";
+    std::vector<PathResult> results;
+    unsigned total = 2 * (options.frames + 3), done = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1 && results[0].path != kInterop) break;  // it was the host path already
+        ImageView view;
+        if (pass == 1) view.disable_interop("for comparison");
+        std::vector<double> encode, present;
+        bool equal = true;
+        for (unsigned f = 0; f < options.frames + 3; ++f) {
+            const samples::FrameResult frame = session->frame();  // not timed: the render
+            const Clock::time_point start = Clock::now();
+            view.show(*frame.display);
+            view.draw(int(options.width), int(options.height));
+            glFinish();  // the texture and the draw are done, as before a swap
+            const double ms = ms_between(start, Clock::now());
+            if (f == 0) equal = framebuffer_equals(*frame.display);
+            if (f >= 3) {  // after warm-up: kernel compile, first registration, allocations
+                present.push_back(ms);
+                encode.push_back(stage_ms(frame, "display frame"));
+            }
+            if (options.progress) options.progress(++done, total);
+        }
+        if (view.presentation() != kInterop) total = done;
+        results.push_back({view.presentation(), spread_of(encode), spread_of(present), equal});
+    }
+
+    const bool all_equal = std::all_of(results.begin(), results.end(),
+                                       [](const PathResult& r) { return r.shown_equals_rendered; });
+    if (options.json) {
+        std::printf(
+            "{\"benchmark\": \"present\", \"sample\": \"%s\", \"backend\": \"%s\", "
+            "\"renderer\": \"%s\", \"width\": %u, \"height\": %u, \"frames\": %u, \"paths\": [",
+            info.name.c_str(), backend.c_str(), gl.renderer().c_str(), options.width,
+            options.height, options.frames);
+        for (size_t i = 0; i < results.size(); ++i) {
+            const PathResult& r = results[i];
+            std::printf(
+                "%s\n  {\"path\": \"%s\", \"encode_median_ms\": %.4f, \"present_median_ms\": %.4f, "
+                "\"present_min_ms\": %.4f, \"present_max_ms\": %.4f, \"total_median_ms\": %.4f, "
+                "\"shown_equals_rendered\": %s}",
+                i ? "," : "", r.path.c_str(), r.encode.median, r.present.median, r.present.min,
+                r.present.max, r.encode.median + r.present.median,
+                r.shown_equals_rendered ? "true" : "false");
+        }
+        std::printf("\n]}\n");
+    } else {
+        std::printf("present: %s at %ux%u on %s; OpenGL: %s; %u frames per path\n",
+                    info.name.c_str(), options.width, options.height, backend.c_str(),
+                    gl.renderer().c_str(), options.frames);
+        std::printf("%-22s %12s %28s %12s  %s\n", "path", "encode ms", "present ms (median [min, max])",
+                    "total ms", "shown = rendered");
+        for (const PathResult& r : results)
+            std::printf("%-22.22s %12.3f %10.3f [%6.3f, %7.3f] %12.3f  %s\n", r.path.c_str(),
+                        r.encode.median, r.present.median, r.present.min, r.present.max,
+                        r.encode.median + r.present.median, r.shown_equals_rendered ? "yes" : "NO");
+        if (results[0].path.rfind("host upload (", 0) == 0)
+            std::printf("interop: %s\n", results[0].path.c_str());
+        std::printf(
+            "encode: the display frame from the launch's output (8-bit sRGB), on the thread that "
+            "renders; present: show + draw + glFinish, on the window's thread\n");
+    }
+    return all_equal ? 0 : 1;
+}
+
+}  // namespace lucent::viewer

@@ -1,0 +1,213 @@
+#include "cuda/display_frame.h"
+
+#include <algorithm>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cuda/device/lucent_gpu/display.cuh"
+#include "cuda/driver_api.h"
+#include "cuda/nvrtc_compiler.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+
+const DriverApi& api() {
+    std::string why;
+    const DriverApi* d = driver(&why);
+    if (!d) throw Error("display frames: " + why);
+    return *d;
+}
+
+/// Makes `context` current on this thread for the scope, restoring the previous one (frames
+/// and pixel buffers are used from the application's threads, e.g. its OpenGL thread).
+class ScopedContext {
+  public:
+    explicit ScopedContext(CUcontext context) {
+        check(api().cuCtxPushCurrent(context), "cuCtxPushCurrent");
+    }
+    ~ScopedContext() {
+        CUcontext popped = nullptr;
+        api().cuCtxPopCurrent(&popped);
+    }
+    ScopedContext(const ScopedContext&) = delete;
+    ScopedContext& operator=(const ScopedContext&) = delete;
+};
+
+}  // namespace
+
+/// Pixel blocks of one GPU, shared by its encoder and the frames it made. Holds a reference
+/// to the GPU's primary context so the blocks stay valid after the Context is gone.
+struct DisplayPool {
+    static constexpr size_t kKept = 4;  // the viewer holds about three frames at once
+
+    explicit DisplayPool(CUdevice device) : device(device) {
+        check(api().cuDevicePrimaryCtxRetain(&context, device), "cuDevicePrimaryCtxRetain");
+    }
+    ~DisplayPool() {
+        if (const DriverApi* d = driver()) {  // errors while tearing down are not actionable
+            d->cuCtxPushCurrent(context);
+            for (const auto& block : free) d->cuMemFree(block.second);
+            CUcontext popped = nullptr;
+            d->cuCtxPopCurrent(&popped);
+            d->cuDevicePrimaryCtxRelease(device);
+        }
+    }
+
+    /// A block of `bytes`; the caller has this GPU's context current.
+    CUdeviceptr take(size_t bytes) {
+        {
+            std::lock_guard lock(mutex);
+            auto it = std::find_if(free.begin(), free.end(),
+                                   [&](const auto& block) { return block.first == bytes; });
+            if (it != free.end()) {
+                const CUdeviceptr ptr = it->second;
+                free.erase(it);
+                return ptr;
+            }
+        }
+        CUdeviceptr ptr = 0;
+        check(api().cuMemAlloc(&ptr, bytes), "cuMemAlloc (display frame)");
+        return ptr;
+    }
+    /// Called by a frame's destructor, on any thread.
+    void give_back(CUdeviceptr ptr, size_t bytes) {
+        std::lock_guard lock(mutex);
+        free.emplace_back(bytes, ptr);
+        if (free.size() > kKept) {
+            ScopedContext scope(context);
+            api().cuMemFree(free.front().second);
+            free.erase(free.begin());
+        }
+    }
+
+    CUdevice device;
+    CUcontext context = nullptr;
+    std::mutex mutex;
+    std::vector<std::pair<size_t, CUdeviceptr>> free;  // (bytes, block), oldest first
+};
+
+CudaDisplayFrame::CudaDisplayFrame(std::shared_ptr<DisplayPool> pool, CUdeviceptr pixels,
+                                   unsigned width, unsigned height)
+    : DisplayFrame(width, height), m_pool(std::move(pool)), m_pixels(pixels) {}
+
+CudaDisplayFrame::~CudaDisplayFrame() {
+    m_pool->give_back(m_pixels, bytes());
+}
+
+CUcontext CudaDisplayFrame::context() const {
+    return m_pool->context;
+}
+
+std::vector<unsigned char> CudaDisplayFrame::rgba() const {
+    std::vector<unsigned char> pixels(bytes());
+    ScopedContext scope(m_pool->context);
+    check(api().cuMemcpyDtoH(pixels.data(), m_pixels, pixels.size()),
+          "download a display frame");
+    return pixels;
+}
+
+DisplayEncoder::DisplayEncoder(CUdevice device, int sm)
+    : m_pool(std::make_shared<DisplayPool>(device)) {
+    const CompileResult compiled = compile_cubin(embedded_request(
+        "lucent_display.cu", "#include \"lucent_gpu/display.cuh\"\n", {"--std=c++17"}, sm));
+    check(api().cuModuleLoadData(&m_module, compiled.cubin.data()),
+          "cuModuleLoadData (display frames)");
+    check(api().cuModuleGetFunction(&m_encode, m_module, "lucent_display_srgb8"),
+          "lucent_display_srgb8");
+    m_thresholds.upload(srgb8_thresholds(), gpu::kSrgbThresholds * sizeof(float));
+}
+
+DisplayEncoder::~DisplayEncoder() {
+    if (const DriverApi* d = driver(); d && m_module) d->cuModuleUnload(m_module);
+}
+
+std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigned width,
+                                                     unsigned height) {
+    unsigned count = width * height;
+    CUdeviceptr pixels = m_pool->take(size_t(count) * 4);
+    auto frame = std::make_shared<CudaDisplayFrame>(m_pool, pixels, width, height);
+    CUdeviceptr thresholds = m_thresholds.ptr();
+    void* args[] = {&linear, &pixels, &count, &thresholds};
+    const unsigned blocks = std::min(4096u, (count + gpu::kDisplayThreads - 1) / gpu::kDisplayThreads);
+    // The legacy default stream: it waits for the launch's (blocking) streams.
+    check(api().cuLaunchKernel(m_encode, std::max(blocks, 1u), 1, 1, gpu::kDisplayThreads, 1, 1, 0,
+                               nullptr, args, nullptr),
+          "encode a display frame");
+    check(api().cuStreamSynchronize(nullptr), "encode a display frame");
+    return frame;
+}
+
+// ---- GlPixelBuffer (lucent/display.h): CUDA–OpenGL interop ------------------------------
+
+}  // namespace lucent::cuda
+
+namespace lucent {
+
+struct GlPixelBuffer::Impl {
+    const cuda::DriverApi* d = nullptr;
+    CUgraphicsResource resource = nullptr;
+    CUcontext context = nullptr;  // the GPU it is registered with
+};
+
+GlPixelBuffer::GlPixelBuffer(unsigned gl_buffer)
+    : m_gl_buffer(gl_buffer), m(std::make_unique<Impl>()) {
+    std::string why;
+    m->d = cuda::driver(&why);
+    if (!m->d) throw Error("CUDA-OpenGL interop: " + why);
+}
+
+GlPixelBuffer::~GlPixelBuffer() {
+    release();
+}
+
+void GlPixelBuffer::release() {
+    if (!m->resource) return;
+    m->d->cuCtxPushCurrent(m->context);
+    m->d->cuGraphicsUnregisterResource(m->resource);  // errors while tearing down: nothing to do
+    CUcontext popped = nullptr;
+    m->d->cuCtxPopCurrent(&popped);
+    m->resource = nullptr;
+    m->context = nullptr;
+}
+
+void GlPixelBuffer::copy_from(const DisplayFrame& frame) {
+    const auto* device_frame = dynamic_cast<const cuda::CudaDisplayFrame*>(&frame);
+    if (!device_frame)
+        throw Error("GlPixelBuffer::copy_from: the frame is in host memory; upload its rgba() "
+                    "to OpenGL instead");
+    if (m->resource && m->context != device_frame->context()) release();  // another GPU
+    cuda::ScopedContext scope(device_frame->context());
+    const cuda::DriverApi& d = *m->d;
+    if (!m->resource) {
+        const CUresult r = d.cuGraphicsGLRegisterBuffer(&m->resource, m_gl_buffer,
+                                                        CU_GRAPHICS_REGISTER_FLAGS_WRITE_DISCARD);
+        if (r != CUDA_SUCCESS) {
+            m->resource = nullptr;
+            const char* s = nullptr;
+            d.cuGetErrorString(r, &s);
+            throw Error("CUDA-OpenGL interop: cannot register OpenGL buffer " +
+                        std::to_string(m_gl_buffer) + " with the GPU (" + (s ? s : "?") +
+                        "); the OpenGL context must be current and run on the same NVIDIA GPU");
+        }
+        m->context = device_frame->context();
+    }
+    cuda::check(d.cuGraphicsMapResources(1, &m->resource, nullptr), "cuGraphicsMapResources");
+    CUdeviceptr target = 0;
+    size_t size = 0;
+    CUresult r = d.cuGraphicsResourceGetMappedPointer(&target, &size, m->resource);
+    if (r == CUDA_SUCCESS && size >= frame.bytes())
+        r = d.cuMemcpyDtoD(target, device_frame->pixels(), frame.bytes());
+    d.cuGraphicsUnmapResources(1, &m->resource, nullptr);
+    cuda::check(r, "copy a display frame into an OpenGL buffer");
+    if (size < frame.bytes())
+        throw Error("GlPixelBuffer::copy_from: OpenGL buffer " + std::to_string(m_gl_buffer) +
+                    " holds " + std::to_string(size) + " bytes but the frame needs " +
+                    std::to_string(frame.bytes()) +
+                    "; release() it, size it with glBufferData, then copy again");
+}
+
+}  // namespace lucent
