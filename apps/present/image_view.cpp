@@ -21,17 +21,12 @@ void main() {
 }
 )";
 
-// The pixels are sRGB already (the encoding `lucent render` uses for PNGs), row 0 first;
-// the nearest one to uv, as GL_NEAREST would pick it.
+// The texels are sRGB already (the conversion `lucent render` uses for PNGs).
 constexpr const char* kFragmentShader = R"(#version 330 core
-uniform samplerBuffer image;
-uniform ivec2 size;
+uniform sampler2D image;
 in vec2 uv;
 out vec4 color;
-void main() {
-    ivec2 p = clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
-    color = vec4(texelFetch(image, p.y * size.x + p.x).rgb, 1.0);
-}
+void main() { color = vec4(texture(image, uv).rgb, 1.0); }
 )";
 
 GLuint compile(GLenum kind, const char* source) {
@@ -63,42 +58,54 @@ ImageView::ImageView() {
     glGetProgramiv(m_program, GL_LINK_STATUS, &ok);
     if (!ok) throw Error("viewer: the OpenGL driver could not link the image shader");
     m_scale = glGetUniformLocation(m_program, "scale");
-    m_size = glGetUniformLocation(m_program, "size");
     glGenVertexArrays(1, &m_vao);  // core profile: a draw needs one bound, even empty
     glGenTextures(1, &m_texture);
-    glGenBuffers(1, &m_upload_buffer);
-    glGenBuffers(1, &m_interop_buffer);
-    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &m_max_texels);
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    // Nearest: at 1:1 every pixel is shown as rendered (the headless check compares them).
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glGenBuffers(1, &m_upload_pbo);
 }
 
 ImageView::~ImageView() {
-    m_interop.reset();  // unregistered from CUDA before the buffer goes
-    GLuint buffers[] = {m_upload_buffer, m_interop_buffer};
-    glDeleteBuffers(2, buffers);
+    m_interop.reset();  // unregistered from CUDA before the texture goes
+    glDeleteBuffers(1, &m_upload_pbo);
     glDeleteTextures(1, &m_texture);
     glDeleteVertexArrays(1, &m_vao);
     glDeleteProgram(m_program);
 }
 
-void ImageView::use_buffer(GLuint buffer, unsigned width, unsigned height) {
-    glBindTexture(GL_TEXTURE_BUFFER, m_texture);
-    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA8, buffer);
-    glBindTexture(GL_TEXTURE_BUFFER, 0);
+void ImageView::size_texture(unsigned width, unsigned height) {
+    if (width == m_width && height == m_height) return;
+    if (m_interop) m_interop->release();  // a registered texture must not be re-specified
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, GLsizei(width), GLsizei(height), 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, nullptr);
     m_width = width;
     m_height = height;
 }
 
 void ImageView::upload(const unsigned char* rgba, unsigned width, unsigned height) {
-    if (double(width) * height > double(m_max_texels))
-        throw Error("viewer: a " + std::to_string(width) + "x" + std::to_string(height) +
-                    " image is more than this OpenGL driver's " + std::to_string(m_max_texels) +
-                    " texels in a buffer texture; render a smaller --size");
+    size_texture(width, height);
     const GLsizeiptr bytes = GLsizeiptr(width) * height * 4;
-    glBindBuffer(GL_TEXTURE_BUFFER, m_upload_buffer);
-    // New storage each time (orphaning): the driver need not wait for the last draw's reads.
-    glBufferData(GL_TEXTURE_BUFFER, bytes, rgba, GL_STREAM_DRAW);
-    glBindBuffer(GL_TEXTURE_BUFFER, 0);
-    use_buffer(m_upload_buffer, width, height);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_upload_pbo);
+    // Orphan the old storage so the driver need not wait for the previous upload to finish.
+    glBufferData(GL_PIXEL_UNPACK_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
+    void* mapped = glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, bytes,
+                                    GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+    if (mapped) {
+        std::memcpy(mapped, rgba, size_t(bytes));
+        glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
+    }
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    // From the pixel-buffer object (the pointer 0 stands for its start), or straight from
+    // memory on a driver that cannot map.
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGBA,
+                    GL_UNSIGNED_BYTE, mapped ? nullptr : rgba);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
 }
 
 void ImageView::disable_interop(const std::string& why) {
@@ -109,22 +116,13 @@ void ImageView::disable_interop(const std::string& why) {
 
 bool ImageView::show_through_interop(const DisplayFrame& frame) {
     try {
-        if (double(frame.width()) * frame.height() > double(m_max_texels))
-            throw Error("the frame is larger than a buffer texture may be");
-        if (!m_interop) m_interop = std::make_unique<GlPixelBuffer>(m_interop_buffer);
-        if (m_interop_bytes != frame.bytes()) {
-            m_interop->release();  // a registered buffer must not change its storage
-            glBindBuffer(GL_TEXTURE_BUFFER, m_interop_buffer);
-            glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(frame.bytes()), nullptr, GL_DYNAMIC_DRAW);
-            glBindBuffer(GL_TEXTURE_BUFFER, 0);
-            m_interop_bytes = frame.bytes();
-        }
+        size_texture(frame.width(), frame.height());
+        if (!m_interop) m_interop = std::make_unique<GlTexture>(m_texture);
         m_interop->copy_from(frame);  // GPU to GPU; done when it returns
     } catch (const std::exception& e) {
         disable_interop(e.what());
         return false;
     }
-    use_buffer(m_interop_buffer, frame.width(), frame.height());
     m_presentation = "CUDA-OpenGL interop";
     return true;
 }
@@ -145,9 +143,8 @@ void ImageView::draw(int framebuffer_width, int framebuffer_height) {
     glViewport(0, 0, framebuffer_width, framebuffer_height);
     glUseProgram(m_program);
     glUniform2f(m_scale, sx, sy);
-    glUniform2i(m_size, GLint(m_width), GLint(m_height));
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_BUFFER, m_texture);
+    glBindTexture(GL_TEXTURE_2D, m_texture);
     glBindVertexArray(m_vao);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     glBindVertexArray(0);

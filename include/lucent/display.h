@@ -1,5 +1,5 @@
 // Showing a rendered image: 8-bit sRGB display frames made where the launch left the
-// image, and an OpenGL pixel-buffer object they are copied into. On the CUDA backend the
+// image, and an OpenGL texture they are copied into. On the CUDA backend the
 // pixels never leave the GPU (CUDA–OpenGL interop, the path OptiX's GL-interop buffers
 // serve); elsewhere they are host memory, uploaded by the application.
 #pragma once
@@ -37,7 +37,7 @@ class DisplayFrame {
     unsigned height() const { return m_height; }
     size_t bytes() const { return size_t(m_width) * m_height * 4; }
     /// True when the pixels are in a GPU's memory (a CUDA launch made them there); then
-    /// GlPixelBuffer copies them GPU to GPU.
+    /// GlTexture copies them GPU to GPU.
     virtual bool on_device() const = 0;
     /// The pixels in host memory (a download when on_device()).
     virtual std::vector<unsigned char> rgba() const = 0;
@@ -53,31 +53,35 @@ class DisplayFrame {
     unsigned m_width, m_height;
 };
 
-/// An OpenGL buffer object that device display frames are copied into with CUDA–OpenGL
+/// An OpenGL 2D texture that device display frames are copied into with CUDA–OpenGL
 /// interop (registered with the GPU of the first frame, again when a frame comes from
-/// another GPU). Every call needs the OpenGL context that owns the buffer current on the
-/// calling thread, on the same GPU as the frames. Throws lucent::Error when that cannot
-/// be done (no CUDA, an OpenGL driver of another vendor): callers then upload rgba().
-class GlPixelBuffer {
+/// another GPU). A texture, not a buffer object: textures live in the GPU's memory, where
+/// the copy and the draw that reads it run at its bandwidth (a registered buffer object
+/// measured 0.33 ms per 1920x1080 copy, placed in host memory by the driver). Every call
+/// needs the OpenGL context that owns the texture current on the calling thread, on the
+/// same GPU as the frames. Throws lucent::Error when that cannot be done (no CUDA, an
+/// OpenGL driver of another vendor): callers then upload rgba().
+class GlTexture {
   public:
-    /// `gl_buffer`: the name of a buffer object (glGenBuffers) whose storage the caller
-    /// sizes with glBufferData before each copy_from of a new size, and must not resize
-    /// while registered (release() first).
-    explicit GlPixelBuffer(unsigned gl_buffer);
-    ~GlPixelBuffer();
-    GlPixelBuffer(const GlPixelBuffer&) = delete;
-    GlPixelBuffer& operator=(const GlPixelBuffer&) = delete;
+    /// `gl_texture`: the name of a GL_TEXTURE_2D texture with internal format GL_RGBA8,
+    /// which the caller sizes (glTexImage2D) to the frames before copy_from, and must not
+    /// re-specify while registered (release() first).
+    explicit GlTexture(unsigned gl_texture);
+    ~GlTexture();
+    GlTexture(const GlTexture&) = delete;
+    GlTexture& operator=(const GlTexture&) = delete;
 
-    /// Copies a device frame's pixels into the buffer's first frame.bytes() bytes, GPU to
-    /// GPU, and returns when the copy is done. frame.on_device() must be true.
+    /// Copies a device frame's pixels into level 0 of the texture (row 0 of the frame into
+    /// texture row 0), GPU to GPU. frame.on_device() must be true and the texture exactly
+    /// the frame's size.
     void copy_from(const DisplayFrame& frame);
-    /// Unregisters the buffer from CUDA (before the caller resizes or deletes it).
+    /// Unregisters the texture from CUDA (before the caller re-specifies or deletes it).
     void release();
 
     struct Impl;
 
   private:
-    unsigned m_gl_buffer;
+    unsigned m_gl_texture;
     std::unique_ptr<Impl> m;
 };
 

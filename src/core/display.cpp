@@ -91,13 +91,13 @@ std::shared_ptr<DisplayFrame> DisplayFrame::from_linear(unsigned width, unsigned
 
 #ifndef LUCENT_HAVE_CUDA
 // Without the CUDA backend no frame is ever on a device.
-struct GlPixelBuffer::Impl {};
-GlPixelBuffer::GlPixelBuffer(unsigned gl_buffer) : m_gl_buffer(gl_buffer) {
+struct GlTexture::Impl {};
+GlTexture::GlTexture(unsigned gl_texture) : m_gl_texture(gl_texture) {
     throw Error("CUDA-OpenGL interop: this build of Lucent has no CUDA backend");
 }
-GlPixelBuffer::~GlPixelBuffer() = default;
-void GlPixelBuffer::copy_from(const DisplayFrame&) {}
-void GlPixelBuffer::release() {}
+GlTexture::~GlTexture() = default;
+void GlTexture::copy_from(const DisplayFrame&) {}
+void GlTexture::release() {}
 #endif
 
 }  // namespace lucent

@@ -141,30 +141,33 @@ std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigne
     return frame;
 }
 
-// ---- GlPixelBuffer (lucent/display.h): CUDA–OpenGL interop ------------------------------
+// ---- GlTexture (lucent/display.h): CUDA–OpenGL interop --------------------------------
 
 }  // namespace lucent::cuda
 
 namespace lucent {
 
-struct GlPixelBuffer::Impl {
+namespace {
+constexpr unsigned kGlTexture2D = 0x0DE1;  // GL_TEXTURE_2D (no OpenGL headers here)
+}
+
+struct GlTexture::Impl {
     const cuda::DriverApi* d = nullptr;
     CUgraphicsResource resource = nullptr;
     CUcontext context = nullptr;  // the GPU it is registered with
 };
 
-GlPixelBuffer::GlPixelBuffer(unsigned gl_buffer)
-    : m_gl_buffer(gl_buffer), m(std::make_unique<Impl>()) {
+GlTexture::GlTexture(unsigned gl_texture) : m_gl_texture(gl_texture), m(std::make_unique<Impl>()) {
     std::string why;
     m->d = cuda::driver(&why);
     if (!m->d) throw Error("CUDA-OpenGL interop: " + why);
 }
 
-GlPixelBuffer::~GlPixelBuffer() {
+GlTexture::~GlTexture() {
     release();
 }
 
-void GlPixelBuffer::release() {
+void GlTexture::release() {
     if (!m->resource) return;
     m->d->cuCtxPushCurrent(m->context);
     m->d->cuGraphicsUnregisterResource(m->resource);  // errors while tearing down: nothing to do
@@ -174,40 +177,55 @@ void GlPixelBuffer::release() {
     m->context = nullptr;
 }
 
-void GlPixelBuffer::copy_from(const DisplayFrame& frame) {
+void GlTexture::copy_from(const DisplayFrame& frame) {
     const auto* device_frame = dynamic_cast<const cuda::CudaDisplayFrame*>(&frame);
     if (!device_frame)
-        throw Error("GlPixelBuffer::copy_from: the frame is in host memory; upload its rgba() "
-                    "to OpenGL instead");
+        throw Error("GlTexture::copy_from: the frame is in host memory; upload its rgba() to "
+                    "OpenGL instead");
     if (m->resource && m->context != device_frame->context()) release();  // another GPU
     cuda::ScopedContext scope(device_frame->context());
     const cuda::DriverApi& d = *m->d;
     if (!m->resource) {
-        const CUresult r = d.cuGraphicsGLRegisterBuffer(&m->resource, m_gl_buffer,
-                                                        CU_GRAPHICS_REGISTER_FLAGS_WRITE_DISCARD);
+        const CUresult r = d.cuGraphicsGLRegisterImage(&m->resource, m_gl_texture, kGlTexture2D,
+                                                       CU_GRAPHICS_REGISTER_FLAGS_WRITE_DISCARD);
         if (r != CUDA_SUCCESS) {
             m->resource = nullptr;
             const char* s = nullptr;
             d.cuGetErrorString(r, &s);
-            throw Error("CUDA-OpenGL interop: cannot register OpenGL buffer " +
-                        std::to_string(m_gl_buffer) + " with the GPU (" + (s ? s : "?") +
+            throw Error("CUDA-OpenGL interop: cannot register OpenGL texture " +
+                        std::to_string(m_gl_texture) + " with the GPU (" + (s ? s : "?") +
                         "); the OpenGL context must be current and run on the same NVIDIA GPU");
         }
         m->context = device_frame->context();
     }
     cuda::check(d.cuGraphicsMapResources(1, &m->resource, nullptr), "cuGraphicsMapResources");
-    CUdeviceptr target = 0;
-    size_t size = 0;
-    CUresult r = d.cuGraphicsResourceGetMappedPointer(&target, &size, m->resource);
-    if (r == CUDA_SUCCESS && size >= frame.bytes())
-        r = d.cuMemcpyDtoD(target, device_frame->pixels(), frame.bytes());
+    CUarray array = nullptr;
+    CUresult r = d.cuGraphicsSubResourceGetMappedArray(&array, m->resource, 0, 0);
+    CUDA_ARRAY_DESCRIPTOR shape{};
+    if (r == CUDA_SUCCESS) r = d.cuArrayGetDescriptor(&shape, array);
+    const bool fits = r == CUDA_SUCCESS && shape.Width == frame.width() &&
+                      shape.Height == frame.height() && shape.NumChannels == 4 &&
+                      shape.Format == CU_AD_FORMAT_UNSIGNED_INT8;
+    if (fits) {
+        CUDA_MEMCPY2D copy{};
+        copy.srcMemoryType = CU_MEMORYTYPE_DEVICE;
+        copy.srcDevice = device_frame->pixels();
+        copy.srcPitch = size_t(frame.width()) * 4;
+        copy.dstMemoryType = CU_MEMORYTYPE_ARRAY;
+        copy.dstArray = array;
+        copy.WidthInBytes = size_t(frame.width()) * 4;
+        copy.Height = frame.height();
+        r = d.cuMemcpy2D(&copy);  // returns when the copy is done
+    }
     d.cuGraphicsUnmapResources(1, &m->resource, nullptr);
-    cuda::check(r, "copy a display frame into an OpenGL buffer");
-    if (size < frame.bytes())
-        throw Error("GlPixelBuffer::copy_from: OpenGL buffer " + std::to_string(m_gl_buffer) +
-                    " holds " + std::to_string(size) + " bytes but the frame needs " +
-                    std::to_string(frame.bytes()) +
-                    "; release() it, size it with glBufferData, then copy again");
+    cuda::check(r, "copy a display frame into an OpenGL texture");
+    if (!fits)
+        throw Error("GlTexture::copy_from: OpenGL texture " + std::to_string(m_gl_texture) +
+                    " is " + std::to_string(shape.Width) + "x" + std::to_string(shape.Height) +
+                    (shape.NumChannels == 4 ? "" : " and not RGBA8") + " but the frame is " +
+                    std::to_string(frame.width()) + "x" + std::to_string(frame.height()) +
+                    "; release() it, glTexImage2D it as GL_RGBA8 of the frame's size, then "
+                    "copy again");
 }
 
 }  // namespace lucent

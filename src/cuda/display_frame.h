@@ -1,5 +1,5 @@
 // Display frames on a GPU (Context::display_frame on the CUDA backend): the launch's float4
-// output encoded as RGBA8 in device memory, and handed to OpenGL by GlPixelBuffer
+// output encoded as RGBA8 in device memory, and handed to OpenGL by GlTexture
 // (lucent/display.h) without a trip through host memory.
 #pragma once
 

@@ -73,14 +73,15 @@ Loaded load() {
     LUCENT_LOAD(cuDeviceCanAccessPeer, "cuDeviceCanAccessPeer")
     LUCENT_LOAD(cuCtxEnablePeerAccess, "cuCtxEnablePeerAccess")
     LUCENT_LOAD(cuDeviceGetP2PAttribute, "cuDeviceGetP2PAttribute")
-    LUCENT_LOAD(cuMemcpyDtoD, "cuMemcpyDtoD_v2")
+    LUCENT_LOAD(cuMemcpy2D, "cuMemcpy2D_v2")
+    LUCENT_LOAD(cuArrayGetDescriptor, "cuArrayGetDescriptor_v2")
     LUCENT_LOAD(cuCtxPushCurrent, "cuCtxPushCurrent_v2")
     LUCENT_LOAD(cuCtxPopCurrent, "cuCtxPopCurrent_v2")
     LUCENT_LOAD(cuGraphicsUnregisterResource, "cuGraphicsUnregisterResource")
     LUCENT_LOAD(cuGraphicsMapResources, "cuGraphicsMapResources")
     LUCENT_LOAD(cuGraphicsUnmapResources, "cuGraphicsUnmapResources")
-    LUCENT_LOAD(cuGraphicsResourceGetMappedPointer, "cuGraphicsResourceGetMappedPointer_v2")
-    LUCENT_LOAD(cuGraphicsGLRegisterBuffer, "cuGraphicsGLRegisterBuffer")
+    LUCENT_LOAD(cuGraphicsSubResourceGetMappedArray, "cuGraphicsSubResourceGetMappedArray")
+    LUCENT_LOAD(cuGraphicsGLRegisterImage, "cuGraphicsGLRegisterImage")
 #undef LUCENT_LOAD
     if (missing) return l;
     if (CUresult r = l.api.cuInit(0); r != CUDA_SUCCESS) {

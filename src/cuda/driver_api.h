@@ -49,18 +49,19 @@ struct DriverApi {
     LUCENT_CU_FN(cuDeviceCanAccessPeer)
     LUCENT_CU_FN(cuCtxEnablePeerAccess)
     LUCENT_CU_FN(cuDeviceGetP2PAttribute)
-    LUCENT_CU_FN(cuMemcpyDtoD)
+    LUCENT_CU_FN(cuMemcpy2D)
+    LUCENT_CU_FN(cuArrayGetDescriptor)
     LUCENT_CU_FN(cuCtxPushCurrent)
     LUCENT_CU_FN(cuCtxPopCurrent)
     LUCENT_CU_FN(cuGraphicsUnregisterResource)
     LUCENT_CU_FN(cuGraphicsMapResources)
     LUCENT_CU_FN(cuGraphicsUnmapResources)
-    LUCENT_CU_FN(cuGraphicsResourceGetMappedPointer)
+    LUCENT_CU_FN(cuGraphicsSubResourceGetMappedArray)
 #undef LUCENT_CU_FN
-    /// cudaGL.h's, declared here so the engine needs no OpenGL headers (a GLuint is an
-    /// unsigned int).
-    CUresult (*cuGraphicsGLRegisterBuffer)(CUgraphicsResource*, unsigned int gl_buffer,
-                                           unsigned int flags) = nullptr;
+    /// cudaGL.h's, declared here so the engine needs no OpenGL headers (GLuint and GLenum
+    /// are unsigned ints).
+    CUresult (*cuGraphicsGLRegisterImage)(CUgraphicsResource*, unsigned int gl_image,
+                                          unsigned int gl_target, unsigned int flags) = nullptr;
 };
 
 /// The driver, loaded and initialised once; null when there is none (`why` says what failed).
