@@ -68,6 +68,21 @@ TEST(jit, gpu_bvh_builder_kernels) {
         EXPECT_NE(result.log.find(kernel), std::string::npos) << kernel;
 }
 
+TEST(jit, display_kernels) {
+    // Display frames' module (sRGB encoding, the copy into an OpenGL texture's surface)
+    // compiles to sm_90 code without warnings, with both kernels in it.
+    std::string why;
+    if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
+    setenv("LUCENT_CACHE_DIR", "off", 1);
+    const cuda::CompileResult result = cuda::compile_cubin(cuda::embedded_request(
+        "lucent_display.cu", "#include \"lucent_gpu/display.cuh\"\n",
+        {"--std=c++17", "--ptxas-options=-v"}, 90));
+    EXPECT_FALSE(result.cubin.empty());
+    EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;
+    for (const char* kernel : {"lucent_display_srgb8", "lucent_display_to_surface"})
+        EXPECT_NE(result.log.find(kernel), std::string::npos) << kernel;
+}
+
 TEST(jit, gpu_bvh_layout_matches_brute_force) {
     const Mesh mesh = test_mesh(7, 1500);
     const Brute brute{mesh};

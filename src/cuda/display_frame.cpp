@@ -51,6 +51,7 @@ struct DisplayPool {
         if (const DriverApi* d = driver()) {  // errors while tearing down are not actionable
             d->cuCtxPushCurrent(context);
             for (const auto& block : free) d->cuMemFree(block.second);
+            if (module) d->cuModuleUnload(module);
             CUcontext popped = nullptr;
             d->cuCtxPopCurrent(&popped);
             d->cuDevicePrimaryCtxRelease(device);
@@ -86,6 +87,8 @@ struct DisplayPool {
 
     CUdevice device;
     CUcontext context = nullptr;
+    CUmodule module = nullptr;  // lucent_gpu/display.cuh
+    CUfunction encode = nullptr, to_surface = nullptr;
     std::mutex mutex;
     std::vector<std::pair<size_t, CUdeviceptr>> free;  // (bytes, block), oldest first
 };
@@ -102,6 +105,24 @@ CUcontext CudaDisplayFrame::context() const {
     return m_pool->context;
 }
 
+void CudaDisplayFrame::copy_to_array(CUarray array) const {
+    const DriverApi& d = api();
+    CUDA_RESOURCE_DESC resource{};
+    resource.resType = CU_RESOURCE_TYPE_ARRAY;
+    resource.res.array.hArray = array;
+    CUsurfObject surface = 0;
+    check(d.cuSurfObjectCreate(&surface, &resource), "cuSurfObjectCreate");
+    CUdeviceptr pixels = m_pixels;
+    unsigned width = this->width(), height = this->height();
+    void* args[] = {&pixels, &surface, &width, &height};
+    const CUresult launched = d.cuLaunchKernel(m_pool->to_surface, (width + 31) / 32,
+                                               (height + 7) / 8, 1, 32, 8, 1, 0, nullptr, args,
+                                               nullptr);
+    const CUresult done = launched == CUDA_SUCCESS ? d.cuStreamSynchronize(nullptr) : launched;
+    d.cuSurfObjectDestroy(surface);
+    check(done, "copy a display frame into an OpenGL texture");
+}
+
 std::vector<unsigned char> CudaDisplayFrame::rgba() const {
     std::vector<unsigned char> pixels(bytes());
     ScopedContext scope(m_pool->context);
@@ -114,16 +135,17 @@ DisplayEncoder::DisplayEncoder(CUdevice device, int sm)
     : m_pool(std::make_shared<DisplayPool>(device)) {
     const CompileResult compiled = compile_cubin(embedded_request(
         "lucent_display.cu", "#include \"lucent_gpu/display.cuh\"\n", {"--std=c++17"}, sm));
-    check(api().cuModuleLoadData(&m_module, compiled.cubin.data()),
+    check(api().cuModuleLoadData(&m_pool->module, compiled.cubin.data()),
           "cuModuleLoadData (display frames)");
-    check(api().cuModuleGetFunction(&m_encode, m_module, "lucent_display_srgb8"),
+    check(api().cuModuleGetFunction(&m_pool->encode, m_pool->module, "lucent_display_srgb8"),
           "lucent_display_srgb8");
+    check(api().cuModuleGetFunction(&m_pool->to_surface, m_pool->module,
+                                    "lucent_display_to_surface"),
+          "lucent_display_to_surface");
     m_thresholds.upload(srgb8_thresholds(), gpu::kSrgbThresholds * sizeof(float));
 }
 
-DisplayEncoder::~DisplayEncoder() {
-    if (const DriverApi* d = driver(); d && m_module) d->cuModuleUnload(m_module);
-}
+DisplayEncoder::~DisplayEncoder() = default;
 
 std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigned width,
                                                      unsigned height) {
@@ -134,7 +156,7 @@ std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigne
     void* args[] = {&linear, &pixels, &count, &thresholds};
     const unsigned blocks = std::min(4096u, (count + gpu::kDisplayThreads - 1) / gpu::kDisplayThreads);
     // The legacy default stream: it waits for the launch's (blocking) streams.
-    check(api().cuLaunchKernel(m_encode, std::max(blocks, 1u), 1, 1, gpu::kDisplayThreads, 1, 1, 0,
+    check(api().cuLaunchKernel(m_pool->encode, std::max(blocks, 1u), 1, 1, gpu::kDisplayThreads, 1, 1, 0,
                                nullptr, args, nullptr),
           "encode a display frame");
     check(api().cuStreamSynchronize(nullptr), "encode a display frame");
@@ -206,19 +228,17 @@ void GlTexture::copy_from(const DisplayFrame& frame) {
     const bool fits = r == CUDA_SUCCESS && shape.Width == frame.width() &&
                       shape.Height == frame.height() && shape.NumChannels == 4 &&
                       shape.Format == CU_AD_FORMAT_UNSIGNED_INT8;
+    std::string failure;
     if (fits) {
-        CUDA_MEMCPY2D copy{};
-        copy.srcMemoryType = CU_MEMORYTYPE_DEVICE;
-        copy.srcDevice = device_frame->pixels();
-        copy.srcPitch = size_t(frame.width()) * 4;
-        copy.dstMemoryType = CU_MEMORYTYPE_ARRAY;
-        copy.dstArray = array;
-        copy.WidthInBytes = size_t(frame.width()) * 4;
-        copy.Height = frame.height();
-        r = d.cuMemcpy2D(&copy);  // returns when the copy is done
+        try {
+            device_frame->copy_to_array(array);
+        } catch (const Error& e) {
+            failure = e.what();
+        }
     }
     d.cuGraphicsUnmapResources(1, &m->resource, nullptr);
-    cuda::check(r, "copy a display frame into an OpenGL texture");
+    cuda::check(r, "map an OpenGL texture for CUDA");
+    if (!failure.empty()) throw Error(failure);
     if (!fits)
         throw Error("GlTexture::copy_from: OpenGL texture " + std::to_string(m_gl_texture) +
                     " is " + std::to_string(shape.Width) + "x" + std::to_string(shape.Height) +

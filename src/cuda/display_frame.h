@@ -25,6 +25,9 @@ class CudaDisplayFrame final : public DisplayFrame {
     std::vector<unsigned char> rgba() const override;
     CUdeviceptr pixels() const { return m_pixels; }
     CUcontext context() const;
+    /// Writes the pixels into a CUDA array of the frame's size (an OpenGL texture's, mapped
+    /// by GlTexture) with this context current; returns when done.
+    void copy_to_array(CUarray array) const;
 
   private:
     std::shared_ptr<DisplayPool> m_pool;
@@ -46,9 +49,7 @@ class DisplayEncoder {
     std::shared_ptr<DisplayFrame> encode(CUdeviceptr linear, unsigned width, unsigned height);
 
   private:
-    std::shared_ptr<DisplayPool> m_pool;
-    CUmodule m_module = nullptr;
-    CUfunction m_encode = nullptr;
+    std::shared_ptr<DisplayPool> m_pool;  // also holds the kernels
     DeviceBuffer m_thresholds;
 };
 

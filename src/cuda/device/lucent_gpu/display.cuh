@@ -38,6 +38,21 @@ extern "C" __global__ void __launch_bounds__(kDisplayThreads)
     }
 }
 
+/// Copies a frame's pixels into an OpenGL texture's CUDA array (GlTexture::copy_from), one
+/// thread per pixel through a surface: the copy engine's 2D copy into the array's tiled
+/// layout measured 24 GB/s (0.34 ms at 1920x1080 on an H200), a kernel runs at memory speed.
+extern "C" __global__ void lucent_display_to_surface(const unsigned* __restrict__ rgba,
+                                                     unsigned long long surface, unsigned width,
+                                                     unsigned height) {
+    const unsigned x = blockIdx.x * blockDim.x + threadIdx.x;
+    const unsigned y = blockIdx.y * blockDim.y + threadIdx.y;
+    if (x >= width || y >= height) return;
+    // sust: a 32-bit store at byte column 4x of row y (surf2Dwrite without the runtime headers).
+    asm volatile("sust.b.2d.b32.trap [%0, {%1, %2}], {%3};" ::"l"(surface), "r"(x * 4), "r"(y),
+                 "r"(rgba[size_t(y) * width + x])
+                 : "memory");
+}
+
 #endif  // LUCENT_GPU_CODE
 
 }  // namespace lucent::gpu
