@@ -29,7 +29,10 @@ Spread spread_of(std::vector<double> v) {
 
 struct PathResult {
     std::string path;  // how the frames reached the texture (ImageView::presentation)
-    Spread encode, present;
+    Spread encode;     // the display frame, on the thread that renders
+    Spread calls;      // show + draw as the window's thread spends them (no wait)
+    Spread gpu;        // show + draw on the GPU (an OpenGL timer query)
+    Spread present;    // show + draw + glFinish: the round trip
     bool shown_equals_rendered = false;
 };
 
@@ -78,24 +81,36 @@ int run_present_bench(const PresentBenchOptions& options) {
         if (pass == 1 && results[0].path != kInterop) break;  // it was the host path already
         ImageView view;
         if (pass == 1) view.disable_interop("for comparison");
-        std::vector<double> encode, present;
+        GLuint timer = 0;
+        glGenQueries(1, &timer);
+        std::vector<double> encode, calls, gpu, present;
         bool equal = true;
         for (unsigned f = 0; f < options.frames + 3; ++f) {
             const samples::FrameResult frame = session->frame();  // not timed: the render
+            glFinish();  // nothing of the last frame left in flight
             const Clock::time_point start = Clock::now();
+            glBeginQuery(GL_TIME_ELAPSED, timer);
             view.show(*frame.display);
             view.draw(int(options.width), int(options.height));
+            glEndQuery(GL_TIME_ELAPSED);
+            const Clock::time_point issued = Clock::now();
             glFinish();  // the texture and the draw are done, as before a swap
-            const double ms = ms_between(start, Clock::now());
+            const Clock::time_point finished = Clock::now();
+            GLuint64 gpu_ns = 0;
+            glGetQueryObjectui64v(timer, GL_QUERY_RESULT, &gpu_ns);
             if (f == 0) equal = framebuffer_equals(*frame.display);
             if (f >= 3) {  // after warm-up: kernel compile, first registration, allocations
-                present.push_back(ms);
                 encode.push_back(stage_ms(frame, "display frame"));
+                calls.push_back(ms_between(start, issued));
+                gpu.push_back(double(gpu_ns) * 1e-6);
+                present.push_back(ms_between(start, finished));
             }
             if (options.progress) options.progress(++done, total);
         }
+        glDeleteQueries(1, &timer);
         if (view.presentation() != kInterop) total = done;
-        results.push_back({view.presentation(), spread_of(encode), spread_of(present), equal});
+        results.push_back({view.presentation(), spread_of(encode), spread_of(calls),
+                           spread_of(gpu), spread_of(present), equal});
     }
 
     const bool all_equal = std::all_of(results.begin(), results.end(),
@@ -109,11 +124,12 @@ int run_present_bench(const PresentBenchOptions& options) {
         for (size_t i = 0; i < results.size(); ++i) {
             const PathResult& r = results[i];
             std::printf(
-                "%s\n  {\"path\": \"%s\", \"encode_median_ms\": %.4f, \"present_median_ms\": %.4f, "
-                "\"present_min_ms\": %.4f, \"present_max_ms\": %.4f, \"total_median_ms\": %.4f, "
-                "\"shown_equals_rendered\": %s}",
-                i ? "," : "", r.path.c_str(), r.encode.median, r.present.median, r.present.min,
-                r.present.max, r.encode.median + r.present.median,
+                "%s\n  {\"path\": \"%s\", \"encode_median_ms\": %.4f, \"calls_median_ms\": %.4f, "
+                "\"gpu_median_ms\": %.4f, \"gpu_min_ms\": %.4f, \"gpu_max_ms\": %.4f, "
+                "\"round_trip_median_ms\": %.4f, \"round_trip_min_ms\": %.4f, "
+                "\"round_trip_max_ms\": %.4f, \"shown_equals_rendered\": %s}",
+                i ? "," : "", r.path.c_str(), r.encode.median, r.calls.median, r.gpu.median,
+                r.gpu.min, r.gpu.max, r.present.median, r.present.min, r.present.max,
                 r.shown_equals_rendered ? "true" : "false");
         }
         std::printf("\n]}\n");
@@ -121,17 +137,20 @@ int run_present_bench(const PresentBenchOptions& options) {
         std::printf("present: %s at %ux%u on %s; OpenGL: %s; %u frames per path\n",
                     info.name.c_str(), options.width, options.height, backend.c_str(),
                     gl.renderer().c_str(), options.frames);
-        std::printf("%-22s %12s %28s %12s  %s\n", "path", "encode ms", "present ms (median [min, max])",
-                    "total ms", "shown = rendered");
+        std::printf("%-20s %8s %8s %26s %26s  %s\n", "path", "encode", "calls",
+                    "GPU (median [min, max])", "round trip (median [...])", "shown = rendered");
         for (const PathResult& r : results)
-            std::printf("%-22.22s %12.3f %10.3f [%6.3f, %7.3f] %12.3f  %s\n", r.path.c_str(),
-                        r.encode.median, r.present.median, r.present.min, r.present.max,
-                        r.encode.median + r.present.median, r.shown_equals_rendered ? "yes" : "NO");
+            std::printf("%-20.20s %8.3f %8.3f %8.3f [%6.3f, %7.3f] %8.3f [%6.3f, %7.3f]  %s\n",
+                        r.path.c_str(), r.encode.median, r.calls.median, r.gpu.median, r.gpu.min,
+                        r.gpu.max, r.present.median, r.present.min, r.present.max,
+                        r.shown_equals_rendered ? "yes" : "NO");
         if (results[0].path.rfind("host upload (", 0) == 0)
             std::printf("interop: %s\n", results[0].path.c_str());
         std::printf(
-            "encode: the display frame from the launch's output (8-bit sRGB), on the thread that "
-            "renders; present: show + draw + glFinish, on the window's thread\n");
+            "ms per frame. encode: the display frame from the launch's output (8-bit sRGB), on "
+            "the thread that renders; calls: show + draw on the window's thread, not waiting; "
+            "GPU: show + draw on the GPU (OpenGL timer query); round trip: show + draw + "
+            "glFinish\n");
     }
     return all_equal ? 0 : 1;
 }

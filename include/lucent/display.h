@@ -72,8 +72,9 @@ class GlTexture {
     GlTexture& operator=(const GlTexture&) = delete;
 
     /// Copies a device frame's pixels into level 0 of the texture (row 0 of the frame into
-    /// texture row 0), GPU to GPU; returns when done. frame.on_device() must be true and the
-    /// texture GL_RGBA8 of exactly the frame's size.
+    /// texture row 0), GPU to GPU, without waiting: OpenGL commands issued after it see the
+    /// pixels. frame.on_device() must be true and the texture GL_RGBA8 of exactly the
+    /// frame's size.
     void copy_from(const DisplayFrame& frame);
     /// Unregisters the texture from CUDA (before the caller re-specifies or deletes it).
     void release();

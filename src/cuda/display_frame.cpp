@@ -105,22 +105,15 @@ CUcontext CudaDisplayFrame::context() const {
     return m_pool->context;
 }
 
-void CudaDisplayFrame::copy_to_array(CUarray array) const {
-    const DriverApi& d = api();
-    CUDA_RESOURCE_DESC resource{};
-    resource.resType = CU_RESOURCE_TYPE_ARRAY;
-    resource.res.array.hArray = array;
-    CUsurfObject surface = 0;
-    check(d.cuSurfObjectCreate(&surface, &resource), "cuSurfObjectCreate");
+void CudaDisplayFrame::copy_to_surface(CUsurfObject surface) const {
     CUdeviceptr pixels = m_pixels;
     unsigned width = this->width(), height = this->height();
     void* args[] = {&pixels, &surface, &width, &height};
-    const CUresult launched = d.cuLaunchKernel(m_pool->to_surface, (width + 31) / 32,
-                                               (height + 7) / 8, 1, 32, 8, 1, 0, nullptr, args,
-                                               nullptr);
-    const CUresult done = launched == CUDA_SUCCESS ? d.cuStreamSynchronize(nullptr) : launched;
-    d.cuSurfObjectDestroy(surface);
-    check(done, "copy a display frame into an OpenGL texture");
+    // No wait here: the unmap that follows on the same stream orders OpenGL after the kernel,
+    // and the frame's block is only reused (or freed) behind it.
+    check(api().cuLaunchKernel(m_pool->to_surface, (width + 31) / 32, (height + 7) / 8, 1, 32, 8,
+                               1, 0, nullptr, args, nullptr),
+          "copy a display frame into an OpenGL texture");
 }
 
 std::vector<unsigned char> CudaDisplayFrame::rgba() const {
@@ -177,6 +170,27 @@ struct GlTexture::Impl {
     const cuda::DriverApi* d = nullptr;
     CUgraphicsResource resource = nullptr;
     CUcontext context = nullptr;  // the GPU it is registered with
+    CUarray array = nullptr;      // the texture's array when last mapped,
+    CUsurfObject surface = 0;     // and a surface over it (kept while the array stays)
+
+    /// A surface over `mapped`, made again when the mapping gives another array.
+    CUsurfObject surface_for(CUarray mapped) {
+        if (mapped == array && surface) return surface;
+        drop_surface();
+        CUDA_RESOURCE_DESC resource_desc{};
+        resource_desc.resType = CU_RESOURCE_TYPE_ARRAY;
+        resource_desc.res.array.hArray = mapped;
+        cuda::check(d->cuSurfObjectCreate(&surface, &resource_desc), "cuSurfObjectCreate");
+        array = mapped;
+        return surface;
+    }
+    void drop_surface() {
+        if (!surface) return;
+        d->cuStreamSynchronize(nullptr);  // no queued copy uses it any more
+        d->cuSurfObjectDestroy(surface);
+        surface = 0;
+        array = nullptr;
+    }
 };
 
 GlTexture::GlTexture(unsigned gl_texture) : m_gl_texture(gl_texture), m(std::make_unique<Impl>()) {
@@ -192,6 +206,7 @@ GlTexture::~GlTexture() {
 void GlTexture::release() {
     if (!m->resource) return;
     m->d->cuCtxPushCurrent(m->context);
+    m->drop_surface();
     m->d->cuGraphicsUnregisterResource(m->resource);  // errors while tearing down: nothing to do
     CUcontext popped = nullptr;
     m->d->cuCtxPopCurrent(&popped);
@@ -231,7 +246,7 @@ void GlTexture::copy_from(const DisplayFrame& frame) {
     std::string failure;
     if (fits) {
         try {
-            device_frame->copy_to_array(array);
+            device_frame->copy_to_surface(m->surface_for(array));
         } catch (const Error& e) {
             failure = e.what();
         }

@@ -25,9 +25,10 @@ class CudaDisplayFrame final : public DisplayFrame {
     std::vector<unsigned char> rgba() const override;
     CUdeviceptr pixels() const { return m_pixels; }
     CUcontext context() const;
-    /// Writes the pixels into a CUDA array of the frame's size (an OpenGL texture's, mapped
-    /// by GlTexture) with this context current; returns when done.
-    void copy_to_array(CUarray array) const;
+    /// Queues, on the legacy default stream with this frame's context current, a kernel that
+    /// writes the pixels through `surface` (over an array of the frame's size: an OpenGL
+    /// texture's, mapped by GlTexture).
+    void copy_to_surface(CUsurfObject surface) const;
 
   private:
     std::shared_ptr<DisplayPool> m_pool;
