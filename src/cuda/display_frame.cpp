@@ -23,7 +23,7 @@ const DriverApi& api() {
 }
 
 /// Makes `context` current on this thread for the scope, restoring the previous one (frames
-/// and pixel buffers are used from the application's threads, e.g. its OpenGL thread).
+/// and GlTexture are used from the application's threads, e.g. its OpenGL thread).
 class ScopedContext {
   public:
     explicit ScopedContext(CUcontext context) {
