@@ -64,10 +64,7 @@ int run_bench_build(const BuildBenchOptions& options) {
         in.json = options.json;
         in.width = options.width, in.height = options.height;
         try {
-            const Camera cam = find_camera(options.scene);
-            in.has_camera = true;
-            in.eye = cam.eye, in.look = cam.look, in.up = cam.up, in.fov = cam.fov;
-            in.light = cam.light;
+            in.camera = find_camera(options.scene);
         } catch (const Error& e) {
             // The builds are still timed; the report says no rays were traced, and why.
             std::fprintf(stderr, "lucent bench build: no ray comparison: %s\n", e.what());

@@ -240,8 +240,7 @@ int run_bench_rays(const RaysOptions& options) {
         in.scene = options.scene;
         in.positions = mesh.positions;
         in.indices = mesh.indices;
-        in.eye = cam.eye, in.look = cam.look, in.up = cam.up, in.fov = cam.fov;
-        in.light = cam.light;
+        in.camera = cam;
         in.width = options.width, in.height = options.height;
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
         return cuda::run_bench_rays_cuda(in);

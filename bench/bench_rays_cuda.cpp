@@ -58,6 +58,11 @@ class ContextScope {
         check(m_api.cuDeviceGetAttribute(&v, a, m_device), "cuDeviceGetAttribute");
         return v;
     }
+    /// Compute capability x10 (90 for sm_90).
+    int sm() const {
+        return 10 * attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
+               attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+    }
     std::string name() const {
         char buf[256] = {};
         check(m_api.cuDeviceGetName(buf, sizeof buf, m_device), "cuDeviceGetName");
@@ -193,8 +198,7 @@ class RayBench {
   public:
     RayBench(const DriverApi& api, const ContextScope& ctx, const CudaRaysInput& in)
         : m_api(api), m_in(in), m_start(api), m_stop(api) {
-        sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
-             ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+        sm = ctx.sm();
         sm_count = ctx.attribute(CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT);
         k.persistent = env_flag("LUCENT_BENCH_PERSISTENT", true);
         const CompileResult compiled = compile_bench_kernels(sm, k.persistent);
@@ -246,13 +250,14 @@ class RayBench {
         primary = DeviceBuffer(sizeof(float4) * 2 * n);
         primary_hits = DeviceBuffer(sizeof(uint2) * n);
         {
-            const float3 fwd = normalize(m_in.look - m_in.eye);
-            const float3 right = normalize(cross(fwd, m_in.up));
+            const bench::Camera& cam = m_in.camera;
+            const float3 fwd = normalize(cam.look - cam.eye);
+            const float3 right = normalize(cross(fwd, cam.up));
             const float3 up2 = cross(right, fwd);
-            float t = std::tan(m_in.fov / 2 * kPi / 180);
+            float t = std::tan(cam.fov / 2 * kPi / 180);
             float a = (float)m_in.width / (float)m_in.height;
-            float p[12] = {m_in.eye.x, m_in.eye.y, m_in.eye.z, fwd.x, fwd.y, fwd.z,
-                           right.x,    right.y,    right.z,    up2.x, up2.y, up2.z};
+            float p[12] = {cam.eye.x, cam.eye.y, cam.eye.z, fwd.x, fwd.y, fwd.z,
+                           right.x,   right.y,   right.z,   up2.x, up2.y, up2.z};
             unsigned w = m_in.width, h = m_in.height;
             CUdeviceptr rays = primary.ptr();
             void* args[] = {&p[0], &p[1],  &p[2],  &p[3], &p[4], &p[5], &p[6], &p[7],  &p[8],
@@ -260,7 +265,7 @@ class RayBench {
             launch_1d(k.primary_rays, n, args, "primary ray generation");
         }
         trace(k.closest, k.grid_closest, view, primary.ptr(), n, primary_hits.ptr());
-        hits_p.resize(n);
+        std::vector<uint2> hits_p(n);
         primary_hits.download(hits_p.data(), sizeof(uint2) * n);
         slot.assign(n, 0);  // primary ray -> its secondary rays
         m = 0;
@@ -276,7 +281,7 @@ class RayBench {
             CUdeviceptr a0 = primary.ptr(), a1 = primary_hits.ptr(), a2 = slots.ptr(),
                         a3 = by_prim.ptr(), a4 = shadow.ptr(), a5 = diffuse.ptr();
             unsigned w = m_in.width, h = m_in.height;
-            float lx = m_in.light.x, ly = m_in.light.y, lz = m_in.light.z;
+            float lx = m_in.camera.light.x, ly = m_in.camera.light.y, lz = m_in.camera.light.z;
             void* args[] = {&a0, &a1, &a2, &a3, &w, &h, &tiled, &lx, &ly, &lz, &a4, &a5};
             launch_1d(k.secondary_rays, n, args, "secondary ray generation");
         }
@@ -300,7 +305,6 @@ class RayBench {
     BenchKernels k;
     unsigned n = 0, m = 0, tiled = 1;  // primary rays; secondary rays of each kind
     std::vector<unsigned> ray_of_pixel, slot;
-    std::vector<uint2> hits_p;  // of make_rays' trace
     DeviceBuffer primary, primary_hits, slots, shadow, diffuse, occluded, diffuse_hits;
 
   private:
@@ -525,8 +529,7 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
         throw Error("bench build: the image size must be at least 1x1");
     const DriverApi& api = require_driver();
     ContextScope ctx(api);
-    const int sm = 10 * ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR) +
-                   ctx.attribute(CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR);
+    const int sm = ctx.sm();
     const size_t tris = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
     const GpuBvhBuildOptions options = gpu_build_options();
 
@@ -535,15 +538,10 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
     GpuBvhBuilder builder(sm);
     DeviceBuffer positions, indices;
     const auto u0 = std::chrono::steady_clock::now();
-    positions.upload(in.positions);
-    indices.upload(in.indices);
+    const DeviceTriangles device_tris =
+        upload_triangles(in.positions, in.indices, positions, indices);
     const double mesh_upload_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - u0).count();
-    DeviceTriangles device_tris;
-    device_tris.positions = positions.ptr();
-    device_tris.vertex_count = unsigned(in.positions.size());
-    device_tris.indices = in.indices.empty() ? 0 : indices.ptr();
-    device_tris.triangle_count = unsigned(tris);
     GpuTriangleBvhDevice hploc;
     GpuBvhStats hploc_stats;
     std::vector<double> gpu_ms, refit_ms;
@@ -576,10 +574,9 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
         Rate primary, shadow, diffuse;
     } rates_sah, rates_hploc;
     size_t differ_p = 0, differ_s = 0, differ_d = 0, ray_count = 0;
-    if (in.has_camera && tris > 0) {
+    if (in.camera && tris > 0) {
         CudaRaysInput rin;
-        rin.eye = in.eye, rin.look = in.look, rin.up = in.up, rin.fov = in.fov;
-        rin.light = in.light;
+        rin.camera = *in.camera;
         rin.width = in.width, rin.height = in.height, rin.repeat = in.repeat;
         RayBench bench(api, ctx, rin);
         const DeviceBuffer by_prim = triangles_by_prim(sah_bvh);

@@ -4,9 +4,11 @@
 // The header needs no CUDA headers; the functions exist when LUCENT_HAVE_CUDA is defined.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 
+#include "bench/bench_camera.h"
 #include "lucent/device/vector_math.h"
 
 namespace lucent::cuda {
@@ -15,9 +17,7 @@ struct CudaRaysInput {
     std::string scene;  // for the report
     std::span<const float3> positions;
     std::span<const uint3> indices;
-    float3 eye, look, up;
-    float fov = 60;
-    float3 light;
+    bench::Camera camera;
     unsigned width = 3840, height = 2160;
     int repeat = 5;
     unsigned threads = 0;  // CPU threads of the reference trace, 0 = all
@@ -40,10 +40,7 @@ struct CudaBuildInput {
     int repeat = 5;
     bool json = false;
     // The ray sets both trees are timed on; no rays are traced without a camera.
-    bool has_camera = false;
-    float3 eye, look, up;
-    float fov = 60;
-    float3 light;
+    std::optional<bench::Camera> camera;
     unsigned width = 3840, height = 2160;
 };
 

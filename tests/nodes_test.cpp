@@ -478,7 +478,8 @@ class RefitTest : public NodesTest {
             for (int b = 0; b < 8; ++b)
                 r.push_back(along_z(0.23f + 0.45f * a, 0.21f + 0.45f * b, 0));
         return r;
-    }    void refit_and_rebuild(Builder builder);
+    }
+    void refit_and_rebuild(Builder builder);
 };
 
 /// Traces the grid, moves it, and traces it refitted and rebuilt, with `builder` for the

@@ -24,11 +24,11 @@ namespace {
 // Box far distances are scaled up by 2 ulp so that rounding never culls a box the ray
 // touches (Ize 2013, "Robust BVH ray traversal").
 constexpr float kFarScale = 1.00000024f;
-constexpr int kStackSize = 512;
+constexpr int kStackSize = 512;  // 7 pushes per level; wide depth <= binary depth <= 60
 // The largest |1/d| of the fused slab test, and the largest |o * (1/d)|: 1/d is clamped to
 // both, so o/d stays finite wherever the origin is (far beyond any t a ray asks about).
 constexpr float kMaxInverse = 1e20f;
-constexpr float kMaxOverInverse = 1e37f;  // 7 pushes per level; wide depth <= binary depth <= 60
+constexpr float kMaxOverInverse = 1e37f;
 
 float safe_inverse(float d) {
     return d != 0.0f ? 1.0f / d : (std::signbit(d) ? -kInfinity * 1e8f : kInfinity * 1e8f);

@@ -5,9 +5,8 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
+#include <vector>
 
-#include "core/host_display_frame.h"
 #include "lucent/error.h"
 
 namespace lucent {
@@ -52,6 +51,20 @@ struct BucketTable {
     }
 };
 
+/// A display frame in host memory: what the CPU backend (and a GPU whose host copy of the
+/// output is the newer) gives Context::display_frame.
+class HostDisplayFrame final : public DisplayFrame {
+  public:
+    HostDisplayFrame(unsigned width, unsigned height)
+        : DisplayFrame(width, height), m_rgba(bytes()) {}
+    bool on_device() const override { return false; }
+    std::vector<unsigned char> rgba() const override { return m_rgba; }
+    unsigned char* pixels() { return m_rgba.data(); }
+
+  private:
+    std::vector<unsigned char> m_rgba;
+};
+
 const std::array<float, 255>& thresholds() {
     static const std::array<float, 255> t = make_thresholds();
     return t;
@@ -84,7 +97,7 @@ void encode_srgb8_rgba(const float4* linear, size_t count, unsigned char* rgba) 
 
 std::shared_ptr<DisplayFrame> DisplayFrame::from_linear(unsigned width, unsigned height,
                                                         const float4* linear) {
-    auto frame = std::make_shared<core::HostDisplayFrame>(width, height);
+    auto frame = std::make_shared<HostDisplayFrame>(width, height);
     encode_srgb8_rgba(linear, size_t(width) * height, frame->pixels());
     return frame;
 }

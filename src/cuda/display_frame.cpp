@@ -138,8 +138,6 @@ DisplayEncoder::DisplayEncoder(CUdevice device, int sm)
     m_thresholds.upload(srgb8_thresholds(), gpu::kSrgbThresholds * sizeof(float));
 }
 
-DisplayEncoder::~DisplayEncoder() = default;
-
 std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigned width,
                                                      unsigned height) {
     unsigned count = width * height;

@@ -41,7 +41,6 @@ class DisplayEncoder {
   public:
     /// For `device` (compute capability `sm`, x10); its primary context must be current.
     DisplayEncoder(CUdevice device, int sm);
-    ~DisplayEncoder();
     DisplayEncoder(const DisplayEncoder&) = delete;
     DisplayEncoder& operator=(const DisplayEncoder&) = delete;
 

@@ -70,16 +70,21 @@ struct GpuBvhBuilder::Impl {
     void sort(unsigned n);
     /// Copies host triangles to the device (host_positions, host_indices).
     DeviceTriangles upload(std::span<const float3> positions, std::span<const uint3> indices) {
-        host_positions.upload(positions);
-        host_indices.upload(indices);
-        DeviceTriangles tris;
-        tris.positions = host_positions.ptr();
-        tris.vertex_count = unsigned(positions.size());
-        tris.indices = indices.empty() ? 0 : host_indices.ptr();
-        tris.triangle_count = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
-        return tris;
+        return upload_triangles(positions, indices, host_positions, host_indices);
     }
 };
+
+DeviceTriangles upload_triangles(std::span<const float3> positions, std::span<const uint3> indices,
+                                 DeviceBuffer& positions_out, DeviceBuffer& indices_out) {
+    positions_out.upload(positions);
+    indices_out.upload(indices);
+    DeviceTriangles tris;
+    tris.positions = positions_out.ptr();
+    tris.vertex_count = unsigned(positions.size());
+    tris.indices = indices.empty() ? 0 : indices_out.ptr();
+    tris.triangle_count = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
+    return tris;
+}
 
 GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     CompileRequest req = embedded_request(

@@ -24,6 +24,11 @@ struct DeviceTriangles {
     unsigned triangle_count = 0;
 };
 
+/// Copies host triangles (indices may be empty) into `positions_out` and `indices_out` and
+/// describes them.
+DeviceTriangles upload_triangles(std::span<const float3> positions, std::span<const uint3> indices,
+                                 DeviceBuffer& positions_out, DeviceBuffer& indices_out);
+
 /// A tree deeper than the GPU traversal stack: agglomerative builds can chain (triangles in a
 /// geometric progression do); the host SAH builder bounds its depth and can take the mesh.
 class GpuBvhTooDeep : public Error {

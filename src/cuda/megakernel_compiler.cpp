@@ -3,7 +3,6 @@
 #include <cstdlib>
 #include <fstream>
 
-
 namespace lucent::cuda {
 
 ProgramTable build_program_table(const core::CompiledScene& scene) {
