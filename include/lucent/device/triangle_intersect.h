@@ -19,22 +19,35 @@ LUCENT_HD inline float lc_axis(float3 v, int k) {
     return k == 0 ? v.x : (k == 1 ? v.y : v.z);
 }
 
+/// The axis permutation of a ray: kz the dominant axis of the direction, kx and ky the
+/// other two in the order that keeps the winding (Fig. 1 of the paper).
+struct WatertightAxes {
+    int kx, ky, kz;
+};
+
+LUCENT_HD inline WatertightAxes watertight_axes(float3 direction) {
+    float ax = direction.x < 0.0f ? -direction.x : direction.x;
+    float ay = direction.y < 0.0f ? -direction.y : direction.y;
+    float az = direction.z < 0.0f ? -direction.z : direction.z;
+    WatertightAxes k;
+    k.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    k.kx = k.kz == 2 ? 0 : k.kz + 1;
+    k.ky = k.kx == 2 ? 0 : k.kx + 1;
+    // Swap kx and ky when the dominant component is negative, to preserve the winding.
+    if (lc_axis(direction, k.kz) < 0.0f) {
+        int tmp = k.kx;
+        k.kx = k.ky;
+        k.ky = tmp;
+    }
+    return k;
+}
+
 /// Precomputes the permutation and shear of a ray (Fig. 1 of the paper).
 LUCENT_HD inline WatertightRay make_watertight_ray(float3 origin, float3 direction) {
     WatertightRay r;
     r.origin = origin;
-    float ax = direction.x < 0.0f ? -direction.x : direction.x;
-    float ay = direction.y < 0.0f ? -direction.y : direction.y;
-    float az = direction.z < 0.0f ? -direction.z : direction.z;
-    r.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-    r.kx = r.kz == 2 ? 0 : r.kz + 1;
-    r.ky = r.kx == 2 ? 0 : r.kx + 1;
-    // Swap kx and ky when the dominant component is negative, to preserve the winding.
-    if (lc_axis(direction, r.kz) < 0.0f) {
-        int tmp = r.kx;
-        r.kx = r.ky;
-        r.ky = tmp;
-    }
+    const WatertightAxes k = watertight_axes(direction);
+    r.kx = k.kx, r.ky = k.ky, r.kz = k.kz;
     float dz = lc_axis(direction, r.kz);
     r.sx = lc_axis(direction, r.kx) / dz;
     r.sy = lc_axis(direction, r.ky) / dz;
