@@ -1,7 +1,8 @@
 // Single-ray traversal of TriangleAccel's 8-wide tree: one SIMD slab test for the eight
 // children of a node (AVX2) and one watertight test for the four triangles of a leaf
 // (SSE + FMA), the same arithmetic as lucent/device/triangle_intersect.h. Builds without
-// AVX2/FMA fall back to scalar loops over the same layout.
+// AVX2/FMA (or with LUCENT_ACCEL_SCALAR, as accel_scalar_test does) fall back to scalar
+// loops over the same layout and the same arithmetic.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -10,7 +11,7 @@
 #include "accel/wide_bvh.h"
 #include "lucent/device/triangle_intersect.h"
 
-#if defined(__AVX2__) && defined(__FMA__)
+#if defined(__AVX2__) && defined(__FMA__) && !defined(LUCENT_ACCEL_SCALAR)
 #include <immintrin.h>
 #define LUCENT_ACCEL_SIMD 1
 #else
@@ -89,18 +90,24 @@ struct RayState {
         sz4 = _mm_set1_ps(shear[2]);
     }
 #else
-    float org[3];
-    float rdir[3];
+    // The same fused slab test and watertight setup in scalar code, bit for bit.
+    float rdir[3], org_rdir_near[3], org_rdir_far[3];
     WatertightRay wt;
     float tmin;
 
     RayState(float3 o, float3 d, float t0) {
-        org[0] = o.x, org[1] = o.y, org[2] = o.z;
-        const float dir[3] = {d.x, d.y, d.z};
+        const float org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
         for (int k = 0; k < 3; ++k) {
-            rdir[k] = dir[k] != 0.0f ? 1.0f / dir[k] : std::copysign(kInfinity * 1e8f, dir[k]);
-            near_plane[k] = 16 * k + (rdir[k] >= 0.0f ? 0 : 8);
-            far_plane[k] = 16 * k + (rdir[k] >= 0.0f ? 8 : 0);
+            const float limit =
+                std::min(kMaxInverse, kMaxOverInverse / std::max(std::fabs(org[k]), 1.0f));
+            const float r = std::clamp(1.0f / dir[k], -limit, limit);
+            const float od = org[k] * r;
+            const float err = std::fabs(od) * 0x1p-21f;
+            rdir[k] = r;
+            org_rdir_near[k] = od + err;
+            org_rdir_far[k] = od - err;
+            near_plane[k] = 16 * k + (r < 0.0f ? 8 : 0);
+            far_plane[k] = 16 * k + (r < 0.0f ? 0 : 8);
         }
         wt = make_watertight_ray(o, d);
         tmin = t0;
@@ -130,8 +137,8 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
     for (int i = 0; i < kWideArity; ++i) {
         float t_near = r.tmin, t_far = tmax;
         for (int k = 0; k < 3; ++k) {
-            t_near = lc_max(t_near, (p[r.near_plane[k] + i] - r.org[k]) * r.rdir[k]);
-            t_far = lc_min(t_far, (p[r.far_plane[k] + i] - r.org[k]) * r.rdir[k]);
+            t_near = lc_max(t_near, std::fma(p[r.near_plane[k] + i], r.rdir[k], -r.org_rdir_near[k]));
+            t_far = lc_min(t_far, std::fma(p[r.far_plane[k] + i], r.rdir[k], -r.org_rdir_far[k]));
         }
         dist[i] = t_near;
         if (t_near <= t_far * kFarScale) mask |= 1u << i;
