@@ -229,6 +229,30 @@ inline unsigned test_block(const TriangleBlock& block, uint32_t count, const Ray
 #endif
 }
 
+/// Asks for the memory of a child about to be tested: a node's four cache lines, a block's
+/// three. Diffuse rays miss in L2 on about every node (Sponza's tree is 1.2 MB of nodes
+/// and 4 MB of blocks); fetching all the hit children at once overlaps those misses.
+inline void prefetch_child(const TriangleAccel::Impl& accel, uint32_t ref) {
+#if LUCENT_ACCEL_SIMD
+    if (is_leaf(ref)) {
+        const char* p = reinterpret_cast<const char*>(&accel.blocks[leaf_block(ref)]);
+        static_assert(sizeof(TriangleBlock) == 3 * 64);
+        _mm_prefetch(p, _MM_HINT_T0);
+        _mm_prefetch(p + 64, _MM_HINT_T0);
+        _mm_prefetch(p + 128, _MM_HINT_T0);
+    } else {
+        const char* p = reinterpret_cast<const char*>(&accel.nodes[ref]);
+        static_assert(sizeof(WideNode) == 4 * 64);
+        _mm_prefetch(p, _MM_HINT_T0);
+        _mm_prefetch(p + 64, _MM_HINT_T0);
+        _mm_prefetch(p + 128, _MM_HINT_T0);
+        _mm_prefetch(p + 192, _MM_HINT_T0);
+    }
+#else
+    (void)accel, (void)ref;
+#endif
+}
+
 enum class Query { kClosest, kAny, kFiltered };
 
 /// The one traversal loop, specialized per query. Closest and filtered queries visit the
@@ -269,6 +293,12 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                     ref = node.child[c0];
                     continue;
                 } else {
+                    // Occlusion rays gain nothing from this (they measured 4 % slower): a
+                    // closest-hit ray visits most of the children it pushes, an occlusion
+                    // ray often stops at the first.
+                    prefetch_child(accel, node.child[c0]);
+                    for (unsigned m = mask; m != 0; m &= m - 1)
+                        prefetch_child(accel, node.child[std::countr_zero(m)]);
                     unsigned c1 = (unsigned)std::countr_zero(mask);
                     mask &= mask - 1;
                     if (mask == 0) {
