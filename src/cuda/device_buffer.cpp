@@ -10,10 +10,7 @@ namespace lucent::cuda {
 
 namespace {
 const DriverApi& api() {
-    std::string why;
-    const DriverApi* d = driver(&why);
-    if (!d) throw Error("CUDA device memory: " + why);
-    return *d;
+    return require_driver("CUDA device memory");
 }
 }  // namespace
 

@@ -16,10 +16,7 @@ namespace lucent::cuda {
 namespace {
 
 const DriverApi& api() {
-    std::string why;
-    const DriverApi* d = driver(&why);
-    if (!d) throw Error("display frames: " + why);
-    return *d;
+    return require_driver("display frames");
 }
 
 /// Makes `context` current on this thread for the scope, restoring the previous one (frames
@@ -111,16 +108,15 @@ void CudaDisplayFrame::copy_to_surface(CUsurfObject surface) const {
     void* args[] = {&pixels, &surface, &width, &height};
     // No wait here: the unmap that follows on the same stream orders OpenGL after the kernel,
     // and the frame's block is only reused (or freed) behind it.
-    check(api().cuLaunchKernel(m_pool->to_surface, (width + 31) / 32, (height + 7) / 8, 1, 32, 8,
-                               1, 0, nullptr, args, nullptr),
+    check(api().cuLaunchKernel(m_pool->to_surface, (width + 31) / 32, (height + 7) / 8, 1, 32, 8, 1,
+                               0, nullptr, args, nullptr),
           "copy a display frame into an OpenGL texture");
 }
 
 std::vector<unsigned char> CudaDisplayFrame::rgba() const {
     std::vector<unsigned char> pixels(bytes());
     ScopedContext scope(m_pool->context);
-    check(api().cuMemcpyDtoH(pixels.data(), m_pixels, pixels.size()),
-          "download a display frame");
+    check(api().cuMemcpyDtoH(pixels.data(), m_pixels, pixels.size()), "download a display frame");
     return pixels;
 }
 
@@ -132,9 +128,9 @@ DisplayEncoder::DisplayEncoder(CUdevice device, int sm)
           "cuModuleLoadData (display frames)");
     check(api().cuModuleGetFunction(&m_pool->encode, m_pool->module, "lucent_display_srgb8"),
           "lucent_display_srgb8");
-    check(api().cuModuleGetFunction(&m_pool->to_surface, m_pool->module,
-                                    "lucent_display_to_surface"),
-          "lucent_display_to_surface");
+    check(
+        api().cuModuleGetFunction(&m_pool->to_surface, m_pool->module, "lucent_display_to_surface"),
+        "lucent_display_to_surface");
     m_thresholds.upload(srgb8_thresholds(), gpu::kSrgbThresholds * sizeof(float));
 }
 
@@ -145,10 +141,11 @@ std::shared_ptr<DisplayFrame> DisplayEncoder::encode(CUdeviceptr linear, unsigne
     auto frame = std::make_shared<CudaDisplayFrame>(m_pool, pixels, width, height);
     CUdeviceptr thresholds = m_thresholds.ptr();
     void* args[] = {&linear, &pixels, &count, &thresholds};
-    const unsigned blocks = std::min(4096u, (count + gpu::kDisplayThreads - 1) / gpu::kDisplayThreads);
+    const unsigned blocks =
+        std::min(4096u, (count + gpu::kDisplayThreads - 1) / gpu::kDisplayThreads);
     // The legacy default stream: it waits for the launch's (blocking) streams.
-    check(api().cuLaunchKernel(m_pool->encode, std::max(blocks, 1u), 1, 1, gpu::kDisplayThreads, 1, 1, 0,
-                               nullptr, args, nullptr),
+    check(api().cuLaunchKernel(m_pool->encode, std::max(blocks, 1u), 1, 1, gpu::kDisplayThreads, 1,
+                               1, 0, nullptr, args, nullptr),
           "encode a display frame");
     check(api().cuStreamSynchronize(nullptr), "encode a display frame");
     return frame;
@@ -215,8 +212,9 @@ void GlTexture::release() {
 void GlTexture::copy_from(const DisplayFrame& frame) {
     const auto* device_frame = dynamic_cast<const cuda::CudaDisplayFrame*>(&frame);
     if (!device_frame)
-        throw Error("GlTexture::copy_from: the frame is in host memory; upload its rgba() to "
-                    "OpenGL instead");
+        throw Error(
+            "GlTexture::copy_from: the frame is in host memory; upload its rgba() to "
+            "OpenGL instead");
     if (m->resource && m->context != device_frame->context()) release();  // another GPU
     cuda::ScopedContext scope(device_frame->context());
     const cuda::DriverApi& d = *m->d;

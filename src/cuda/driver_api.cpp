@@ -107,6 +107,13 @@ const DriverApi* driver(std::string* why) {
     return loaded.ok ? &loaded.api : nullptr;
 }
 
+const DriverApi& require_driver(const char* what) {
+    std::string why;
+    const DriverApi* d = driver(&why);
+    if (!d) throw Error(std::string(what) + ": " + why);
+    return *d;
+}
+
 void check(CUresult result, const char* what) {
     if (result == CUDA_SUCCESS) return;
     const char* s = nullptr;

@@ -68,6 +68,9 @@ struct DriverApi {
 /// The driver, loaded and initialised once; null when there is none (`why` says what failed).
 const DriverApi* driver(std::string* why = nullptr);
 
+/// The driver, or lucent::Error "<what>: <why there is none>".
+const DriverApi& require_driver(const char* what);
+
 /// Throws lucent::Error "<what>: <CUDA error string>" when result is not CUDA_SUCCESS.
 void check(CUresult result, const char* what);
 

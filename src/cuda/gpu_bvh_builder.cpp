@@ -17,10 +17,7 @@ namespace lucent::cuda {
 namespace {
 
 const DriverApi& api() {
-    std::string why;
-    const DriverApi* d = driver(&why);
-    if (!d) throw Error("GPU BVH builder: " + why);
-    return *d;
+    return require_driver("GPU BVH builder");
 }
 
 /// Grows `buffer` to at least `bytes` (keeps it when it is big enough).
