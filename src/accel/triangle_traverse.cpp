@@ -22,9 +22,13 @@ namespace lucent::accel {
 
 namespace {
 
-// Box far distances are scaled up by 2 ulp so that rounding never culls a box the ray
-// touches (Ize 2013, "Robust BVH ray traversal").
-constexpr float kFarScale = 1.00000024f;
+// Far planes are tested with 1/d scaled up by 1 + 2^-21 so that rounding never culls a box
+// the ray touches (Ize 2013, "Robust BVH ray traversal", scales the far distance instead).
+// With u = 2^-24, a computed near distance is at most (1 + u)^2 times the true one (1/d and
+// the FMA each rounded once) and a far one at least (1 - u)^3 * kFarScale times it (1/d,
+// its scaling, the FMA), so near <= far survives rounding when kFarScale >= 1 + 5u + O(u^2);
+// 1 + 8u leaves room. Scaling 1/d at setup keeps a multiply out of every node's test.
+constexpr float kFarScale = 1.0f + 0x1p-21f;
 constexpr int kStackSize = 512;  // 7 pushes per level; wide depth <= binary depth <= 60
 // The largest |1/d| of the fused slab test, and the largest |o * (1/d)|: 1/d is clamped to
 // both, so o/d stays finite wherever the origin is (far beyond any t a ray asks about).
@@ -39,9 +43,9 @@ struct RayState {
     // The slab test in its fused form, t = plane * (1/d) - o * (1/d): one FMA per plane.
     // o * (1/d) is rounded, an absolute error the (plane - o) * (1/d) form does not have,
     // so near planes subtract o/d + err and far planes o/d - err, err bounding that
-    // rounding with room to spare: the interval only widens (Ize 2013 covers the rest
-    // with kFarScale). 1/d is kept finite (|1/d| <= kMaxInverse) so that o/d is.
-    __m256 rdir8[3], org_rdir_near8[3], org_rdir_far8[3], tmin8;
+    // rounding with room to spare: the interval only widens (kFarScale covers the rest).
+    // 1/d is kept finite (|1/d| <= kMaxInverse) so that o/d is.
+    __m256 rdir_near8[3], rdir_far8[3], org_rdir_near8[3], org_rdir_far8[3], tmin8;
     // The watertight test's origin, shear and scale in the permuted axes, four lanes.
     __m128 ox4, oy4, oz4, sx4, sy4, sz4, tmin4;
 
@@ -58,19 +62,25 @@ struct RayState {
         // 1/(+-0) is +-inf, which the clamp turns into +-limit.
         const __m128 r =
             _mm_max_ps(_mm_min_ps(_mm_div_ps(one, d4), limit), _mm_xor_ps(limit, sign_bit));
+        const __m128 r_far = _mm_mul_ps(r, _mm_set1_ps(kFarScale));
         const __m128 od = _mm_mul_ps(o4, r);
-        const __m128 err = _mm_mul_ps(_mm_andnot_ps(sign_bit, od), _mm_set1_ps(0x1p-21f));
-        alignas(16) float rs[4], near[4], far[4];
+        const __m128 od_far = _mm_mul_ps(o4, r_far);
+        const __m128 err_scale = _mm_set1_ps(0x1p-21f);
+        const __m128 err = _mm_mul_ps(_mm_andnot_ps(sign_bit, od), err_scale);
+        const __m128 err_far = _mm_mul_ps(_mm_andnot_ps(sign_bit, od_far), err_scale);
+        alignas(16) float rs[4], rs_far[4], near[4], far[4];
         _mm_store_ps(rs, r);
+        _mm_store_ps(rs_far, r_far);
         _mm_store_ps(near, _mm_add_ps(od, err));
-        _mm_store_ps(far, _mm_sub_ps(od, err));
+        _mm_store_ps(far, _mm_sub_ps(od_far, err_far));
         const unsigned negative =
             (unsigned)_mm_movemask_ps(_mm_cmp_ps(r, _mm_setzero_ps(), _CMP_LT_OQ));
         for (int k = 0; k < 3; ++k) {
             const bool neg = (negative >> k) & 1u;
             near_plane[k] = 16 * k + (neg ? 8 : 0);
             far_plane[k] = 16 * k + (neg ? 0 : 8);
-            rdir8[k] = _mm256_broadcast_ss(&rs[k]);
+            rdir_near8[k] = _mm256_broadcast_ss(&rs[k]);
+            rdir_far8[k] = _mm256_broadcast_ss(&rs_far[k]);
             org_rdir_near8[k] = _mm256_broadcast_ss(&near[k]);
             org_rdir_far8[k] = _mm256_broadcast_ss(&far[k]);
         }
@@ -92,7 +102,7 @@ struct RayState {
     }
 #else
     // The same fused slab test and watertight setup in scalar code, bit for bit.
-    float rdir[3], org_rdir_near[3], org_rdir_far[3];
+    float rdir_near[3], rdir_far[3], org_rdir_near[3], org_rdir_far[3];
     WatertightRay wt;
     float tmin;
 
@@ -102,11 +112,12 @@ struct RayState {
             const float limit =
                 std::min(kMaxInverse, kMaxOverInverse / std::max(std::fabs(org[k]), 1.0f));
             const float r = std::clamp(1.0f / dir[k], -limit, limit);
-            const float od = org[k] * r;
-            const float err = std::fabs(od) * 0x1p-21f;
-            rdir[k] = r;
-            org_rdir_near[k] = od + err;
-            org_rdir_far[k] = od - err;
+            const float r_far = r * kFarScale;
+            const float od = org[k] * r, od_far = org[k] * r_far;
+            rdir_near[k] = r;
+            rdir_far[k] = r_far;
+            org_rdir_near[k] = od + std::fabs(od) * 0x1p-21f;
+            org_rdir_far[k] = od_far - std::fabs(od_far) * 0x1p-21f;
             near_plane[k] = 16 * k + (r < 0.0f ? 8 : 0);
             far_plane[k] = 16 * k + (r < 0.0f ? 0 : 8);
         }
@@ -124,26 +135,28 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
     __m256 tn[3], tf[3];
     for (int k = 0; k < 3; ++k) {
         tn[k] =
-            _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir8[k], r.org_rdir_near8[k]);
-        tf[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir8[k], r.org_rdir_far8[k]);
+            _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir_near8[k], r.org_rdir_near8[k]);
+        tf[k] =
+            _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir_far8[k], r.org_rdir_far8[k]);
     }
     __m256 t_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), _mm256_max_ps(tn[2], r.tmin8));
-    __m256 t_far =
-        _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]), _mm256_min_ps(tf[2], _mm256_set1_ps(tmax)));
-    t_far = _mm256_mul_ps(t_far, _mm256_set1_ps(kFarScale));
+    // tmax is scaled like the far planes: a box entered within rounding of tmax stays in.
+    const __m256 t_far = _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]),
+                                       _mm256_min_ps(tf[2], _mm256_set1_ps(tmax * kFarScale)));
     _mm256_storeu_ps(dist, t_near);
     return (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ));
 #else
     unsigned mask = 0;
     for (int i = 0; i < kWideArity; ++i) {
-        float t_near = r.tmin, t_far = tmax;
+        float t_near = r.tmin, t_far = tmax * kFarScale;
         for (int k = 0; k < 3; ++k) {
-            t_near =
-                lc_max(t_near, std::fma(p[r.near_plane[k] + i], r.rdir[k], -r.org_rdir_near[k]));
-            t_far = lc_min(t_far, std::fma(p[r.far_plane[k] + i], r.rdir[k], -r.org_rdir_far[k]));
+            t_near = lc_max(t_near,
+                            std::fma(p[r.near_plane[k] + i], r.rdir_near[k], -r.org_rdir_near[k]));
+            t_far =
+                lc_min(t_far, std::fma(p[r.far_plane[k] + i], r.rdir_far[k], -r.org_rdir_far[k]));
         }
         dist[i] = t_near;
-        if (t_near <= t_far * kFarScale) mask |= 1u << i;
+        if (t_near <= t_far) mask |= 1u << i;
     }
     return mask;
 #endif
