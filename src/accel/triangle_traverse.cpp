@@ -63,26 +63,24 @@ struct RayState {
         const __m128 r =
             _mm_max_ps(_mm_min_ps(_mm_div_ps(one, d4), limit), _mm_xor_ps(limit, sign_bit));
         const __m128 r_far = _mm_mul_ps(r, _mm_set1_ps(kFarScale));
+        // One err serves both sides: |o/d| * 2^-21 is still several ulp of o * r_far.
         const __m128 od = _mm_mul_ps(o4, r);
-        const __m128 od_far = _mm_mul_ps(o4, r_far);
-        const __m128 err_scale = _mm_set1_ps(0x1p-21f);
-        const __m128 err = _mm_mul_ps(_mm_andnot_ps(sign_bit, od), err_scale);
-        const __m128 err_far = _mm_mul_ps(_mm_andnot_ps(sign_bit, od_far), err_scale);
-        alignas(16) float rs[4], rs_far[4], near[4], far[4];
-        _mm_store_ps(rs, r);
-        _mm_store_ps(rs_far, r_far);
-        _mm_store_ps(near, _mm_add_ps(od, err));
-        _mm_store_ps(far, _mm_sub_ps(od_far, err_far));
-        const unsigned negative =
-            (unsigned)_mm_movemask_ps(_mm_cmp_ps(r, _mm_setzero_ps(), _CMP_LT_OQ));
+        const __m128 err = _mm_mul_ps(_mm_andnot_ps(sign_bit, od), _mm_set1_ps(0x1p-21f));
+        const __m128 near = _mm_add_ps(od, err);
+        const __m128 far = _mm_sub_ps(_mm_mul_ps(o4, r_far), err);
+        // The planes to load follow the sign of d, not of 1/d, so that the first node's
+        // loads need not wait for the division (the two agree but for a NaN d).
+        const unsigned negative = (unsigned)_mm_movemask_ps(d4);
         for (int k = 0; k < 3; ++k) {
             const bool neg = (negative >> k) & 1u;
             near_plane[k] = 16 * k + (neg ? 8 : 0);
             far_plane[k] = 16 * k + (neg ? 0 : 8);
-            rdir_near8[k] = _mm256_broadcast_ss(&rs[k]);
-            rdir_far8[k] = _mm256_broadcast_ss(&rs_far[k]);
-            org_rdir_near8[k] = _mm256_broadcast_ss(&near[k]);
-            org_rdir_far8[k] = _mm256_broadcast_ss(&far[k]);
+            // Lane k to all eight lanes, register to register.
+            const __m256i lane = _mm256_set1_epi32(k);
+            rdir_near8[k] = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(r), lane);
+            rdir_far8[k] = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(r_far), lane);
+            org_rdir_near8[k] = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(near), lane);
+            org_rdir_far8[k] = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(far), lane);
         }
         tmin8 = _mm256_set1_ps(t0);
         tmin4 = _mm_set1_ps(t0);
@@ -113,13 +111,14 @@ struct RayState {
                 std::min(kMaxInverse, kMaxOverInverse / std::max(std::fabs(org[k]), 1.0f));
             const float r = std::clamp(1.0f / dir[k], -limit, limit);
             const float r_far = r * kFarScale;
-            const float od = org[k] * r, od_far = org[k] * r_far;
+            const float od = org[k] * r, err = std::fabs(od) * 0x1p-21f;
             rdir_near[k] = r;
             rdir_far[k] = r_far;
-            org_rdir_near[k] = od + std::fabs(od) * 0x1p-21f;
-            org_rdir_far[k] = od_far - std::fabs(od_far) * 0x1p-21f;
-            near_plane[k] = 16 * k + (r < 0.0f ? 8 : 0);
-            far_plane[k] = 16 * k + (r < 0.0f ? 0 : 8);
+            org_rdir_near[k] = od + err;
+            org_rdir_far[k] = org[k] * r_far - err;
+            const bool neg = std::signbit(dir[k]);
+            near_plane[k] = 16 * k + (neg ? 8 : 0);
+            far_plane[k] = 16 * k + (neg ? 0 : 8);
         }
         wt = make_watertight_ray(o, d);
         tmin = t0;
