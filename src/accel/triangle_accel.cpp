@@ -46,8 +46,8 @@ struct Collapser {
     const Bvh& binary;
     std::span<const float3> vertices;
     std::span<const uint3> indices;
-    std::vector<WideNode>& nodes;
-    std::vector<TriangleBlock>& blocks;
+    WideNodes& nodes;
+    TriangleBlocks& blocks;
     unsigned max_depth = 0;
     // cover[n][k], k = 1..kWideArity; split[n][k]: subtrees given to n's first child, or 0
     // when n stands as one subtree itself.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/huge_page_allocator.h"
 
 namespace lucent::accel {
 
@@ -29,6 +30,9 @@ struct alignas(64) TriangleBlock {
     uint32_t prim[4];
 };
 
+using WideNodes = std::vector<WideNode, HugePageAllocator<WideNode>>;
+using TriangleBlocks = std::vector<TriangleBlock, HugePageAllocator<TriangleBlock>>;
+
 inline bool is_leaf(uint32_t ref) {
     return (ref & kLeafBit) != 0;
 }
@@ -41,8 +45,8 @@ inline uint32_t leaf_count(uint32_t ref) {
 
 struct TriangleAccel::Impl {
     Bvh binary;                   // the SAH tree, kept for refit
-    std::vector<WideNode> nodes;  // nodes[0] is the root
-    std::vector<TriangleBlock> blocks;
+    WideNodes nodes;  // nodes[0] is the root
+    TriangleBlocks blocks;
     size_t triangle_count = 0;
     unsigned wide_depth = 0;
     double sah_cost = 0.0;
