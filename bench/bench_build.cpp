@@ -102,9 +102,9 @@ int run_bench_build(const BuildBenchOptions& options) {
         std::printf(
             "{\"scene\": \"%s\", \"triangles\": %zu, \"build_ms\": %.3f, \"min_ms\": %.3f, "
             "\"max_ms\": %.3f, \"mtris_per_s\": %.3f, \"sah_cost\": %.4f, "
-            "\"wide_nodes\": %zu, \"leaves\": %zu, \"depth\": %u",
+            "\"wide_nodes\": %zu, \"leaves\": %zu, \"large_leaves\": %zu, \"depth\": %u",
             options.scene.c_str(), tris, lucent_ms, lo, hi, tris / lucent_ms * 1e-3, stats.sah_cost,
-            stats.node_count, stats.leaf_count, stats.depth);
+            stats.node_count, stats.leaf_count, stats.large_leaf_count, stats.depth);
         if (peer)
             std::printf(", \"embree_build_ms\": %.3f, \"ratio\": %.4f", embree_ms,
                         embree_ms / lucent_ms);
@@ -115,9 +115,9 @@ int run_bench_build(const BuildBenchOptions& options) {
                 options.repeat);
     std::printf(
         "build %.2f ms (min %.2f, max %.2f) %.2f Mtris/s sah=%.3f wide_nodes=%zu "
-        "leaves=%zu depth=%u\n",
+        "leaves=%zu large_leaves=%zu depth=%u\n",
         lucent_ms, lo, hi, tris / lucent_ms * 1e-3, stats.sah_cost, stats.node_count,
-        stats.leaf_count, stats.depth);
+        stats.leaf_count, stats.large_leaf_count, stats.depth);
     if (peer) {
         std::printf("embree build %.2f ms (RTC_BUILD_QUALITY_HIGH, %u threads)\n", embree_ms,
                     threads);

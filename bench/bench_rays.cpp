@@ -308,8 +308,9 @@ int run_bench_rays(const RaysOptions& options) {
     std::printf("scene %s: %zu triangles, %ux%u, %u threads, median of %d repeats\n",
                 options.scene.c_str(), mesh.indices.size(), options.width, options.height, threads,
                 options.repeat);
-    std::printf("build %.2f ms (sah %.2f, %zu wide nodes, %zu leaves)\n", stats.build_ms,
-                stats.sah_cost, stats.node_count, stats.leaf_count);
+    std::printf("build %.2f ms (sah %.2f, %zu wide nodes, %zu leaves, %zu of them 5-8 triangles)\n",
+                stats.build_ms, stats.sah_cost, stats.node_count, stats.leaf_count,
+                stats.large_leaf_count);
     print_engine("", lucent);
     if (!peer) {
         if (options.peer) std::printf("embree: not built in, no peer figures\n");

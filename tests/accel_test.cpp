@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -307,6 +308,43 @@ TEST(TriangleAccel, FarFromTheOriginEqualsBruteForce) {
     accel.build(m.positions, m.indices);
     for (TestRay r : random_rays(77, 1500)) {
         r.o = r.o + offset;
+        expect_same_closest(m, accel, r);
+        EXPECT_EQ(accel.occluded(r.o, r.d, r.tmin, r.tmax),
+                  brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
+    }
+}
+
+TEST(TriangleAccel, LeavesOfFiveToEightTrianglesEqualBruteForce) {
+    // Triangles whose boxes coincide cannot be split by the SAH, so each cell of 5 to 8 of
+    // them becomes one leaf, tested 8 lanes at once (4 for the cells of 3 and 4).
+    std::vector<std::array<int, 3>> spanning;  // corner triples whose box is the whole cube
+    for (int a = 0; a < 8; ++a)
+        for (int b = a + 1; b < 8; ++b)
+            for (int c = b + 1; c < 8; ++c)
+                if (((a ^ b) | (a ^ c)) == 7) spanning.push_back({a, b, c});
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    Mesh m;
+    for (int cell = 0; cell < 400; ++cell) {
+        const float3 lo = make_float3(uni(rng), uni(rng), uni(rng));
+        const float size = 0.01f + 0.05f * uni(rng);
+        const int count = 3 + cell % 6;
+        for (int i = 0; i < count; ++i) {
+            const auto& tri = spanning[(size_t(cell) * 7 + size_t(i) * 5) % spanning.size()];
+            const uint32_t base = (uint32_t)m.positions.size();
+            for (int corner : tri)
+                m.positions.push_back(lo + size * make_float3(float(corner & 1),
+                                                              float((corner >> 1) & 1),
+                                                              float((corner >> 2) & 1)));
+            m.indices.push_back(make_uint3(base, base + 1, base + 2));
+        }
+    }
+    TriangleAccel accel;
+    BuildStats stats;
+    accel.build(m.positions, m.indices, {}, &stats);
+    EXPECT_GT(stats.large_leaf_count, 100u);
+    EXPECT_LT(stats.large_leaf_count, stats.leaf_count);
+    for (const TestRay& r : random_rays(31, 1500)) {
         expect_same_closest(m, accel, r);
         EXPECT_EQ(accel.occluded(r.o, r.d, r.tmin, r.tmax),
                   brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);

@@ -292,7 +292,7 @@ struct Builder {
         while (depth > seen && !max_depth.compare_exchange_weak(seen, depth)) {
         }
         const uint32_t n = end - begin;
-        const uint32_t max_leaf = std::max(1, opt.max_leaf_size);
+        const uint32_t max_leaf = opt.max_leaf_size > 0 ? uint32_t(opt.max_leaf_size) : 4u;
         if (n <= 1) return make_leaf(node, begin, end);
 
         // Depth guard: below this depth a median split can still finish within kMaxDepth.

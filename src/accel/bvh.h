@@ -12,8 +12,10 @@
 namespace lucent::accel {
 
 struct BuildOptions {
-    int bins = 32;          // SAH bins per axis
-    int max_leaf_size = 4;  // primitives per leaf at most
+    int bins = 32;  // SAH bins per axis
+    // Primitives per leaf at most; 0 takes the structure's own: 4 for a Bvh, 8 for a
+    // TriangleAccel (one 8-lane block).
+    int max_leaf_size = 0;
     float traversal_cost = 1.0f;
     float intersection_cost = 1.0f;
     // TriangleAccel: split space too, not only the triangles (see SplitTriangles). Off where
@@ -36,6 +38,7 @@ struct BuildStats {
     double sah_cost = 0;  // SAH cost of the tree (traversal_cost, intersection_cost above)
     size_t node_count = 0;
     size_t leaf_count = 0;
+    size_t large_leaf_count = 0;  // TriangleAccel: leaves of 5 to 8 triangles (8-lane blocks)
     unsigned depth = 0;
 };
 

@@ -52,7 +52,9 @@ struct HugePageAllocator {
     }
 
   private:
-    static bool is_huge(size_t bytes) { return bytes >= kHugePage / 2; }
+    static bool is_huge(size_t bytes) {
+        return bytes >= kHugePage / 2;
+    }
 };
 
 }  // namespace lucent::accel

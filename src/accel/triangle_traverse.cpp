@@ -38,7 +38,7 @@ constexpr float kMaxOverInverse = 1e37f;
 /// Everything a ray needs in the inner loops, computed once per query.
 struct RayState {
     int near_plane[3], far_plane[3];  // offsets into WideNode::planes[axis]
-    int vx, vy, vz;                   // offsets of the permuted axes in TriangleBlock::vertex[v]
+    int kx, ky, kz;                   // the watertight test's permuted axes
 #if LUCENT_ACCEL_SIMD
     // The slab test in its fused form, t = plane * (1/d) - o * (1/d): one FMA per plane.
     // o * (1/d) is rounded, an absolute error the (plane - o) * (1/d) form does not have,
@@ -46,8 +46,9 @@ struct RayState {
     // rounding with room to spare: the interval only widens (kFarScale covers the rest).
     // 1/d is kept finite (|1/d| <= kMaxInverse) so that o/d is.
     __m256 rdir_near8[3], rdir_far8[3], org_rdir_near8[3], org_rdir_far8[3], tmin8;
-    // The watertight test's origin, shear and scale in the permuted axes, four lanes.
-    __m128 ox4, oy4, oz4, sx4, sy4, sz4, tmin4;
+    // The watertight test's origin, shear and scale in the permuted axes (a 4-lane block
+    // test takes the low half).
+    __m256 ox8, oy8, oz8, sx8, sy8, sz8;
 
     // The setup was 7-8 % of a query's time, so its nine divisions go three to an
     // instruction (the same correctly rounded quotients as make_watertight_ray's).
@@ -83,20 +84,19 @@ struct RayState {
             org_rdir_far8[k] = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(far), lane);
         }
         tmin8 = _mm256_set1_ps(t0);
-        tmin4 = _mm_set1_ps(t0);
 
         const float dir[3] = {d.x, d.y, d.z}, org[3] = {o.x, o.y, o.z};
         const WatertightAxes axes = watertight_axes(d);
-        vx = 4 * axes.kx, vy = 4 * axes.ky, vz = 4 * axes.kz;
+        kx = axes.kx, ky = axes.ky, kz = axes.kz;
         alignas(16) float shear[4];
         _mm_store_ps(shear, _mm_div_ps(_mm_setr_ps(dir[axes.kx], dir[axes.ky], 1.0f, 1.0f),
                                        _mm_set1_ps(dir[axes.kz])));
-        ox4 = _mm_set1_ps(org[axes.kx]);
-        oy4 = _mm_set1_ps(org[axes.ky]);
-        oz4 = _mm_set1_ps(org[axes.kz]);
-        sx4 = _mm_set1_ps(shear[0]);
-        sy4 = _mm_set1_ps(shear[1]);
-        sz4 = _mm_set1_ps(shear[2]);
+        ox8 = _mm256_set1_ps(org[axes.kx]);
+        oy8 = _mm256_set1_ps(org[axes.ky]);
+        oz8 = _mm256_set1_ps(org[axes.kz]);
+        sx8 = _mm256_set1_ps(shear[0]);
+        sy8 = _mm256_set1_ps(shear[1]);
+        sz8 = _mm256_set1_ps(shear[2]);
     }
 #else
     // The same fused slab test and watertight setup in scalar code, bit for bit.
@@ -122,7 +122,7 @@ struct RayState {
         }
         wt = make_watertight_ray(o, d);
         tmin = t0;
-        vx = 4 * wt.kx, vy = 4 * wt.ky, vz = 4 * wt.kz;
+        kx = wt.kx, ky = wt.ky, kz = wt.kz;
     }
 #endif
 };
@@ -133,8 +133,8 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
 #if LUCENT_ACCEL_SIMD
     __m256 tn[3], tf[3];
     for (int k = 0; k < 3; ++k) {
-        tn[k] =
-            _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir_near8[k], r.org_rdir_near8[k]);
+        tn[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir_near8[k],
+                                r.org_rdir_near8[k]);
         tf[k] =
             _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir_far8[k], r.org_rdir_far8[k]);
     }
@@ -162,12 +162,68 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
 }
 
 #if LUCENT_ACCEL_SIMD
-/// a*b - c*d, four lanes, with the same operations as difference_of_products().
-inline __m128 dop4(__m128 a, __m128 b, __m128 c, __m128 d) {
-    __m128 cd = _mm_mul_ps(c, d);
-    __m128 err = _mm_fnmadd_ps(c, d, cd);
-    __m128 dop = _mm_fmsub_ps(a, b, cd);
-    return _mm_add_ps(dop, err);
+/// The operations of the watertight block test on four lanes (SSE) or eight (AVX), so one
+/// template serves both block widths.
+template <int kLanes>
+struct Lanes;
+
+template <>
+struct Lanes<4> {
+    using V = __m128;
+    static V load(const float* p) { return _mm_load_ps(p); }
+    static V set1(float x) { return _mm_set1_ps(x); }
+    static V zero() { return _mm_setzero_ps(); }
+    static V from8(__m256 x) { return _mm256_castps256_ps128(x); }
+    static V add(V a, V b) { return _mm_add_ps(a, b); }
+    static V sub(V a, V b) { return _mm_sub_ps(a, b); }
+    static V mul(V a, V b) { return _mm_mul_ps(a, b); }
+    static V div(V a, V b) { return _mm_div_ps(a, b); }
+    static V fmadd(V a, V b, V c) { return _mm_fmadd_ps(a, b, c); }
+    static V fmsub(V a, V b, V c) { return _mm_fmsub_ps(a, b, c); }
+    static V fnmadd(V a, V b, V c) { return _mm_fnmadd_ps(a, b, c); }
+    static V and_(V a, V b) { return _mm_and_ps(a, b); }
+    static V or_(V a, V b) { return _mm_or_ps(a, b); }
+    static V andnot(V a, V b) { return _mm_andnot_ps(a, b); }
+    template <int kCmp>
+    static V cmp(V a, V b) {
+        return _mm_cmp_ps(a, b, kCmp);
+    }
+    static unsigned mask(V a) { return (unsigned)_mm_movemask_ps(a); }
+    static void store(float* p, V a) { _mm_store_ps(p, a); }
+};
+
+template <>
+struct Lanes<8> {
+    using V = __m256;
+    static V load(const float* p) { return _mm256_load_ps(p); }
+    static V set1(float x) { return _mm256_set1_ps(x); }
+    static V zero() { return _mm256_setzero_ps(); }
+    static V from8(__m256 x) { return x; }
+    static V add(V a, V b) { return _mm256_add_ps(a, b); }
+    static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
+    static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
+    static V div(V a, V b) { return _mm256_div_ps(a, b); }
+    static V fmadd(V a, V b, V c) { return _mm256_fmadd_ps(a, b, c); }
+    static V fmsub(V a, V b, V c) { return _mm256_fmsub_ps(a, b, c); }
+    static V fnmadd(V a, V b, V c) { return _mm256_fnmadd_ps(a, b, c); }
+    static V and_(V a, V b) { return _mm256_and_ps(a, b); }
+    static V or_(V a, V b) { return _mm256_or_ps(a, b); }
+    static V andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
+    template <int kCmp>
+    static V cmp(V a, V b) {
+        return _mm256_cmp_ps(a, b, kCmp);
+    }
+    static unsigned mask(V a) { return (unsigned)_mm256_movemask_ps(a); }
+    static void store(float* p, V a) { _mm256_store_ps(p, a); }
+};
+
+/// a*b - c*d on every lane, with the same operations as difference_of_products().
+template <class L>
+inline typename L::V difference_of_products(typename L::V a, typename L::V b, typename L::V c,
+                                            typename L::V d) {
+    const typename L::V cd = L::mul(c, d);
+    const typename L::V err = L::fnmadd(c, d, cd);
+    return L::add(L::fmsub(a, b, cd), err);
 }
 #endif
 
@@ -175,54 +231,59 @@ inline __m128 dop4(__m128 a, __m128 b, __m128 c, __m128 d) {
 /// barycentrics of vertices 1 and 2 with their denominator, so that a hit's (u, v) are
 /// two divisions away instead of a second test.
 struct BlockLanes {
-    alignas(16) float t[4];
-    alignas(16) float e1[4];
-    alignas(16) float e2[4];
-    alignas(16) float det[4];
+    alignas(32) float t[kMaxLeafTriangles];
+    alignas(32) float e1[kMaxLeafTriangles];
+    alignas(32) float e2[kMaxLeafTriangles];
+    alignas(32) float det[kMaxLeafTriangles];
 };
 
 /// Watertight test of the `count` triangles of a block against (tmin, tmax): returns the
 /// lanes hit and writes their distances and edge functions.
-inline unsigned test_block(const TriangleBlock& block, uint32_t count, const RayState& r,
+template <int kLanes>
+inline unsigned test_block(const TriangleBlock<kLanes>& block, uint32_t count, const RayState& r,
                            float tmax, BlockLanes& out) {
 #if LUCENT_ACCEL_SIMD
+    using L = Lanes<kLanes>;
+    using V = typename L::V;
     const float* v0 = &block.vertex[0][0][0];
     const float* v1 = &block.vertex[1][0][0];
     const float* v2 = &block.vertex[2][0][0];
-    const __m128 az = _mm_sub_ps(_mm_load_ps(v0 + r.vz), r.oz4);
-    const __m128 bz = _mm_sub_ps(_mm_load_ps(v1 + r.vz), r.oz4);
-    const __m128 cz = _mm_sub_ps(_mm_load_ps(v2 + r.vz), r.oz4);
-    const __m128 ax = _mm_fnmadd_ps(r.sx4, az, _mm_sub_ps(_mm_load_ps(v0 + r.vx), r.ox4));
-    const __m128 ay = _mm_fnmadd_ps(r.sy4, az, _mm_sub_ps(_mm_load_ps(v0 + r.vy), r.oy4));
-    const __m128 bx = _mm_fnmadd_ps(r.sx4, bz, _mm_sub_ps(_mm_load_ps(v1 + r.vx), r.ox4));
-    const __m128 by = _mm_fnmadd_ps(r.sy4, bz, _mm_sub_ps(_mm_load_ps(v1 + r.vy), r.oy4));
-    const __m128 cx = _mm_fnmadd_ps(r.sx4, cz, _mm_sub_ps(_mm_load_ps(v2 + r.vx), r.ox4));
-    const __m128 cy = _mm_fnmadd_ps(r.sy4, cz, _mm_sub_ps(_mm_load_ps(v2 + r.vy), r.oy4));
-    const __m128 e0 = dop4(cx, by, cy, bx);
-    const __m128 e1 = dop4(ax, cy, ay, cx);
-    const __m128 e2 = dop4(bx, ay, by, ax);
-    const __m128 zero = _mm_setzero_ps();
-    const __m128 neg =
-        _mm_or_ps(_mm_or_ps(_mm_cmp_ps(e0, zero, _CMP_LT_OQ), _mm_cmp_ps(e1, zero, _CMP_LT_OQ)),
-                  _mm_cmp_ps(e2, zero, _CMP_LT_OQ));
-    const __m128 pos =
-        _mm_or_ps(_mm_or_ps(_mm_cmp_ps(e0, zero, _CMP_GT_OQ), _mm_cmp_ps(e1, zero, _CMP_GT_OQ)),
-                  _mm_cmp_ps(e2, zero, _CMP_GT_OQ));
-    const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
-    const __m128 inside = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmp_ps(det, zero, _CMP_NEQ_UQ));
-    unsigned mask = (unsigned)_mm_movemask_ps(inside) & ((1u << count) - 1);
+    const int kx = kLanes * r.kx, ky = kLanes * r.ky, kz = kLanes * r.kz;
+    const V ox = L::from8(r.ox8), oy = L::from8(r.oy8), oz = L::from8(r.oz8);
+    const V sx = L::from8(r.sx8), sy = L::from8(r.sy8), sz = L::from8(r.sz8);
+    const V az = L::sub(L::load(v0 + kz), oz);
+    const V bz = L::sub(L::load(v1 + kz), oz);
+    const V cz = L::sub(L::load(v2 + kz), oz);
+    const V ax = L::fnmadd(sx, az, L::sub(L::load(v0 + kx), ox));
+    const V ay = L::fnmadd(sy, az, L::sub(L::load(v0 + ky), oy));
+    const V bx = L::fnmadd(sx, bz, L::sub(L::load(v1 + kx), ox));
+    const V by = L::fnmadd(sy, bz, L::sub(L::load(v1 + ky), oy));
+    const V cx = L::fnmadd(sx, cz, L::sub(L::load(v2 + kx), ox));
+    const V cy = L::fnmadd(sy, cz, L::sub(L::load(v2 + ky), oy));
+    const V e0 = difference_of_products<L>(cx, by, cy, bx);
+    const V e1 = difference_of_products<L>(ax, cy, ay, cx);
+    const V e2 = difference_of_products<L>(bx, ay, by, ax);
+    const V zero = L::zero();
+    const V neg =
+        L::or_(L::or_(L::template cmp<_CMP_LT_OQ>(e0, zero), L::template cmp<_CMP_LT_OQ>(e1, zero)),
+               L::template cmp<_CMP_LT_OQ>(e2, zero));
+    const V pos =
+        L::or_(L::or_(L::template cmp<_CMP_GT_OQ>(e0, zero), L::template cmp<_CMP_GT_OQ>(e1, zero)),
+               L::template cmp<_CMP_GT_OQ>(e2, zero));
+    const V det = L::add(L::add(e0, e1), e2);
+    const V inside = L::andnot(L::and_(neg, pos), L::template cmp<_CMP_NEQ_UQ>(det, zero));
+    unsigned mask = L::mask(inside) & ((1u << count) - 1);
     if (mask == 0) return 0;
-    const __m128 scaled = _mm_fmadd_ps(
-        e2, _mm_mul_ps(r.sz4, cz),
-        _mm_fmadd_ps(e1, _mm_mul_ps(r.sz4, bz), _mm_mul_ps(e0, _mm_mul_ps(r.sz4, az))));
-    const __m128 t = _mm_div_ps(scaled, det);
-    const __m128 in_range = _mm_and_ps(_mm_cmp_ps(t, r.tmin4, _CMP_GT_OQ),
-                                       _mm_cmp_ps(t, _mm_set1_ps(tmax), _CMP_LT_OQ));
-    mask &= (unsigned)_mm_movemask_ps(in_range);
-    _mm_store_ps(out.t, t);
-    _mm_store_ps(out.e1, e1);
-    _mm_store_ps(out.e2, e2);
-    _mm_store_ps(out.det, det);
+    const V scaled =
+        L::fmadd(e2, L::mul(sz, cz), L::fmadd(e1, L::mul(sz, bz), L::mul(e0, L::mul(sz, az))));
+    const V t = L::div(scaled, det);
+    const V in_range = L::and_(L::template cmp<_CMP_GT_OQ>(t, L::from8(r.tmin8)),
+                               L::template cmp<_CMP_LT_OQ>(t, L::set1(tmax)));
+    mask &= L::mask(in_range);
+    L::store(out.t, t);
+    L::store(out.e1, e1);
+    L::store(out.e2, e2);
+    L::store(out.det, det);
     return mask;
 #else
     unsigned mask = 0;
@@ -244,13 +305,16 @@ inline unsigned test_block(const TriangleBlock& block, uint32_t count, const Ray
 }
 
 /// Asks for the memory of a child about to be tested: a node's four cache lines, a block's
-/// three. Diffuse rays miss in L2 on about every node (Sponza's tree is 1.2 MB of nodes
+/// three or five. Diffuse rays miss in L2 on about every node (Sponza's tree is 1.2 MB of nodes
 /// and 4 MB of blocks); fetching all the hit children at once overlaps those misses.
 inline void prefetch_child(const TriangleAccel::Impl& accel, uint32_t ref) {
 #if LUCENT_ACCEL_SIMD
-    if (is_leaf(ref)) {
-        const char* p = reinterpret_cast<const char*>(&accel.blocks[leaf_block(ref)]);
-        static_assert(sizeof(TriangleBlock) == 3 * 64);
+    static_assert(sizeof(TriangleBlock4) == 3 * 64 && sizeof(TriangleBlock8) == 5 * 64);
+    if (is_wide_leaf(ref)) {
+        const char* p = reinterpret_cast<const char*>(&accel.blocks8[leaf_block(ref)]);
+        for (int line = 0; line < 5; ++line) _mm_prefetch(p + 64 * line, _MM_HINT_T0);
+    } else if (is_leaf(ref)) {
+        const char* p = reinterpret_cast<const char*>(&accel.blocks4[leaf_block(ref)]);
         _mm_prefetch(p, _MM_HINT_T0);
         _mm_prefetch(p + 64, _MM_HINT_T0);
         _mm_prefetch(p + 128, _MM_HINT_T0);
@@ -351,8 +415,18 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                 }
             }
         } else if (ref != kEmptyChild) {
-            const TriangleBlock& block = accel.blocks[leaf_block(ref)];
-            unsigned mask = test_block(block, leaf_count(ref), r, tmax, lanes);
+            const uint32_t count = leaf_count(ref);
+            const uint32_t* prims;
+            unsigned mask;
+            if (count > kNarrowLeafTriangles) {
+                const TriangleBlock8& block = accel.blocks8[leaf_block(ref)];
+                mask = test_block(block, count, r, tmax, lanes);
+                prims = block.prim;
+            } else {
+                const TriangleBlock4& block = accel.blocks4[leaf_block(ref)];
+                mask = test_block(block, count, r, tmax, lanes);
+                prims = block.prim;
+            }
             if (mask != 0) {
                 if constexpr (kQuery == Query::kAny) {
                     return true;
@@ -362,7 +436,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         mask &= mask - 1;
                         if (lanes.t[lane] < tmax) {
                             tmax = lanes.t[lane];
-                            best_prim = block.prim[lane];
+                            best_prim = prims[lane];
                             best_e1 = lanes.e1[lane];
                             best_e2 = lanes.e2[lane];
                             best_det = lanes.det[lane];
@@ -376,7 +450,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         if (!(lanes.t[lane] < tmax)) continue;
                         TriangleHit candidate;
                         candidate.t = lanes.t[lane];
-                        candidate.prim = block.prim[lane];
+                        candidate.prim = prims[lane];
                         candidate.u = lanes.e1[lane] / lanes.det[lane];
                         candidate.v = lanes.e2[lane] / lanes.det[lane];
                         HitDecision decision = thunk(filter, candidate);
