@@ -127,8 +127,29 @@ struct RayState {
 #endif
 };
 
+/// The ray's current end with the broadcasts the tests compare against, computed when a
+/// hit moves it rather than at every node.
+struct RayEnd {
+    float t;
+#if LUCENT_ACCEL_SIMD
+    __m256 t8;    // for the block tests
+    __m256 far8;  // t * kFarScale for the node tests: a box entered within rounding of t
+                  // stays in, like the far planes
+#endif
+    explicit RayEnd(float tmax) {
+        set(tmax);
+    }
+    void set(float tmax) {
+        t = tmax;
+#if LUCENT_ACCEL_SIMD
+        t8 = _mm256_set1_ps(tmax);
+        far8 = _mm256_set1_ps(tmax * kFarScale);
+#endif
+    }
+};
+
 /// Slab test of the eight children: returns the hit mask and writes entry distances.
-inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, float* dist) {
+inline unsigned test_node(const WideNode& node, const RayState& r, const RayEnd& end, float* dist) {
     const float* p = &node.planes[0][0][0];
 #if LUCENT_ACCEL_SIMD
     __m256 tn[3], tf[3];
@@ -139,15 +160,13 @@ inline unsigned test_node(const WideNode& node, const RayState& r, float tmax, f
             _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir_far8[k], r.org_rdir_far8[k]);
     }
     __m256 t_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), _mm256_max_ps(tn[2], r.tmin8));
-    // tmax is scaled like the far planes: a box entered within rounding of tmax stays in.
-    const __m256 t_far = _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]),
-                                       _mm256_min_ps(tf[2], _mm256_set1_ps(tmax * kFarScale)));
+    const __m256 t_far = _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]), _mm256_min_ps(tf[2], end.far8));
     _mm256_storeu_ps(dist, t_near);
     return (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ));
 #else
     unsigned mask = 0;
     for (int i = 0; i < kWideArity; ++i) {
-        float t_near = r.tmin, t_far = tmax * kFarScale;
+        float t_near = r.tmin, t_far = end.t * kFarScale;
         for (int k = 0; k < 3; ++k) {
             t_near = lc_max(t_near,
                             std::fma(p[r.near_plane[k] + i], r.rdir_near[k], -r.org_rdir_near[k]));
@@ -241,7 +260,7 @@ struct BlockLanes {
 /// lanes hit and writes their distances and edge functions.
 template <int kLanes>
 inline unsigned test_block(const TriangleBlock<kLanes>& block, uint32_t count, const RayState& r,
-                           float tmax, BlockLanes& out) {
+                           const RayEnd& end, BlockLanes& out) {
 #if LUCENT_ACCEL_SIMD
     using L = Lanes<kLanes>;
     using V = typename L::V;
@@ -278,7 +297,7 @@ inline unsigned test_block(const TriangleBlock<kLanes>& block, uint32_t count, c
         L::fmadd(e2, L::mul(sz, cz), L::fmadd(e1, L::mul(sz, bz), L::mul(e0, L::mul(sz, az))));
     const V t = L::div(scaled, det);
     const V in_range = L::and_(L::template cmp<_CMP_GT_OQ>(t, L::from8(r.tmin8)),
-                               L::template cmp<_CMP_LT_OQ>(t, L::set1(tmax)));
+                               L::template cmp<_CMP_LT_OQ>(t, L::from8(end.t8)));
     mask &= L::mask(in_range);
     L::store(out.t, t);
     L::store(out.e1, e1);
@@ -293,7 +312,7 @@ inline unsigned test_block(const TriangleBlock<kLanes>& block, uint32_t count, c
             p[k] = make_float3(block.vertex[k][0][lane], block.vertex[k][1][lane],
                                block.vertex[k][2][lane]);
         float u, v;
-        if (intersect_triangle_watertight(r.wt, p[0], p[1], p[2], r.tmin, tmax, out.t[lane], u,
+        if (intersect_triangle_watertight(r.wt, p[0], p[1], p[2], r.tmin, end.t, out.t[lane], u,
                                           v)) {
             // (u, v) = (e1, e2) / det: a denominator of 1 hands them over unchanged.
             out.e1[lane] = u, out.e2[lane] = v, out.det[lane] = 1.0f;
@@ -331,6 +350,27 @@ inline void prefetch_child(const TriangleAccel::Impl& accel, uint32_t ref) {
 #endif
 }
 
+/// Pushes the children in `mask`, unordered, without their distances (an occlusion ray
+/// never compares them). With AVX-512 one compress moves the hit children together and one
+/// store writes them, eight slots wide; without, a loop per child.
+inline void push_children(const WideNode& node, unsigned mask, uint32_t* stack_ref,
+                          float* stack_dist, const float* dist, int& sp) {
+#if LUCENT_ACCEL_SIMD && defined(__AVX512VL__)
+    (void)stack_dist, (void)dist;
+    const __m256i children = _mm256_load_si256(reinterpret_cast<const __m256i*>(node.child));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack_ref + sp),
+                        _mm256_maskz_compress_epi32(__mmask8(mask), children));
+    sp += std::popcount(mask);
+#else
+    do {
+        const unsigned c = (unsigned)std::countr_zero(mask);
+        mask &= mask - 1;
+        stack_ref[sp] = node.child[c];
+        stack_dist[sp++] = dist[c];
+    } while (mask != 0);
+#endif
+}
+
 enum class Query { kClosest, kAny, kFiltered };
 
 /// The one traversal loop, specialized per query. Closest and filtered queries visit the
@@ -340,7 +380,8 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
               float tmax, TriangleHit* hit, HitDecision (*thunk)(void*, const TriangleHit&),
               void* filter) {
     const RayState r(origin, direction, tmin);
-    uint32_t stack_ref[kStackSize];
+    RayEnd end(tmax);
+    uint32_t stack_ref[kStackSize + kWideArity];  // push_children may write 8 past the top
     float stack_dist[kStackSize];
     int sp = 0;
     uint32_t ref = 0;
@@ -352,7 +393,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
     for (;;) {
         if (!is_leaf(ref)) {
             const WideNode& node = accel.nodes[ref];
-            unsigned mask = test_node(node, r, tmax, dist);
+            unsigned mask = test_node(node, r, end, dist);
             if (mask != 0) {
                 unsigned c0 = (unsigned)std::countr_zero(mask);
                 mask &= mask - 1;
@@ -362,12 +403,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                 }
                 if constexpr (kQuery == Query::kAny) {
                     // Order does not matter for occlusion: go down the first, keep the rest.
-                    do {
-                        unsigned c = (unsigned)std::countr_zero(mask);
-                        mask &= mask - 1;
-                        stack_ref[sp] = node.child[c];
-                        stack_dist[sp++] = dist[c];
-                    } while (mask != 0);
+                    push_children(node, mask, stack_ref, stack_dist, dist, sp);
                     ref = node.child[c0];
                     continue;
                 } else {
@@ -420,11 +456,11 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
             unsigned mask;
             if (count > kNarrowLeafTriangles) {
                 const TriangleBlock8& block = accel.blocks8[leaf_block(ref)];
-                mask = test_block(block, count, r, tmax, lanes);
+                mask = test_block(block, count, r, end, lanes);
                 prims = block.prim;
             } else {
                 const TriangleBlock4& block = accel.blocks4[leaf_block(ref)];
-                mask = test_block(block, count, r, tmax, lanes);
+                mask = test_block(block, count, r, end, lanes);
                 prims = block.prim;
             }
             if (mask != 0) {
@@ -442,6 +478,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                             best_det = lanes.det[lane];
                         }
                     } while (mask != 0);
+                    end.set(tmax);
                     found = true;
                 } else {
                     do {
@@ -458,6 +495,7 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         *hit = candidate;
                         found = true;
                         tmax = candidate.t;
+                        end.set(tmax);
                         if (decision == HitDecision::kAcceptAndStop) return true;
                     } while (mask != 0);
                 }
