@@ -1,5 +1,6 @@
 // `lucent bench rays`: the primary, shadow and diffuse ray sets of shared/BENCH.md traced
-// with TriangleAccel on all cores, then with Embree on the same threads in this process.
+// with TriangleAccel on all cores and with Embree on the same threads in this process, the
+// two engines' timed passes alternating.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -7,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -32,6 +34,7 @@ namespace fs = std::filesystem;
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kOffset = 1e-3f;  // secondary ray origins: p + 1e-3 n (BENCH.md)
 constexpr unsigned kChunk = 64;   // rays per work item handed out by the atomic counter
+static_assert(kChunk % 64 == 0, "a chunk's 1-byte results must fill whole cache lines");
 
 uint32_t hash(uint32_t a) {
     a ^= a >> 16;
@@ -72,10 +75,32 @@ RaySet primary_rays(const Camera& cam, unsigned w, unsigned h) {
     return rays;
 }
 
+/// Allocates on cache-line boundaries. The threads of a pass write their results in chunks
+/// of kChunk rays; when a chunk's results start mid-line, two threads working on
+/// neighbouring chunks write the same line at once, and every such write moves the line
+/// between cores. Unaligned, 1-byte shadow results made Lucent's shadow rays 25 % slower
+/// on two threads and Embree's by a varying amount.
+template <class T>
+struct CacheLineAllocator {
+    using value_type = T;
+    static constexpr std::align_val_t kLine{64};
+    CacheLineAllocator() = default;
+    template <class U>
+    CacheLineAllocator(const CacheLineAllocator<U>&) noexcept {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kLine)); }
+    void deallocate(T* p, size_t) noexcept { ::operator delete(p, kLine); }
+    template <class U>
+    bool operator==(const CacheLineAllocator<U>&) const noexcept {
+        return true;
+    }
+};
+template <class T>
+using ResultVector = std::vector<T, CacheLineAllocator<T>>;
+
 /// Closest-hit results of a ray set: t (negative on a miss) and the triangle.
 struct Hits {
-    std::vector<float> t;
-    std::vector<uint32_t> prim;
+    ResultVector<float> t;
+    ResultVector<uint32_t> prim;
 };
 
 /// Shadow and diffuse rays from the primary hits of one engine (BENCH.md).
@@ -111,36 +136,84 @@ struct Rate {
     double median = 0, min = 0, max = 0;
 };
 
-/// Runs body(i) for every ray on `threads` threads, once to warm up and `repeat` timed times.
-template <class Body>
-Rate timed(size_t count, unsigned threads, int repeat, Body&& body) {
-    std::vector<double> mrays;
-    for (int run = -1; run < repeat; ++run) {
-        std::atomic<size_t> next{0};
-        auto worker = [&] {
-            for (;;) {
-                size_t begin = next.fetch_add(kChunk, std::memory_order_relaxed);
-                if (begin >= count) return;
-                size_t end = std::min(count, begin + kChunk);
-                for (size_t i = begin; i < end; ++i) body(i);
-            }
-        };
-        auto start = std::chrono::steady_clock::now();
-        std::vector<std::thread> pool;
-        for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
-        worker();
-        for (std::thread& t : pool) t.join();
-        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (run >= 0) mrays.push_back(count / s * 1e-6);
-    }
-    std::sort(mrays.begin(), mrays.end());
+double median_of(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    const size_t m = v.size();
+    return m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+}
+
+Rate rate_of(const std::vector<double>& mrays) {
     Rate r;
     if (mrays.empty()) return r;
-    r.min = mrays.front();
-    r.max = mrays.back();
-    size_t m = mrays.size();
-    r.median = m % 2 ? mrays[m / 2] : 0.5 * (mrays[m / 2 - 1] + mrays[m / 2]);
+    r.median = median_of(mrays);
+    r.min = *std::min_element(mrays.begin(), mrays.end());
+    r.max = *std::max_element(mrays.begin(), mrays.end());
     return r;
+}
+
+/// Seconds for body(i) over every ray, on `threads` threads that take chunks of rays from a
+/// shared counter.
+template <class Body>
+double timed_pass(size_t count, unsigned threads, Body&& body) {
+    // The counter has a cache line to itself: every thread takes it once per chunk, and a
+    // line shared with the calling thread's locals would move between cores with it.
+    struct alignas(64) Counter {
+        std::atomic<size_t> next{0};
+        char pad[64 - sizeof(std::atomic<size_t>)];
+    };
+    Counter counter;
+    std::atomic<size_t>& next = counter.next;
+    auto worker = [&] {
+        for (;;) {
+            size_t begin = next.fetch_add(kChunk, std::memory_order_relaxed);
+            if (begin >= count) return;
+            size_t end = std::min(count, begin + kChunk);
+            for (size_t i = begin; i < end; ++i) body(i);
+        }
+    };
+    auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Two engines' rates on the same rays, and the median of the ratios of their neighbouring
+/// passes.
+struct PairedRates {
+    Rate a, b;
+    double ratio = 0;  // a's Mrays/s over b's
+};
+
+/// Times body_a(i) and body_b(i) over every ray: one untimed warm-up pass each, then
+/// `repeat` timed passes each, in the order A B, B A, A B, ... The machines this runs on
+/// slow down for seconds at a time (other tenants), so two engines timed one after the
+/// other can see different machines; alternating passes lets both see the same one, and
+/// each ratio compares two neighbouring passes. Without a peer (with_b false) only A runs.
+template <class BodyA, class BodyB>
+PairedRates timed_pair(size_t count, unsigned threads, int repeat, BodyA&& body_a, BodyB&& body_b,
+                       bool with_b) {
+    std::vector<double> mrays_a, mrays_b, ratios;
+    timed_pass(count, threads, body_a);
+    if (with_b) timed_pass(count, threads, body_b);
+    for (int run = 0; run < repeat; ++run) {
+        double seconds_a = 0, seconds_b = 0;
+        if (run % 2 == 0 || !with_b) {
+            seconds_a = timed_pass(count, threads, body_a);
+            if (with_b) seconds_b = timed_pass(count, threads, body_b);
+        } else {
+            seconds_b = timed_pass(count, threads, body_b);
+            seconds_a = timed_pass(count, threads, body_a);
+        }
+        mrays_a.push_back(count / seconds_a * 1e-6);
+        if (with_b) {
+            mrays_b.push_back(count / seconds_b * 1e-6);
+            ratios.push_back(seconds_b / seconds_a);
+        }
+    }
+    return PairedRates{rate_of(mrays_a), rate_of(mrays_b), median_of(ratios)};
 }
 
 /// One engine's figures and checksums for the three ray kinds.
@@ -148,44 +221,71 @@ struct EngineResult : RayChecksums {
     Rate primary, shadow, diffuse;
 };
 
-/// Traces the three ray sets with closest(o, d, tmax, t&, prim&) and any(o, d, tmax). The
-/// shadow and diffuse rays start at the primary hits in `secondary_from` when given (so a
-/// peer traces exactly the rays Lucent traced), else at this engine's own; the primary hits
-/// are returned in `primary_hits` when asked.
-template <class Closest, class Any>
-EngineResult run_engine(const RaySet& primary, const scene::ObjMesh& mesh, float3 light,
-                        unsigned threads, int repeat, Closest&& closest, Any&& any,
-                        Hits* primary_hits = nullptr, const Hits* secondary_from = nullptr) {
-    EngineResult res;
-    Hits hits{std::vector<float>(primary.size()), std::vector<uint32_t>(primary.size())};
-    auto trace_closest = [&](const RaySet& rays, Hits& out) {
-        return timed(rays.size(), threads, repeat, [&](size_t i) {
+/// Lucent's figures, the peer's, and Lucent's rate over the peer's per ray kind.
+struct BenchResult {
+    EngineResult lucent, peer;
+    double primary_ratio = 0, shadow_ratio = 0, diffuse_ratio = 0;
+};
+
+/// Traces the three ray sets with Lucent and, when `with_peer`, with the peer, each engine
+/// given as closest(o, d, tmax, t&, prim&) and any(o, d, tmax). Both trace the shadow and
+/// diffuse rays that start at Lucent's primary hits, so their checksums compare line by
+/// line.
+template <class LucentClosest, class LucentAny, class PeerClosest, class PeerAny>
+BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float3 light,
+                        unsigned threads, int repeat, LucentClosest&& lucent_closest,
+                        LucentAny&& lucent_any, PeerClosest&& peer_closest, PeerAny&& peer_any,
+                        bool with_peer) {
+    BenchResult res;
+    auto tracer = [](auto& closest, const RaySet& rays, Hits& out) {
+        return [&closest, &rays, &out](size_t i) {
             float t;
             uint32_t prim;
-            bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
+            const bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
             out.t[i] = hit ? t : -1.0f;
             out.prim[i] = hit ? prim : 0;
-        });
+        };
     };
-    res.primary = trace_closest(primary, hits);
-    for (float t : hits.t)
-        if (t >= 0.0f) ++res.primary_hits, res.primary_sum_t += t;
+    auto sum_hits = [](const Hits& hits, size_t& count, double& sum_t) {
+        for (float t : hits.t)
+            if (t >= 0.0f) ++count, sum_t += t;
+    };
+    auto hits_for = [](const RaySet& rays) {
+        return Hits{ResultVector<float>(rays.size()), ResultVector<uint32_t>(rays.size())};
+    };
+
+    Hits lucent_hits = hits_for(primary), peer_hits = hits_for(primary);
+    PairedRates p =
+        timed_pair(primary.size(), threads, repeat, tracer(lucent_closest, primary, lucent_hits),
+                   tracer(peer_closest, primary, peer_hits), with_peer);
+    res.lucent.primary = p.a, res.peer.primary = p.b, res.primary_ratio = p.ratio;
+    sum_hits(lucent_hits, res.lucent.primary_hits, res.lucent.primary_sum_t);
+    sum_hits(peer_hits, res.peer.primary_hits, res.peer.primary_sum_t);
 
     RaySet shadow, diffuse;
-    secondary_rays(primary, secondary_from ? *secondary_from : hits, mesh, light, shadow, diffuse);
-    if (primary_hits) *primary_hits = hits;
-    std::vector<unsigned char> blocked(shadow.size());
-    res.shadow = timed(shadow.size(), threads, repeat, [&](size_t i) {
-        blocked[i] = any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
-    });
-    res.shadow_rays = shadow.size();
-    for (unsigned char b : blocked) res.occluded += b;
+    secondary_rays(primary, lucent_hits, mesh, light, shadow, diffuse);
+    ResultVector<unsigned char> lucent_blocked(shadow.size()), peer_blocked(shadow.size());
+    p = timed_pair(
+        shadow.size(), threads, repeat,
+        [&](size_t i) {
+            lucent_blocked[i] = lucent_any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
+        },
+        [&](size_t i) {
+            peer_blocked[i] = peer_any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
+        },
+        with_peer);
+    res.lucent.shadow = p.a, res.peer.shadow = p.b, res.shadow_ratio = p.ratio;
+    res.lucent.shadow_rays = res.peer.shadow_rays = shadow.size();
+    for (unsigned char b : lucent_blocked) res.lucent.occluded += b;
+    for (unsigned char b : peer_blocked) res.peer.occluded += b;
 
-    Hits bounce{std::vector<float>(diffuse.size()), std::vector<uint32_t>(diffuse.size())};
-    res.diffuse = trace_closest(diffuse, bounce);
-    res.diffuse_rays = diffuse.size();
-    for (float t : bounce.t)
-        if (t >= 0.0f) ++res.diffuse_hits, res.diffuse_sum_t += t;
+    Hits lucent_bounce = hits_for(diffuse), peer_bounce = hits_for(diffuse);
+    p = timed_pair(diffuse.size(), threads, repeat, tracer(lucent_closest, diffuse, lucent_bounce),
+                   tracer(peer_closest, diffuse, peer_bounce), with_peer);
+    res.lucent.diffuse = p.a, res.peer.diffuse = p.b, res.diffuse_ratio = p.ratio;
+    res.lucent.diffuse_rays = res.peer.diffuse_rays = diffuse.size();
+    sum_hits(lucent_bounce, res.lucent.diffuse_hits, res.lucent.diffuse_sum_t);
+    sum_hits(peer_bounce, res.peer.diffuse_hits, res.peer.diffuse_sum_t);
     return res;
 }
 
@@ -255,9 +355,13 @@ int run_bench_rays(const RaysOptions& options) {
     accel::BuildStats stats;
     accel.build(mesh.positions, mesh.indices, {}, &stats);
 
+    const bool peer = options.peer && EmbreePeer::available();
+    std::optional<EmbreePeer> embree_peer;
+    if (peer) embree_peer.emplace(mesh.positions, mesh.indices, threads);
+    const double embree_build_ms = peer ? embree_peer->build_ms() : 0.0;
+
     const RaySet primary = primary_rays(cam, options.width, options.height);
-    Hits lucent_hits;
-    const EngineResult lucent = run_engine(
+    const BenchResult result = run_engines(
         primary, mesh, cam.light, threads, options.repeat,
         [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
             accel::TriangleHit hit;
@@ -267,22 +371,13 @@ int run_bench_rays(const RaysOptions& options) {
             return true;
         },
         [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); },
-        &lucent_hits);
-
-    const bool peer = options.peer && EmbreePeer::available();
-    EngineResult embree;
-    double embree_build_ms = 0;
-    if (peer) {
-        EmbreePeer e(mesh.positions, mesh.indices, threads);
-        embree_build_ms = e.build_ms();
-        embree = run_engine(
-            primary, mesh, cam.light, threads, options.repeat,
-            [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
-                return e.intersect(o, d, 0.0f, tmax, t, prim);
-            },
-            [&](float3 o, float3 d, float tmax) { return e.occluded(o, d, 0.0f, tmax); }, nullptr,
-            &lucent_hits);  // the same shadow and diffuse rays as Lucent's
-    }
+        [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
+            return embree_peer->intersect(o, d, 0.0f, tmax, t, prim);
+        },
+        [&](float3 o, float3 d, float tmax) { return embree_peer->occluded(o, d, 0.0f, tmax); },
+        peer);
+    const EngineResult& lucent = result.lucent;
+    const EngineResult& embree = result.peer;
     const std::string differences =
         peer ? checksum_differences(lucent, embree, "lucent", "embree") : "";
 
@@ -297,11 +392,8 @@ int run_bench_rays(const RaysOptions& options) {
                 ",\n \"embree\": %s,\n \"embree_build_ms\": %.3f, "
                 "\"ratio\": {\"primary\": %.4f, \"shadow\": %.4f, \"diffuse\": %.4f}, "
                 "\"checksums_agree\": %s",
-                json_engine(embree).c_str(), embree_build_ms,
-                lucent.primary.median / embree.primary.median,
-                lucent.shadow.median / embree.shadow.median,
-                lucent.diffuse.median / embree.diffuse.median,
-                differences.empty() ? "true" : "false");
+                json_engine(embree).c_str(), embree_build_ms, result.primary_ratio,
+                result.shadow_ratio, result.diffuse_ratio, differences.empty() ? "true" : "false");
         std::printf("}\n");
         return 0;
     }
@@ -318,12 +410,10 @@ int run_bench_rays(const RaysOptions& options) {
     }
     std::printf("embree build %.2f ms\n", embree_build_ms);
     print_engine("embree ", embree);
-    std::printf("ratio primary %.2fx (lucent/embree)\n",
-                lucent.primary.median / embree.primary.median);
-    std::printf("ratio shadow %.2fx (lucent/embree)\n",
-                lucent.shadow.median / embree.shadow.median);
-    std::printf("ratio diffuse %.2fx (lucent/embree)\n",
-                lucent.diffuse.median / embree.diffuse.median);
+    // Each ratio is the median over the repeats of two neighbouring passes' ratio.
+    std::printf("ratio primary %.2fx (lucent/embree)\n", result.primary_ratio);
+    std::printf("ratio shadow %.2fx (lucent/embree)\n", result.shadow_ratio);
+    std::printf("ratio diffuse %.2fx (lucent/embree)\n", result.diffuse_ratio);
     if (differences.empty())
         std::printf("checksums agree with embree\n");
     else
