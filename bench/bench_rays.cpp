@@ -153,29 +153,30 @@ Rate rate_of(const std::vector<double>& mrays) {
 }
 
 /// Seconds for body(i) over every ray, on `threads` threads that take chunks of rays from a
-/// shared counter.
+/// shared counter. The calling thread only waits: per ray, the workers read the closures
+/// that lead to the engine (body, the query, the accel), which live in the caller's stack
+/// frames, and a caller tracing rays itself writes its stack right beside them. Those
+/// lines then move between cores on every ray; with the caller working, Lucent's shadow
+/// rays measured anywhere from 9 to 33 Mrays/s on two threads depending on how the
+/// compiler laid out the frames.
 template <class Body>
-double timed_pass(size_t count, unsigned threads, Body&& body) {
-    // The counter has a cache line to itself: every thread takes it once per chunk, and a
-    // line shared with the calling thread's locals would move between cores with it.
+double timed_pass(size_t count, unsigned threads, const Body& body) {
+    // The counter has a cache line to itself, as every worker takes it once per chunk.
     struct alignas(64) Counter {
         std::atomic<size_t> next{0};
-        char pad[64 - sizeof(std::atomic<size_t>)];
     };
     Counter counter;
-    std::atomic<size_t>& next = counter.next;
-    auto worker = [&] {
+    auto worker = [&counter, count, body] {  // the worker's own copy of the closure
         for (;;) {
-            size_t begin = next.fetch_add(kChunk, std::memory_order_relaxed);
+            const size_t begin = counter.next.fetch_add(kChunk, std::memory_order_relaxed);
             if (begin >= count) return;
-            size_t end = std::min(count, begin + kChunk);
+            const size_t end = std::min(count, begin + kChunk);
             for (size_t i = begin; i < end; ++i) body(i);
         }
     };
-    auto start = std::chrono::steady_clock::now();
+    const auto start = std::chrono::steady_clock::now();
     std::vector<std::thread> pool;
-    for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
-    worker();
+    for (unsigned k = 0; k < threads; ++k) pool.emplace_back(worker);
     for (std::thread& t : pool) t.join();
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
