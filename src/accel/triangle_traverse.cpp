@@ -393,6 +393,11 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
     for (;;) {
         if (!is_leaf(ref)) {
             const WideNode& node = accel.nodes[ref];
+#if LUCENT_ACCEL_SIMD
+            // The child references are the node's fourth cache line, read only once the
+            // test is done: ask for it now, beside the three the test reads.
+            _mm_prefetch(reinterpret_cast<const char*>(node.child), _MM_HINT_T0);
+#endif
             unsigned mask = test_node(node, r, end, dist);
             if (mask != 0) {
                 unsigned c0 = (unsigned)std::countr_zero(mask);
