@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <string>
 
 #include "accel/triangle_accel.h"
 #include "accel/wide_bvh.h"
+#include "lucent/error.h"
 
 namespace lucent::accel {
 
@@ -122,6 +124,11 @@ struct Collapser {
     /// Appends the leaf's block to `blocks` and returns its index.
     template <int kLanes>
     uint32_t fill_block(TriangleBlocks<kLanes>& blocks, const BvhNode& leaf) {
+        if (blocks.size() > kLeafIndexMask)
+            throw Error("TriangleAccel: more than " + std::to_string(kLeafIndexMask + 1) +
+                        " leaves of " + std::to_string(kLanes) +
+                        "-lane blocks, more than a leaf reference holds; split the mesh "
+                        "into several GeometryTriangles");
         const auto index = uint32_t(blocks.size());
         TriangleBlock<kLanes>& block = blocks.emplace_back();
         for (uint32_t lane = 0; lane < kLanes; ++lane) {

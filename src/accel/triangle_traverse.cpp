@@ -1,8 +1,9 @@
 // Single-ray traversal of TriangleAccel's 8-wide tree: one SIMD slab test for the eight
-// children of a node (AVX2) and one watertight test for the four triangles of a leaf
-// (SSE + FMA), the same arithmetic as lucent/device/triangle_intersect.h. Builds without
-// AVX2/FMA (or with LUCENT_ACCEL_SCALAR, as accel_scalar_test does) fall back to scalar
-// loops over the same layout and the same arithmetic.
+// children of a node (AVX2) and one watertight test for the up to eight triangles of a leaf
+// (four lanes with SSE or eight with AVX, and FMA), the same arithmetic as
+// lucent/device/triangle_intersect.h. Occlusion rays push children with AVX-512 where the
+// build has it. Builds without AVX2/FMA (or with LUCENT_ACCEL_SCALAR, as accel_scalar_test
+// does) fall back to scalar loops over the same layout and the same arithmetic.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -324,8 +325,8 @@ inline unsigned test_block(const TriangleBlock<kLanes>& block, uint32_t count, c
 }
 
 /// Asks for the memory of a child about to be tested: a node's four cache lines, a block's
-/// three or five. Diffuse rays miss in L2 on about every node (Sponza's tree is 1.2 MB of nodes
-/// and 4 MB of blocks); fetching all the hit children at once overlaps those misses.
+/// three or five. Diffuse rays miss in L2 on about every node (Sponza's tree is 0.9 MB of
+/// nodes and 3.6 MB of blocks); fetching all the hit children at once overlaps those misses.
 inline void prefetch_child(const TriangleAccel::Impl& accel, uint32_t ref) {
 #if LUCENT_ACCEL_SIMD
     static_assert(sizeof(TriangleBlock4) == 3 * 64 && sizeof(TriangleBlock8) == 5 * 64);

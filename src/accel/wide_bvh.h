@@ -29,7 +29,7 @@ struct alignas(64) WideNode {
 /// The triangles of one leaf, tested in one SIMD step: vertex[v][axis][lane], then the
 /// input index of each lane. A leaf of up to four triangles is a 4-lane block (three cache
 /// lines), a larger one an 8-lane block (five): with 256-bit registers the 8-wide test
-/// costs the same instructions as the 4-wide one, so big leaves save nodes for nothing.
+/// costs the same instructions as the 4-wide one, one test where two blocks took two.
 template <int kLanes>
 struct alignas(64) TriangleBlock {
     static constexpr int lanes = kLanes;
