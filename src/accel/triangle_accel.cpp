@@ -1,12 +1,12 @@
 // TriangleAccel: build (binned SAH over triangle boxes), collapse of the binary tree into
 // 8-wide nodes with SoA leaves, and refit. The queries are in triangle_traverse.cpp.
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <string>
 
 #include "accel/triangle_accel.h"
 #include "accel/wide_bvh.h"
+#include "accel/wide_collapse.h"
 #include "lucent/error.h"
 
 namespace lucent::accel {
@@ -38,82 +38,16 @@ std::vector<Aabb> triangle_boxes(std::span<const float3> vertices, std::span<con
     return boxes;
 }
 
-float half_area(float3 lo, float3 hi) {
-    float3 d = hi - lo;
-    if (!(d.x >= 0.0f)) return -1.0f;
-    return d.x * d.y + d.y * d.z + d.z * d.x;
-}
-
-/// Depth-first emission of the wide tree. Which binary nodes become the children of a wide
-/// node is chosen to minimise the SAH cost of the wide tree, by dynamic programming over the
-/// binary tree (the optimal collapse of Ylitie, Karras and Laine 2017, Sec. 3.1, without its
-/// leaf formation: the binary leaves stay the leaves): cover[n][k] is the least cost of
-/// standing in for binary node n with at most k subtrees, each a leaf or a wide node.
+/// Depth-first emission of the wide tree, with the children WideCollapse chooses.
 struct Collapser {
     const Bvh& binary;
+    const WideCollapse& plan;
     std::span<const float3> vertices;
     std::span<const uint3> indices;
     WideNodes& nodes;
     TriangleBlocks<4>& blocks4;
     TriangleBlocks<8>& blocks8;
     unsigned max_depth = 0;
-    // cover[n][k], k = 1..kWideArity; split[n][k]: subtrees given to n's first child, or 0
-    // when n stands as one subtree itself.
-    std::vector<std::array<float, kWideArity + 1>> cover;
-    std::vector<std::array<uint8_t, kWideArity + 1>> split;
-
-    /// The least cost of a wide node over binary node n: its children split among n's two.
-    float best_children(uint32_t n, int& left_share) const {
-        const BvhNode& b = binary.nodes()[n];
-        float best = kInfinity;
-        left_share = 1;
-        for (int j = 1; j < kWideArity; ++j) {
-            const float c = cover[b.first][j] + cover[b.first + 1][kWideArity - j];
-            if (c < best) best = c, left_share = j;
-        }
-        return best;
-    }
-
-    /// Fills cover and split bottom-up (children have larger indices than their parent).
-    /// Costs: 1 per wide node entered, 1 per SIMD test of a leaf, times the area.
-    void plan() {
-        const auto& bn = binary.nodes();
-        cover.assign(bn.size(), {});
-        split.assign(bn.size(), {});
-        for (size_t i = bn.size(); i-- > 0;) {
-            const BvhNode& b = bn[i];
-            const float area = std::max(half_area(b.lo, b.hi), 0.0f);
-            if (b.count > 0) {
-                const float leaf =
-                    area * float((b.count + kSahBlockTriangles - 1) / kSahBlockTriangles);
-                cover[i].fill(leaf);
-                continue;
-            }
-            int share;
-            const float self = area + best_children(uint32_t(i), share);
-            cover[i][1] = self;
-            for (int k = 2; k <= kWideArity; ++k) {
-                cover[i][k] = self;
-                split[i][k] = 0;
-                for (int j = 1; j < k; ++j) {
-                    const float c = cover[b.first][j] + cover[b.first + 1][k - j];
-                    if (c < cover[i][k]) cover[i][k] = c, split[i][k] = uint8_t(j);
-                }
-            }
-        }
-    }
-
-    /// The subtrees that stand in for binary node n with at most k of them.
-    void collect(uint32_t n, int k, uint32_t* kids, int& count) const {
-        const int j = split[n][k];
-        if (j == 0) {
-            kids[count++] = n;
-            return;
-        }
-        const uint32_t first = binary.nodes()[n].first;
-        collect(first, j, kids, count);
-        collect(first + 1, k - j, kids, count);
-    }
 
     uint32_t emit_leaf(const BvhNode& leaf) {
         const uint32_t index = leaf.count > kNarrowLeafTriangles ? fill_block(blocks8, leaf)
@@ -150,15 +84,7 @@ struct Collapser {
         max_depth = std::max(max_depth, depth);
         const auto& bn = binary.nodes();
         uint32_t kids[kWideArity];
-        int n = 0;
-        if (bn[bnode].count > 0) {
-            kids[n++] = bnode;  // a tree of one leaf
-        } else {
-            int share;
-            best_children(bnode, share);
-            collect(bn[bnode].first, share, kids, n);
-            collect(bn[bnode].first + 1, kWideArity - share, kids, n);
-        }
+        const int n = plan.children(bnode, kids);
         const uint32_t me = (uint32_t)nodes.size();
         nodes.emplace_back();
         for (int i = 0; i < kWideArity; ++i) {
@@ -202,8 +128,11 @@ void TriangleAccel::Impl::collapse(std::span<const float3> vertices,
         return;
     }
     nodes.reserve(binary.nodes().size() / 4 + 1);
-    Collapser c{binary, vertices, indices, nodes, blocks4, blocks8};
-    c.plan();
+    // Costs: 1 per wide node entered, 1 per block of kSahBlockTriangles, times the area.
+    const WideCollapse plan(binary, [](uint32_t count) {
+        return (count + kSahBlockTriangles - 1) / kSahBlockTriangles;
+    });
+    Collapser c{binary, plan, vertices, indices, nodes, blocks4, blocks8};
     c.emit_node(0, 1);
     wide_depth = c.max_depth;
 }

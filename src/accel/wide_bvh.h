@@ -7,10 +7,10 @@
 
 #include "accel/bvh.h"
 #include "accel/huge_page_allocator.h"
+#include "accel/wide_collapse.h"  // kWideArity
 
 namespace lucent::accel {
 
-constexpr int kWideArity = 8;
 constexpr uint32_t kEmptyChild = 0xffffffffu;
 constexpr uint32_t kLeafBit = 0x80000000u;
 constexpr int kLeafCountShift = 28;  // bits 28..30 hold the leaf's triangle count - 1
