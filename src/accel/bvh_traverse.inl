@@ -13,8 +13,10 @@ inline float slab_entry(const BvhNode& n, float3 org, float3 inv_dir, float tmin
         lc_max(lc_max(lc_min(tx0, tx1), lc_min(ty0, ty1)), lc_max(lc_min(tz0, tz1), tmin));
     float t_far =
         lc_min(lc_min(lc_max(tx0, tx1), lc_max(ty0, ty1)), lc_min(lc_max(tz0, tz1), tmax));
-    // 1 + 2 ulp on the far side keeps boxes of zero thickness (Ize 2013, robust BVH traversal)
-    return t_near <= t_far * 1.00000024f ? t_near : kInfinity * 2.0f;
+    // 1 + 2^-21 on the far side: rounding never culls a box the ray touches, those of zero
+    // thickness included (Ize 2013: the three roundings on each side need 1 + 7u, u = 2^-24).
+    // The GPU's box test for Groups (trace.cuh) takes the same margin.
+    return t_near <= t_far * (1.0f + 0x1p-21f) ? t_near : kInfinity * 2.0f;
 }
 inline float safe_inverse(float d) {
     return d != 0.0f ? 1.0f / d : (std::signbit(d) ? -kInfinity * 1e8f : kInfinity * 1e8f);

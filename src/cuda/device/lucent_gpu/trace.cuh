@@ -110,13 +110,14 @@ __device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, uns
 }
 
 /// Slab test of a binary BVH node against the ray interval [tmin, tmax]; the far distance
-/// gets 2 ulp of slack so boxes of zero thickness are kept (as the CPU traversal does).
+/// is scaled by 1 + 2^-21 so that rounding never culls a box the ray touches, those of zero
+/// thickness included (Ize 2013: the three roundings on each side need 1 + 7u, u = 2^-24).
 __device__ __forceinline__ bool box_overlaps(const GpuBvhNode& n, float3 origin, float3 inv,
                                              float tmin, float tmax) {
     float3 t0 = (n.lo - origin) * inv, t1 = (n.hi - origin) * inv;
     float tn = fmaxf(fmaxf(fminf(t0.x, t1.x), fminf(t0.y, t1.y)), fmaxf(fminf(t0.z, t1.z), tmin));
     float tf = fminf(fminf(fmaxf(t0.x, t1.x), fmaxf(t0.y, t1.y)), fminf(fmaxf(t0.z, t1.z), tmax));
-    return tn <= tf * 1.00000024f;
+    return tn <= tf * (1.0f + 0x1p-21f);
 }
 
 /// The instance (position k in the accel) owning global primitive `ref`.

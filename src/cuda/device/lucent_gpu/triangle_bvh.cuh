@@ -14,7 +14,7 @@
 // The triangle test is the watertight one of the CPU backend
 // (lucent/device/triangle_intersect.h), so the GPU finds the same hits as TriangleAccel, bit
 // for bit. The box test is the CPU's too: plane * (1/d) - o/d in one FMA, o/d widened by a
-// bound on its rounding, the far distance scaled up by 2 ulp (Ize 2013, "Robust BVH ray
+// bound on its rounding, the far distance scaled up by 1 + 2^-21 (Ize 2013, "Robust BVH ray
 // traversal"): boxes are only ever entered too often, never missed.
 //
 // The file compiles with g++ (host: the layout constants, and the same traversal run on
@@ -48,7 +48,11 @@ constexpr unsigned kGpuLeafFirstMask = (1u << kGpuLeafCountShift) - 1u;
 constexpr int kGpuMaxLeafSize = 8;
 constexpr int kGpuStackSize = 64;                   // entries; the CPU builder caps depth at 60
 constexpr int kGpuEntrypointSentinel = 0x76543210;  // bottom of the stack (Aila-Laine)
-constexpr float kGpuFarScale = 1.00000024f;         // 1 + 2 ulp, as TriangleAccel (Ize 2013)
+// The far distance is scaled by 1 + 2^-21 (Ize 2013): a near distance is at most (1 + u)^2
+// times the true one and a far one at least (1 - u)^3 times it before this scale (1/d, the
+// FMA, the multiply by the scale; u = 2^-24), so the test needs 1 + 5u; TriangleAccel takes
+// the same margin (src/accel/triangle_traverse.cpp). 1 + 4u, used before, was a hair short.
+constexpr float kGpuFarScale = 1.0f + 0x1p-21f;
 constexpr float kGpuMaxInverse = 1e20f;             // |1/d| at most
 constexpr float kGpuMaxOverInverse = 1e37f;         // |o/d| at most
 
@@ -186,10 +190,12 @@ struct GpuBvhTraversal {
     LUCENT_HD bool hit() const { return hit_index >= 0; }
 
     /// Near and far distances of one child box: the CPU's slab test (near planes chosen by
-    /// the sign of the direction, far distance * (1 + 2 ulp)). An empty box (lo > hi) is
-    /// never entered.
+    /// the sign of the direction, far distance * kGpuFarScale). An empty box (lo > hi) is
+    /// never entered. `r` is any state with this struct's idx .. ohiz, tmin and tmax (the
+    /// compressed wide layout's traversal uses it too).
+    template <class Ray>
     LUCENT_HD static void slab(float lox, float hix, float loy, float hiy, float loz, float hiz,
-                               const GpuBvhTraversal& r, float& t_near, float& t_far) {
+                               const Ray& r, float& t_near, float& t_far) {
         const float tlx = fmaf(lox, r.idx, -r.olox), thx = fmaf(hix, r.idx, -r.ohix);
         const float tly = fmaf(loy, r.idy, -r.oloy), thy = fmaf(hiy, r.idy, -r.ohiy);
         const float tlz = fmaf(loz, r.idz, -r.oloz), thz = fmaf(hiz, r.idz, -r.ohiz);
