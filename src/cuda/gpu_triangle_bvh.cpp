@@ -32,24 +32,24 @@ void set_children(float4* n, int child0, int child1) {
 
 }  // namespace
 
-GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
-                                      std::span<const uint3> indices,
-                                      const GpuBvhBuildOptions& options) {
+accel::Bvh build_gpu_source_bvh(std::span<const float3> positions, std::span<const uint3> indices,
+                                const GpuBvhBuildOptions& options, const char* layout,
+                                int max_leaf_size, accel::BuildStats& stats) {
     const size_t tri_count = indices.empty() ? positions.size() / 3 : indices.size();
     if (tri_count > gpu::kGpuLeafFirstMask)
-        throw Error("GPU triangle BVH: " + std::to_string(tri_count) +
+        throw Error(std::string(layout) + ": " + std::to_string(tri_count) +
                     " triangles, the layout holds at most " +
                     std::to_string(gpu::kGpuLeafFirstMask));
-    if (options.max_leaf_size < 1 || options.max_leaf_size > gpu::kGpuMaxLeafSize)
-        throw Error("GPU triangle BVH: max_leaf_size must be 1.." +
-                    std::to_string(gpu::kGpuMaxLeafSize));
+    if (options.max_leaf_size < 1 || options.max_leaf_size > max_leaf_size)
+        throw Error(std::string(layout) + ": max_leaf_size must be 1.." +
+                    std::to_string(max_leaf_size));
 
     // Triangle boxes.
     std::vector<Aabb> boxes(tri_count);
     for (size_t i = 0; i < tri_count; ++i) {
         const uint3 t = triangle(indices, i);
         if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size())
-            throw Error("GPU triangle BVH: triangle " + std::to_string(i) +
+            throw Error(std::string(layout) + ": triangle " + std::to_string(i) +
                         " has a vertex index out of range");
         const float3 a = positions[t.x], b = positions[t.y], c = positions[t.z];
         boxes[i].lo = fminf(a, fminf(b, c));
@@ -61,35 +61,52 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
     build.max_leaf_size = options.max_leaf_size;
     build.traversal_cost = options.traversal_cost;
     build.intersection_cost = options.intersection_cost;
-    accel::BuildStats bs;
     accel::Bvh bvh;
-    bvh.build(boxes, build, &bs);
+    bvh.build(boxes, build, &stats);
+    if (stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)
+        throw Error(std::string(layout) + ": depth " + std::to_string(stats.depth) +
+                    " exceeds the traversal stack (" + std::to_string(gpu::kGpuStackSize) + ")");
+    return bvh;
+}
+
+unsigned append_leaf_triangles(std::span<const float3> positions, std::span<const uint3> indices,
+                               const accel::Bvh& bvh, const accel::BvhNode& leaf,
+                               std::vector<float4>& triangles,
+                               std::vector<uint32_t>& triangle_ids) {
+    const unsigned first = (unsigned)triangle_ids.size();
+    for (uint32_t k = 0; k < leaf.count; ++k) {
+        const uint32_t prim = bvh.prim_order()[leaf.first + k];
+        const uint3 t = triangle(indices, prim);
+        triangles.push_back(make_float4(positions[t.x], 0.0f));
+        triangles.push_back(make_float4(positions[t.y], 0.0f));
+        triangles.push_back(make_float4(positions[t.z], 0.0f));
+        triangle_ids.push_back(prim);
+    }
+    return first;
+}
+
+GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
+                                      std::span<const uint3> indices,
+                                      const GpuBvhBuildOptions& options) {
+    const size_t tri_count = indices.empty() ? positions.size() / 3 : indices.size();
+    accel::BuildStats bs;
+    const accel::Bvh bvh = build_gpu_source_bvh(positions, indices, options, "GPU triangle BVH",
+                                                gpu::kGpuMaxLeafSize, bs);
 
     const auto start = std::chrono::steady_clock::now();
     GpuTriangleBvh out;
     out.stats.build_ms = bs.build_ms;
     out.stats.sah_cost = bs.sah_cost;
     out.stats.depth = bs.depth;
-    if (bs.depth + 2 >= (unsigned)gpu::kGpuStackSize)
-        throw Error("GPU triangle BVH: depth " + std::to_string(bs.depth) +
-                    " exceeds the traversal stack (" + std::to_string(gpu::kGpuStackSize) + ")");
     out.triangles.reserve(3 * tri_count);
     out.triangle_ids.reserve(tri_count);
 
     const std::vector<accel::BvhNode>& nodes = bvh.nodes();
-    const std::vector<uint32_t>& order = bvh.prim_order();
     auto emit_leaf = [&](const accel::BvhNode& n) {
         if (n.count > (uint32_t)gpu::kGpuMaxLeafSize)
             throw Error("GPU triangle BVH: a leaf of " + std::to_string(n.count) + " triangles");
-        const unsigned first = (unsigned)out.triangle_ids.size();
-        for (uint32_t k = 0; k < n.count; ++k) {
-            const uint32_t prim = order[n.first + k];
-            const uint3 t = triangle(indices, prim);
-            out.triangles.push_back(make_float4(positions[t.x], 0.0f));
-            out.triangles.push_back(make_float4(positions[t.y], 0.0f));
-            out.triangles.push_back(make_float4(positions[t.z], 0.0f));
-            out.triangle_ids.push_back(prim);
-        }
+        const unsigned first =
+            append_leaf_triangles(positions, indices, bvh, n, out.triangles, out.triangle_ids);
         ++out.stats.leaf_count;
         return gpu::gpu_make_leaf(first, n.count);
     };

@@ -36,7 +36,7 @@ struct GpuTriangleBvh {
     std::vector<float4> nodes;           // 4 per inner node, root first
     std::vector<float4> triangles;       // 3 per triangle, leaf order
     std::vector<uint32_t> triangle_ids;  // leaf order -> input order
-    std::vector<uint32_t> parents;       // per node: parent << 1 | slot (~0u at the root), for refit
+    std::vector<uint32_t> parents;  // per node: parent << 1 | slot (~0u at the root), for refit
     GpuBvhStats stats;
 
     /// A view over these host arrays: lets the host run the GPU traversal (tests).
@@ -44,6 +44,19 @@ struct GpuTriangleBvh {
         return {nodes.data(), triangles.data(), triangle_ids.data()};
     }
 };
+
+/// The binned-SAH binary BVH the GPU layouts are made from, after checking the input: every
+/// vertex index in range, no more triangles than a leaf reference holds, max_leaf_size within
+/// 1..max_leaf_size of the layout, and a depth the traversal stacks hold. Errors name `layout`.
+accel::Bvh build_gpu_source_bvh(std::span<const float3> positions, std::span<const uint3> indices,
+                                const GpuBvhBuildOptions& options, const char* layout,
+                                int max_leaf_size, accel::BuildStats& stats);
+
+/// Appends the triangles of a leaf of `bvh` in leaf order (three float4 each, w = 0) and
+/// their input indices; returns the index of the first.
+unsigned append_leaf_triangles(std::span<const float3> positions, std::span<const uint3> indices,
+                               const accel::Bvh& bvh, const accel::BvhNode& leaf,
+                               std::vector<float4>& triangles, std::vector<uint32_t>& triangle_ids);
 
 /// Builds over triangles (indices may be empty: then triangle i is vertices 3i..3i+2).
 /// Throws lucent::Error for an index out of range or a mesh too big for the format.

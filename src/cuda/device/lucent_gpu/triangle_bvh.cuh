@@ -53,8 +53,8 @@ constexpr int kGpuEntrypointSentinel = 0x76543210;  // bottom of the stack (Aila
 // FMA, the multiply by the scale; u = 2^-24), so the test needs 1 + 5u; TriangleAccel takes
 // the same margin (src/accel/triangle_traverse.cpp). 1 + 4u, used before, was a hair short.
 constexpr float kGpuFarScale = 1.0f + 0x1p-21f;
-constexpr float kGpuMaxInverse = 1e20f;             // |1/d| at most
-constexpr float kGpuMaxOverInverse = 1e37f;         // |o/d| at most
+constexpr float kGpuMaxInverse = 1e20f;      // |1/d| at most
+constexpr float kGpuMaxOverInverse = 1e37f;  // |o/d| at most
 
 /// Dynamic fetch (Kepler addendum): a persistent kernel leaves the traversal loop when
 /// fewer lanes than this are still traversing, to refill the finished ones.
@@ -124,6 +124,18 @@ LUCENT_HD inline int gpu_active_lanes() {
 #else
     return 32;
 #endif
+}
+
+/// The watertight test of leaf-order triangle i (three float4 at tris + 3i) within
+/// (tmin, tmax): the CPU's test, so both layouts find the CPU's hits.
+LUCENT_HD inline bool gpu_intersect_triangle(const float4* tris, unsigned i,
+                                             const WatertightRay& wt, float tmin, float tmax,
+                                             float& t, float& u, float& v) {
+    const float4 a = gpu_load(tris + 3 * i + 0);
+    const float4 b = gpu_load(tris + 3 * i + 1);
+    const float4 c = gpu_load(tris + 3 * i + 2);
+    return intersect_triangle_watertight(wt, make_float3(a.x, a.y, a.z), make_float3(b.x, b.y, b.z),
+                                         make_float3(c.x, c.y, c.z), tmin, tmax, t, u, v);
 }
 
 struct GpuNoFilter {
@@ -256,14 +268,8 @@ struct GpuBvhTraversal {
                 const unsigned first = gpu_leaf_first(leaf);
                 const unsigned end = first + gpu_leaf_count(leaf);
                 for (unsigned i = first; i < end; ++i) {
-                    const float4 a = gpu_load(tris + 3 * i + 0);
-                    const float4 b = gpu_load(tris + 3 * i + 1);
-                    const float4 c = gpu_load(tris + 3 * i + 2);
                     float t, u, v;
-                    if (!intersect_triangle_watertight(
-                            wt, make_float3(a.x, a.y, a.z), make_float3(b.x, b.y, b.z),
-                            make_float3(c.x, c.y, c.z), tmin, tmax, t, u, v))
-                        continue;
+                    if (!gpu_intersect_triangle(tris, i, wt, tmin, tmax, t, u, v)) continue;
                     if constexpr (kQuery == kGpuFiltered) {
                         GpuHit candidate;
                         candidate.t = t;
