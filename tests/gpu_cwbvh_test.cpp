@@ -122,7 +122,7 @@ TEST(GpuCwbvh, GridsAreExactAndReachAcross) {
 TEST(GpuCwbvh, EqualsBruteForceForEveryLeafSize) {
     const Mesh mesh = test_mesh(7, 1500);
     const std::vector<TestRay> rays = test_rays(11, 3000);
-    for (int leaf : {1, 2, 4}) {
+    for (int leaf : {1, 2, 3}) {
         SCOPED_TRACE("leaf size " + std::to_string(leaf));
         cuda::GpuBvhBuildOptions options;
         options.max_leaf_size = leaf;
@@ -183,8 +183,77 @@ TEST(GpuCwbvh, SmallAndEmptyMeshesAndBadInput) {
             << e.what();
     }
     cuda::GpuBvhBuildOptions wide_leaves;
-    wide_leaves.max_leaf_size = 5;
+    wide_leaves.max_leaf_size = 4;  // the unary count holds three
     EXPECT_THROW(cuda::build_gpu_cwbvh(one, {}, wide_leaves), Error);
+}
+
+TEST(GpuCwbvh, MetaBytesGiveThePapersHitMaskBits) {
+    const Mesh mesh = test_mesh(2, 800);
+    const GpuCwbvh bvh = cuda::build_gpu_cwbvh(mesh.positions, mesh.indices);
+    for (unsigned index = 0; index < bvh.stats.node_count; ++index) {
+        const auto node = gpu::GpuCwbvhNode::load(bvh.nodes.data(), index);
+        unsigned triangle_bits = 0;
+        for (int i = 0; i < gpu::kCwbvhArity; ++i) {
+            const unsigned meta = node.slot_meta(i);
+            if (meta == 0u) continue;
+            const unsigned bits = (meta >> 5) << (meta & 31);
+            if (node.inner & (1u << i)) {
+                EXPECT_EQ(bits, 1u << (gpu::kCwbvhInnerBit + i)) << index << " " << i;
+            } else {
+                const int leaf = node.child_ref(i);
+                const unsigned first = gpu::gpu_leaf_first(leaf) - node.triangle_base;
+                const unsigned count = gpu::gpu_leaf_count(leaf);
+                EXPECT_EQ(bits, ((1u << count) - 1u) << first) << index << " " << i;
+                EXPECT_EQ(triangle_bits & bits, 0u) << "leaves overlap";
+                triangle_bits |= bits;
+            }
+        }
+        EXPECT_LT(triangle_bits, 1u << gpu::kCwbvhMaxNodeTriangles);
+    }
+}
+
+TEST(GpuCwbvh, SlotsGiveAFrontToBackOrderByOctant) {
+    // Among the hit children of a node, the first in the order slot ^ octant should be the
+    // nearest one far more often than the first in memory order is.
+    const Mesh mesh = test_mesh(13, 4000);
+    const GpuCwbvh bvh = cuda::build_gpu_cwbvh(mesh.positions, mesh.indices);
+    int nodes = 0, octant_first = 0, memory_first = 0;
+    for (const TestRay& r : test_rays(17, 2000)) {
+        gpu::GpuCwbvhRay ray;
+        ray.start(r.o, r.d, 0.0f, r.tmax);
+        const unsigned octant = (r.d.x < 0.0f) | (r.d.y < 0.0f) << 1 | (r.d.z < 0.0f) << 2;
+        std::vector<unsigned> todo = {0};
+        while (!todo.empty()) {
+            const auto node = gpu::GpuCwbvhNode::load(bvh.nodes.data(), todo.back());
+            todo.pop_back();
+            float best_t = kInfinity;
+            int nearest = -1, by_octant = -1, by_memory = -1, hits = 0;
+            for (int i = 0; i < gpu::kCwbvhArity; ++i) {
+                if (node.slot_meta(i) == 0u) continue;
+                float3 lo, hi;
+                node.child_box(i, lo, hi);
+                float t_near, t_far;
+                gpu::GpuBvhTraversal::slab(lo.x, hi.x, lo.y, hi.y, lo.z, hi.z, ray, t_near, t_far);
+                if (!(t_near <= t_far)) continue;
+                ++hits;
+                if (t_near < best_t) best_t = t_near, nearest = i;
+                if (by_octant < 0 || (unsigned(i) ^ octant) < (unsigned(by_octant) ^ octant))
+                    by_octant = i;
+                if (by_memory < 0) by_memory = i;
+                if (node.child_ref(i) >= 0) todo.push_back((unsigned)node.child_ref(i));
+            }
+            if (hits < 2) continue;
+            ++nodes;
+            octant_first += by_octant == nearest;
+            memory_first += by_memory == nearest;
+        }
+    }
+    std::printf(
+        "%d nodes with two or more children hit: nearest first %.1f %% by octant, "
+        "%.1f %% in memory order\n",
+        nodes, 100.0 * octant_first / nodes, 100.0 * memory_first / nodes);
+    ASSERT_GT(nodes, 1000);
+    EXPECT_GT(octant_first, memory_first + nodes / 10);
 }
 
 TEST(GpuCwbvh, SponzaHitsEqualTheBinaryLayout) {

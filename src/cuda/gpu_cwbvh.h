@@ -25,11 +25,19 @@ struct GpuCwbvh {
     }
 };
 
+/// The binary layout's build options with leaves of up to three triangles: the paper's, and
+/// what a leaf's unary count holds.
+inline GpuBvhBuildOptions cwbvh_build_options() {
+    GpuBvhBuildOptions options;
+    options.max_leaf_size = gpu::kCwbvhMaxLeafSize;
+    return options;
+}
+
 /// Builds over triangles (indices may be empty: then triangle i is vertices 3i..3i+2), with
-/// leaves of at most options.max_leaf_size (1..4) triangles. Throws lucent::Error for an
+/// leaves of at most options.max_leaf_size (1..3) triangles. Throws lucent::Error for an
 /// index out of range, a non-finite vertex, or a mesh too big for the format.
 GpuCwbvh build_gpu_cwbvh(std::span<const float3> positions, std::span<const uint3> indices,
-                         const GpuBvhBuildOptions& options = {});
+                         const GpuBvhBuildOptions& options = cwbvh_build_options());
 
 /// The grid of one axis of a node: planes are origin + q * 2^(biased_exponent - 127) for
 /// q in 0..255, every one of them a float (origin is a multiple of the step, and

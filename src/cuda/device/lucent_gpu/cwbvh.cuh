@@ -37,16 +37,23 @@ namespace lucent::gpu {
 //   [5n + 3] = the same for y, [5n + 4] for z
 // e is the biased exponent of the grid step 2^(e - 127) on each axis; a plane is
 // origin + q * 2^(e - 127) for its byte q. `inner` has bit i set when slot i is a node: the
-// node at child_base + (the number of node slots before i). meta[i] is 0 for an empty slot,
-// kCwbvhMetaInner for a node, and for a leaf kCwbvhMetaLeaf | (count - 1) << 5 | offset: its
-// `count` (1..4) triangles are at triangle_base + offset. Node 0 is the root. An empty slot
-// has qlo = 255 and qhi = 0, a box turned inside out that no ray enters.
+// node at child_base + (the number of node slots before i). meta[i] is the paper's: 0 for an
+// empty slot, 0b001 << 5 | (24 + i) for a node, and for a leaf its triangle count in unary
+// in the top three bits (0b001, 0b011, 0b111) above the offset of its first triangle from
+// triangle_base (< 24). (meta >> 5) << (meta & 31) is then the bit (a node: 24 + i) or the
+// bits (a leaf: one per triangle) a hit child adds to the paper's hit mask. Node 0 is the
+// root. An empty slot has qlo = 255 and qhi = 0, a box turned inside out no ray enters.
+//
+// Slots are assigned by the children's positions in the node (Sec. 3.2 of the paper): slot s
+// holds a child near the corner whose coordinates are high on the axes of the bits of s, so a
+// ray whose direction has negative components on the axes of the bits of o meets the
+// children roughly in the order of s ^ o, a front-to-back order without a sort.
 
 constexpr int kCwbvhNodeFloat4s = 5;
 constexpr int kCwbvhArity = 8;
-constexpr int kCwbvhMaxLeafSize = 4;
-constexpr unsigned kCwbvhMetaInner = 0x20u;
-constexpr unsigned kCwbvhMetaLeaf = 0x80u;
+constexpr int kCwbvhMaxLeafSize = 3;             // a unary count in three bits
+constexpr unsigned kCwbvhMaxNodeTriangles = 24;  // leaf triangles per node: offsets < 24
+constexpr unsigned kCwbvhInnerBit = 24;          // a node child's bit in the hit mask: 24 + slot
 constexpr int kCwbvhQuantMax = 255;
 // Entries: each node pushes at most 7, and the wide tree is no deeper than the binary one
 // (the builder caps that at 60).
@@ -130,7 +137,7 @@ struct GpuCwbvhNode {
         const unsigned m = slot_meta(i);
         if (inner & (1u << i))
             return (int)(child_base + (unsigned)cwbvh_popc(inner & ((1u << i) - 1u)));
-        return gpu_make_leaf(triangle_base + (m & 0x1fu), ((m >> 5) & 3u) + 1u);
+        return gpu_make_leaf(triangle_base + (m & 0x1fu), (unsigned)cwbvh_popc(m >> 5));
     }
 };
 
