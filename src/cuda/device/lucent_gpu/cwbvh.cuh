@@ -15,10 +15,10 @@
 // decoded box is then an ordinary box of floats, rounded outwards at build time, and the box
 // test is the binary layout's (GpuBvhTraversal::slab), so the two layouts find the same hits.
 //
-// This traversal sorts each node's hit children by distance and keeps them on a stack; it is
-// the reference the layout is checked with on the CPU (tests/gpu_cwbvh_test.cpp), the same
-// code a kernel runs. The paper's node-group stack and octant-ordered child slots, which
-// matter on the GPU, are not here yet.
+// The traversal is the paper's (Sec. 3.3): groups of children, taken in the order the slots'
+// octant assignment gives, and one stack entry per level. The CPU runs the very same code to
+// check the layout (tests/gpu_cwbvh_test.cpp); the paper's warp-level postponing of triangle
+// tests is a GPU tuning not done yet.
 #pragma once
 
 #include "lucent/device/platform.h"
@@ -55,9 +55,6 @@ constexpr int kCwbvhMaxLeafSize = 3;             // a unary count in three bits
 constexpr unsigned kCwbvhMaxNodeTriangles = 24;  // leaf triangles per node: offsets < 24
 constexpr unsigned kCwbvhInnerBit = 24;          // a node child's bit in the hit mask: 24 + slot
 constexpr int kCwbvhQuantMax = 255;
-// Entries: each node pushes at most 7, and the wide tree is no deeper than the binary one
-// (the builder caps that at 60).
-constexpr int kCwbvhStackSize = (kCwbvhArity - 1) * 64 + 1;
 
 /// Device pointers of one uploaded GpuCwbvh (same layout on host and device).
 struct GpuCwbvhView {
@@ -143,10 +140,12 @@ struct GpuCwbvhNode {
 
 // ---- traversal ---------------------------------------------------------------------
 
-/// The traversal stack of one ray: references and their entry distances.
+/// The traversal stack of one ray: node groups, each the children of one node still to be
+/// visited (the paper's Sec. 3.3). A node pushes at most one group, so the depth of the tree
+/// bounds the stack (the builder caps the binary tree, deeper than the wide one, at 60).
 struct GpuCwbvhStack {
-    int ref[kCwbvhStackSize];
-    float t[kCwbvhStackSize];
+    unsigned base[kGpuStackSize];  // child_base of the node the group belongs to
+    unsigned bits[kGpuStackSize];  // its `inner` mask << 8 | the children still to visit
 };
 
 /// One ray's box-test terms, in the fields GpuBvhTraversal::slab reads.
@@ -160,11 +159,54 @@ struct GpuCwbvhRay {
         tmin = t0;
         tmax = t1;
     }
+    /// The octant of the direction, a bit per axis set where it is negative (as the slab
+    /// test sees it: the sign of the clamped 1/d).
+    LUCENT_HD unsigned octant() const {
+        return (idx < 0.0f ? 1u : 0u) | (idy < 0.0f ? 2u : 0u) | (idz < 0.0f ? 4u : 0u);
+    }
 };
 
+LUCENT_HD inline unsigned cwbvh_highest_bit(unsigned x) {
+#if LUCENT_GPU_CODE
+    return 31u - (unsigned)__clz(x);
+#else
+    return 31u - (unsigned)__builtin_clz(x);
+#endif
+}
+LUCENT_HD inline unsigned cwbvh_lowest_bit(unsigned x) {
+#if LUCENT_GPU_CODE
+    return (unsigned)(__ffs(x) - 1);
+#else
+    return (unsigned)__builtin_ctz(x);
+#endif
+}
+
+/// The hit mask of a node's children (the paper's): a node child in slot i that the ray
+/// enters sets bit 24 + (i ^ oct_inv), a leaf child its triangles' bits (one each, from its
+/// offset). Taking node bits highest first then visits the children roughly front to back.
+LUCENT_HD inline unsigned cwbvh_intersect_children(const GpuCwbvhNode& node, const GpuCwbvhRay& ray,
+                                                   unsigned oct_inv) {
+    unsigned hits = 0;
+    for (int i = 0; i < kCwbvhArity; ++i) {
+        const unsigned meta = node.slot_meta(i);
+        if (meta == 0u) continue;
+        float3 lo, hi;
+        node.child_box(i, lo, hi);
+        float t_near, t_far;
+        GpuBvhTraversal::slab(lo.x, hi.x, lo.y, hi.y, lo.z, hi.z, ray, t_near, t_far);
+        if (!(t_near <= t_far)) continue;
+        const unsigned bit = (meta & 31u) ^ ((node.inner >> i) & 1u ? oct_inv : 0u);
+        hits |= (meta >> 5) << bit;
+    }
+    return hits;
+}
+
 /// Closest (kGpuClosest), any (kGpuAny) or filtered (kGpuFiltered) hit with t in
-/// (tmin, tmax), nearer children first. Returns whether a hit was found (accepted) and, for
-/// closest and filtered queries, writes it to `out`.
+/// (tmin, tmax), by the paper's traversal (Sec. 3.3, without its warp-level postponing of
+/// triangles): a node group holds the children of one node still to visit; the nearest-
+/// looking one (by octant) is opened, the rest of the group pushed, and the triangles of the
+/// opened node's leaf children are tested at once. Returns whether a hit was found
+/// (accepted) and, for closest and filtered queries, writes it to `out`.
 template <int kQuery, class Filter>
 LUCENT_HD inline bool gpu_cwbvh_trace(const GpuCwbvhView& bvh, float3 origin, float3 dir,
                                       float tmin, float tmax, GpuHit& out, Filter& filter,
@@ -172,79 +214,67 @@ LUCENT_HD inline bool gpu_cwbvh_trace(const GpuCwbvhView& bvh, float3 origin, fl
     GpuCwbvhRay ray;
     ray.start(origin, dir, tmin, tmax);
     const WatertightRay wt = make_watertight_ray(origin, dir);
+    const unsigned oct_inv = 7u - ray.octant();
     int hit_index = -1;
     float hit_u = 0.0f, hit_v = 0.0f;
     int sp = 0;
-    int ref = 0;  // the root
+    // The root as a group of one: node 0, a node child in slot 0.
+    unsigned group_base = 0, group_inner = 1u, group_nodes = 1u << oct_inv;
     for (;;) {
-        if (ref >= 0) {
-            const GpuCwbvhNode node = GpuCwbvhNode::load(bvh.nodes, (unsigned)ref);
-            // The children hit, sorted by entry distance, farthest first.
-            int refs[kCwbvhArity];
-            float ts[kCwbvhArity];
-            int count = 0;
-            for (int i = 0; i < kCwbvhArity; ++i) {
-                if (node.slot_meta(i) == 0u) continue;
-                float3 lo, hi;
-                node.child_box(i, lo, hi);
-                float t_near, t_far;
-                GpuBvhTraversal::slab(lo.x, hi.x, lo.y, hi.y, lo.z, hi.z, ray, t_near, t_far);
-                if (!(t_near <= t_far)) continue;
-                int j = count++;
-                while (j > 0 && ts[j - 1] < t_near) {
-                    ts[j] = ts[j - 1];
-                    refs[j] = refs[j - 1];
-                    --j;
-                }
-                ts[j] = t_near;
-                refs[j] = node.child_ref(i);
+        unsigned triangle_base = 0, triangles = 0;
+        if (group_nodes != 0u) {
+            const unsigned bit = cwbvh_highest_bit(group_nodes);
+            group_nodes &= ~(1u << bit);
+            const unsigned slot = bit ^ oct_inv;
+            const unsigned index =
+                group_base + (unsigned)cwbvh_popc(group_inner & ((1u << slot) - 1u));
+            if (group_nodes != 0u) {
+                stack.base[sp] = group_base;
+                stack.bits[sp++] = group_inner << 8 | group_nodes;
             }
-            if (count > 0) {
-                for (int j = 0; j < count - 1; ++j) {
-                    stack.ref[sp] = refs[j];
-                    stack.t[sp++] = ts[j];
-                }
-                ref = refs[count - 1];
+            const GpuCwbvhNode node = GpuCwbvhNode::load(bvh.nodes, index);
+            const unsigned hits = cwbvh_intersect_children(node, ray, oct_inv);
+            group_base = node.child_base;
+            group_inner = node.inner;
+            group_nodes = hits >> kCwbvhInnerBit;
+            triangle_base = node.triangle_base;
+            triangles = hits & ((1u << kCwbvhInnerBit) - 1u);
+        }
+        while (triangles != 0u) {
+            const unsigned i = triangle_base + cwbvh_lowest_bit(triangles);
+            triangles &= triangles - 1u;
+            float t, u, v;
+            if (!gpu_intersect_triangle(bvh.triangles, i, wt, ray.tmin, ray.tmax, t, u, v))
                 continue;
-            }
-        } else {
-            const unsigned first = gpu_leaf_first(ref);
-            const unsigned end = first + gpu_leaf_count(ref);
-            for (unsigned i = first; i < end; ++i) {
-                float t, u, v;
-                if (!gpu_intersect_triangle(bvh.triangles, i, wt, ray.tmin, ray.tmax, t, u, v))
-                    continue;
-                if constexpr (kQuery == kGpuAny) return true;
-                if constexpr (kQuery == kGpuFiltered) {
-                    const GpuHit candidate{t, u, v, bvh.triangle_ids[i]};
-                    const int decision = filter(candidate);
-                    if (decision == kGpuIgnore) continue;
-                    if (decision == kGpuAcceptAndStop) {
-                        out = candidate;
-                        return true;
-                    }
+            if constexpr (kQuery == kGpuAny) return true;
+            if constexpr (kQuery == kGpuFiltered) {
+                const GpuHit candidate{t, u, v, bvh.triangle_ids[i]};
+                const int decision = filter(candidate);
+                if (decision == kGpuIgnore) continue;
+                if (decision == kGpuAcceptAndStop) {
+                    out = candidate;
+                    return true;
                 }
-                ray.tmax = t;
-                hit_index = (int)i;
-                hit_u = u;
-                hit_v = v;
             }
+            ray.tmax = t;
+            hit_index = (int)i;
+            hit_u = u;
+            hit_v = v;
         }
-        // The next entry that may still hold a nearer hit.
-        for (;;) {
-            if (sp == 0) {
-                if (hit_index < 0) return false;
-                out.t = ray.tmax;
-                out.u = hit_u;
-                out.v = hit_v;
-                out.prim = bvh.triangle_ids[hit_index];
-                return true;
-            }
+        if (group_nodes == 0u) {
+            if (sp == 0) break;
             --sp;
-            if (kQuery == kGpuAny || stack.t[sp] <= ray.tmax) break;
+            group_base = stack.base[sp];
+            group_inner = stack.bits[sp] >> 8;
+            group_nodes = stack.bits[sp] & 0xffu;
         }
-        ref = stack.ref[sp];
     }
+    if (hit_index < 0) return false;
+    out.t = ray.tmax;
+    out.u = hit_u;
+    out.v = hit_v;
+    out.prim = bvh.triangle_ids[hit_index];
+    return true;
 }
 
 /// Closest hit with t in (tmin, tmax).
