@@ -153,12 +153,12 @@ Rate rate_of(const std::vector<double>& mrays) {
 }
 
 /// Seconds for body(i) over every ray, on `threads` threads that take chunks of rays from a
-/// shared counter. The calling thread only waits: per ray, the workers read the closures
-/// that lead to the engine (body, the query, the accel), which live in the caller's stack
-/// frames, and a caller tracing rays itself writes its stack right beside them. Those
-/// lines then move between cores on every ray; with the caller working, Lucent's shadow
-/// rays measured anywhere from 9 to 33 Mrays/s on two threads depending on how the
-/// compiler laid out the frames.
+/// shared counter. The calling thread only waits. With the caller tracing too, Lucent's
+/// two-thread shadow figure moved between 9 and 33 Mrays/s with changes to the caller's
+/// stack frame alone; the likely cause is that per ray the workers read the closures that
+/// lead to the engine (body, the query, the accel), which live in the caller's frames,
+/// beside the stack a tracing caller writes. With the caller waiting, such changes move
+/// nothing.
 template <class Body>
 double timed_pass(size_t count, unsigned threads, const Body& body) {
     // The counter has a cache line to itself, as every worker takes it once per chunk.
