@@ -76,4 +76,31 @@ int WideCollapse::children(uint32_t n, uint32_t (&kids)[kWideArity]) const {
     return count;
 }
 
+void WideCollapse::children_by_octant(uint32_t n, uint32_t (&slot_kid)[kWideArity]) const {
+    static_assert(kWideArity == 8, "one slot per corner of the box");
+    uint32_t kids[kWideArity];
+    const int count = children(n, kids);
+    const auto& bn = m_binary.nodes();
+    const float3 center = 0.5f * (bn[n].lo + bn[n].hi);
+    float score[kWideArity][kWideArity];  // [child][slot]
+    for (int c = 0; c < count; ++c) {
+        const float3 d = 0.5f * (bn[kids[c]].lo + bn[kids[c]].hi) - center;
+        for (int s = 0; s < kWideArity; ++s)
+            score[c][s] = (s & 1 ? d.x : -d.x) + (s & 2 ? d.y : -d.y) + (s & 4 ? d.z : -d.z);
+    }
+    for (uint32_t& k : slot_kid) k = kNoChild;
+    bool placed[kWideArity] = {};
+    for (int round = 0; round < count; ++round) {
+        int best_c = -1, best_s = -1;
+        for (int c = 0; c < count; ++c) {
+            if (placed[c]) continue;
+            for (int s = 0; s < kWideArity; ++s)
+                if (slot_kid[s] == kNoChild && (best_c < 0 || score[c][s] > score[best_c][best_s]))
+                    best_c = c, best_s = s;
+        }
+        slot_kid[best_s] = kids[best_c];
+        placed[best_c] = true;
+    }
+}
+
 }  // namespace lucent::accel

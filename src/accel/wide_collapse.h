@@ -33,6 +33,14 @@ class WideCollapse {
     /// its two children. Returns how many were written to `kids`.
     int children(uint32_t n, uint32_t (&kids)[kWideArity]) const;
 
+    /// children(n), placed in the slots of a wide node by position (Sec. 3.2 of the paper):
+    /// slot s wants the child nearest the corner of n's box that is high on the axes of the
+    /// bits of s, so that a ray whose direction is negative on the axes of the bits of o
+    /// meets the children about in the order s ^ o. Greedily, the best-aligned pair of a free
+    /// child and a free slot first. slot_kid[s] is a binary node, or kNoChild.
+    static constexpr uint32_t kNoChild = 0xffffffffu;
+    void children_by_octant(uint32_t n, uint32_t (&slot_kid)[kWideArity]) const;
+
   private:
     void plan();
     float best_children(uint32_t n, int& left_share) const;

@@ -25,34 +25,6 @@ float as_float(unsigned bits) {
     return std::bit_cast<float>(bits);
 }
 
-/// Which child goes to which slot (Sec. 3.2 of the paper): slot s wants the child nearest the
-/// node's corner that is high on the axes of the bits of s. Greedily, the best-aligned pair
-/// of a free child and a free slot first; slot_kid[s] is an index into kids, or -1.
-void assign_slots(const std::vector<accel::BvhNode>& bn, const accel::BvhNode& node,
-                  const uint32_t* kids, int n, int (&slot_kid)[gpu::kCwbvhArity]) {
-    static_assert(gpu::kCwbvhArity == 8, "one slot per corner of the box");
-    const float3 center = 0.5f * (node.lo + node.hi);
-    float score[gpu::kCwbvhArity][gpu::kCwbvhArity];  // [child][slot]
-    for (int c = 0; c < n; ++c) {
-        const float3 d = 0.5f * (bn[kids[c]].lo + bn[kids[c]].hi) - center;
-        for (int s = 0; s < gpu::kCwbvhArity; ++s)
-            score[c][s] = (s & 1 ? d.x : -d.x) + (s & 2 ? d.y : -d.y) + (s & 4 ? d.z : -d.z);
-    }
-    for (int& k : slot_kid) k = -1;
-    bool child_placed[gpu::kCwbvhArity] = {};
-    for (int placed = 0; placed < n; ++placed) {
-        int best_c = -1, best_s = -1;
-        for (int c = 0; c < n; ++c) {
-            if (child_placed[c]) continue;
-            for (int s = 0; s < gpu::kCwbvhArity; ++s)
-                if (slot_kid[s] < 0 && (best_c < 0 || score[c][s] > score[best_c][best_s]))
-                    best_c = c, best_s = s;
-        }
-        slot_kid[best_s] = best_c;
-        child_placed[best_c] = true;
-    }
-}
-
 struct Emitter {
     std::span<const float3> positions;
     std::span<const uint3> indices;
@@ -65,11 +37,9 @@ struct Emitter {
     void emit(size_t index, uint32_t bnode, unsigned depth) {
         max_depth = std::max(max_depth, depth);
         const auto& bn = bvh.nodes();
-        uint32_t kids[accel::kWideArity];
-        const int n = plan.children(bnode, kids);
         const accel::BvhNode& box = bn[bnode];
-        int slot_kid[gpu::kCwbvhArity];
-        assign_slots(bn, box, kids, n, slot_kid);
+        uint32_t slot_kid[accel::kWideArity];
+        plan.children_by_octant(bnode, slot_kid);
         const CwbvhAxisGrid grid[3] = {cwbvh_axis_grid(box.lo.x, box.hi.x),
                                        cwbvh_axis_grid(box.lo.y, box.hi.y),
                                        cwbvh_axis_grid(box.lo.z, box.hi.z)};
@@ -80,11 +50,11 @@ struct Emitter {
         const size_t triangle_base = out.triangle_ids.size();
         int inner_count = 0;
         for (int i = 0; i < gpu::kCwbvhArity; ++i) {
-            if (slot_kid[i] < 0) {  // empty: a box turned inside out
+            if (slot_kid[i] == accel::WideCollapse::kNoChild) {  // empty: inside-out box
                 for (int k = 0; k < 3; ++k) qlo[k][i] = gpu::kCwbvhQuantMax, qhi[k][i] = 0;
                 continue;
             }
-            const accel::BvhNode& kid = bn[kids[slot_kid[i]]];
+            const accel::BvhNode& kid = bn[slot_kid[i]];
             const float lo[3] = {kid.lo.x, kid.lo.y, kid.lo.z},
                         hi[3] = {kid.hi.x, kid.hi.y, kid.hi.z};
             for (int k = 0; k < 3; ++k) {
@@ -122,7 +92,7 @@ struct Emitter {
 
         int rank = 0;
         for (int i = 0; i < gpu::kCwbvhArity; ++i)
-            if (inner & (1u << i)) emit(child_base + size_t(rank++), kids[slot_kid[i]], depth + 1);
+            if (inner & (1u << i)) emit(child_base + size_t(rank++), slot_kid[i], depth + 1);
     }
 };
 
