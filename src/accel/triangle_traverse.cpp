@@ -191,7 +191,6 @@ template <>
 struct Lanes<4> {
     using V = __m128;
     static V load(const float* p) { return _mm_load_ps(p); }
-    static V set1(float x) { return _mm_set1_ps(x); }
     static V zero() { return _mm_setzero_ps(); }
     static V from8(__m256 x) { return _mm256_castps256_ps128(x); }
     static V add(V a, V b) { return _mm_add_ps(a, b); }
@@ -216,7 +215,6 @@ template <>
 struct Lanes<8> {
     using V = __m256;
     static V load(const float* p) { return _mm256_load_ps(p); }
-    static V set1(float x) { return _mm256_set1_ps(x); }
     static V zero() { return _mm256_setzero_ps(); }
     static V from8(__m256 x) { return x; }
     static V add(V a, V b) { return _mm256_add_ps(a, b); }

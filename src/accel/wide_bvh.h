@@ -32,7 +32,6 @@ struct alignas(64) WideNode {
 /// costs the same instructions as the 4-wide one, one test where two blocks took two.
 template <int kLanes>
 struct alignas(64) TriangleBlock {
-    static constexpr int lanes = kLanes;
     float vertex[3][3][kLanes];
     uint32_t prim[kLanes];
 };

@@ -43,6 +43,8 @@ struct Emitter {
         const CwbvhAxisGrid grid[3] = {cwbvh_axis_grid(box.lo.x, box.hi.x),
                                        cwbvh_axis_grid(box.lo.y, box.hi.y),
                                        cwbvh_axis_grid(box.lo.z, box.hi.z)};
+        double step[3];
+        for (int k = 0; k < 3; ++k) step[k] = gpu::cwbvh_step(grid[k].biased_exponent);
 
         unsigned inner = 0, meta[gpu::kCwbvhArity] = {};
         unsigned qlo[3][gpu::kCwbvhArity], qhi[3][gpu::kCwbvhArity];
@@ -57,13 +59,13 @@ struct Emitter {
             const accel::BvhNode& kid = bn[slot_kid[i]];
             const float lo[3] = {kid.lo.x, kid.lo.y, kid.lo.z},
                         hi[3] = {kid.hi.x, kid.hi.y, kid.hi.z};
+            constexpr double kQuantMax = gpu::kCwbvhQuantMax;
             for (int k = 0; k < 3; ++k) {
                 // Outwards: floor for lo, ceil for hi, in double where both are exact.
-                const double step = std::ldexp(1.0, int(grid[k].biased_exponent) - 127);
                 qlo[k][i] = (unsigned)std::clamp(
-                    std::floor((double(lo[k]) - grid[k].origin) / step), 0.0, 255.0);
-                qhi[k][i] = (unsigned)std::clamp(std::ceil((double(hi[k]) - grid[k].origin) / step),
-                                                 0.0, 255.0);
+                    std::floor((double(lo[k]) - grid[k].origin) / step[k]), 0.0, kQuantMax);
+                qhi[k][i] = (unsigned)std::clamp(
+                    std::ceil((double(hi[k]) - grid[k].origin) / step[k]), 0.0, kQuantMax);
             }
             if (kid.count > 0) {
                 const unsigned first = append_leaf_triangles(positions, indices, bvh, kid,
