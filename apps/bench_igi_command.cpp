@@ -39,6 +39,12 @@ CLI::App* add_bench_igi_command(CLI::App* bench, BenchIgiArgs& args) {
         ->type_name("M")
         ->check(CLI::Range(2u, 8u).description(""))
         ->capture_default_str();
+    c->add_option("--reflection-layer", args.reflection_layer,
+                  "1: the first reflected hits' indirect light is a G-buffer layer, accelerated "
+                  "like the primary hits'; 0: inline, as in the paper")
+        ->type_name("0|1")
+        ->check(CLI::Range(0u, 1u).description(""))
+        ->capture_default_str();
     c->add_flag("--json", args.json, "One JSON object instead of the table");
     c->footer(
         "Examples:\n"
@@ -62,6 +68,7 @@ int run_bench_igi_command(const BenchIgiArgs& args) {
     options.vpls = args.vpls;
     options.downsample = args.downsample;
     options.interleave = args.interleave;
+    options.reflection_layer = args.reflection_layer != 0;
     options.json = args.json;
     ProgressBar bar("bench igi", "configurations");
     if (!args.json)

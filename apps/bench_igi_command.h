@@ -16,6 +16,7 @@ struct BenchIgiArgs {
     unsigned frames = 10;
     std::vector<unsigned> vpls{30, 90, 180};
     unsigned downsample = 4, interleave = 3;
+    unsigned reflection_layer = 1;
     bool json = false;
 };
 

@@ -21,6 +21,7 @@
 #include "cuda/device_buffer.h"
 #include "cuda/driver_api.h"
 #include "cuda/gpu_bvh_builder.h"
+#include "cuda/gpu_cwbvh.h"
 #include "cuda/gpu_triangle_bvh.h"
 #include "cuda/nvrtc_compiler.h"
 #include "lucent/error.h"
@@ -173,10 +174,12 @@ float3 xyz(float4 v) {
 /// The compiled bench module and how to launch its trace kernels.
 struct BenchKernels {
     CUfunction closest = nullptr, any = nullptr, primary_rays = nullptr, secondary_rays = nullptr;
+    CUfunction cwbvh_closest = nullptr, cwbvh_any = nullptr;  // the compressed wide layout
     bool persistent = true;
     int block = 128;
     int grid_closest = 0, grid_any = 0;  // persistent grids: SMs x resident blocks
-    std::string describe;
+    int grid_cwbvh_closest = 0, grid_cwbvh_any = 0;
+    std::string describe, describe_cwbvh;
 };
 
 CompileResult compile_bench_kernels(int sm, bool persistent) {
@@ -207,13 +210,16 @@ class RayBench {
         k.any = m_module->function("lucent_bench_any");
         k.primary_rays = m_module->function("lucent_bench_primary_rays");
         k.secondary_rays = m_module->function("lucent_bench_secondary_rays");
+        k.cwbvh_closest = m_module->function("lucent_bench_cwbvh_closest");
+        k.cwbvh_any = m_module->function("lucent_bench_cwbvh_any");
         auto attr = [&](CUfunction f, CUfunction_attribute a) {
             int v = 0;
             check(api.cuFuncGetAttribute(&v, a, f), "cuFuncGetAttribute");
             return v;
         };
-        k.block = std::min(attr(k.closest, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK),
-                           attr(k.any, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
+        k.block = 1 << 30;
+        for (CUfunction f : {k.closest, k.any, k.cwbvh_closest, k.cwbvh_any})
+            k.block = std::min(k.block, attr(f, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
         auto resident = [&](CUfunction f) {
             int blocks = 0;
             check(api.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, f, k.block, 0),
@@ -223,6 +229,9 @@ class RayBench {
         const int res_closest = resident(k.closest), res_any = resident(k.any);
         k.grid_closest = sm_count * res_closest;
         k.grid_any = sm_count * res_any;
+        const int res_cw_closest = resident(k.cwbvh_closest), res_cw_any = resident(k.cwbvh_any);
+        k.grid_cwbvh_closest = sm_count * res_cw_closest;
+        k.grid_cwbvh_any = sm_count * res_cw_any;
         char buf[512];
         std::snprintf(buf, sizeof buf,
                       "%s, %s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
@@ -235,6 +244,14 @@ class RayBench {
                       attr(k.any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_any, compiled.ms,
                       compiled.from_cache ? " (cache)" : "");
         k.describe = buf;
+        std::snprintf(buf, sizeof buf,
+                      "closest %d regs %d B local %d blocks/SM; any %d regs %d B local %d "
+                      "blocks/SM",
+                      attr(k.cwbvh_closest, CU_FUNC_ATTRIBUTE_NUM_REGS),
+                      attr(k.cwbvh_closest, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_cw_closest,
+                      attr(k.cwbvh_any, CU_FUNC_ATTRIBUTE_NUM_REGS),
+                      attr(k.cwbvh_any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_cw_any);
+        k.describe_cwbvh = buf;
         counter = DeviceBuffer(sizeof(unsigned));
     }
 
@@ -300,6 +317,18 @@ class RayBench {
     Rate time_diffuse(const gpu::GpuTriangleBvhView& view) {
         return time_trace(k.closest, k.grid_closest, view, diffuse.ptr(), m, diffuse_hits.ptr());
     }
+    /// The same three through the compressed wide layout.
+    Rate time_primary(const gpu::GpuCwbvhView& view) {
+        return time_trace(k.cwbvh_closest, k.grid_cwbvh_closest, view, primary.ptr(), n,
+                          primary_hits.ptr());
+    }
+    Rate time_shadow(const gpu::GpuCwbvhView& view) {
+        return time_trace(k.cwbvh_any, k.grid_cwbvh_any, view, shadow.ptr(), m, occluded.ptr());
+    }
+    Rate time_diffuse(const gpu::GpuCwbvhView& view) {
+        return time_trace(k.cwbvh_closest, k.grid_cwbvh_closest, view, diffuse.ptr(), m,
+                          diffuse_hits.ptr());
+    }
 
     int sm = 0, sm_count = 0;
     BenchKernels k;
@@ -308,9 +337,11 @@ class RayBench {
     DeviceBuffer primary, primary_hits, slots, shadow, diffuse, occluded, diffuse_hits;
 
   private:
-    /// One launch of a trace kernel; returns its time in ms (CUDA events).
-    float trace(CUfunction f, int grid_persistent, gpu::GpuTriangleBvhView view, CUdeviceptr rays,
-                unsigned count, CUdeviceptr out) {
+    /// One launch of a trace kernel over a BVH view (either layout); returns its time in ms
+    /// (CUDA events).
+    template <class View>
+    float trace(CUfunction f, int grid_persistent, View view, CUdeviceptr rays, unsigned count,
+                CUdeviceptr out) {
         CUdeviceptr counter_ptr = counter.ptr();
         void* args[] = {&view, &rays, &count, &out, &counter_ptr};
         const unsigned grid =
@@ -325,8 +356,9 @@ class RayBench {
         check(m_api.cuEventElapsedTime(&ms, m_start.get(), m_stop.get()), "cuEventElapsedTime");
         return ms;
     }
-    Rate time_trace(CUfunction f, int grid_persistent, const gpu::GpuTriangleBvhView& view,
-                    CUdeviceptr rays, unsigned count, CUdeviceptr out) {
+    template <class View>
+    Rate time_trace(CUfunction f, int grid_persistent, const View& view, CUdeviceptr rays,
+                    unsigned count, CUdeviceptr out) {
         std::vector<double> mrays;
         if (count == 0) return Rate{};
         for (int run = -1; run < m_in.repeat; ++run) {
@@ -419,6 +451,32 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
         if (t >= 0.0f) ++gpu.diffuse_hits, gpu.diffuse_sum_t += t;
     });
 
+    // The compressed wide layout (cwbvh.cuh) on the same rays: its rates, and every ray's
+    // result against the binary layout's (t bits and triangle; occlusion).
+    const GpuCwbvh cwbvh = build_gpu_cwbvh(in.positions, in.indices);
+    GpuCwbvhDevice dcwbvh;
+    upload_gpu_cwbvh(cwbvh, dcwbvh);
+    const Rate cw_primary = bench.time_primary(dcwbvh.view());
+    std::vector<uint2> cw_hits_p(n);
+    bench.primary_hits.download(cw_hits_p.data(), sizeof(uint2) * n);
+    const Rate cw_shadow = bench.time_shadow(dcwbvh.view());
+    const Rate cw_diffuse = bench.time_diffuse(dcwbvh.view());
+    std::vector<unsigned char> cw_occ(m);
+    std::vector<uint2> cw_hits_d(m);
+    bench.occluded.download(cw_occ.data(), m);
+    bench.diffuse_hits.download(cw_hits_d.data(), sizeof(uint2) * m);
+    auto same_hit = [](uint2 a, uint2 b) {
+        return a.x == b.x && (std::bit_cast<float>(a.x) < 0.0f || a.y == b.y);
+    };
+    size_t cw_differ_p = 0, cw_differ_s = 0, cw_differ_d = 0;
+    for (unsigned i = 0; i < n; ++i) cw_differ_p += !same_hit(hits_p[i], cw_hits_p[i]);
+    for (unsigned i = 0; i < m; ++i) {
+        cw_differ_s += occ[i] != cw_occ[i];
+        cw_differ_d += !same_hit(hits_d[i], cw_hits_d[i]);
+    }
+    const double cw_mb = (cwbvh.nodes.size() * sizeof(float4)) / 1e6;
+    const double binary_mb = (bvh.nodes.size() * sizeof(float4)) / 1e6;
+
     // The CPU backend (TriangleAccel, all threads) on the same rays.
     std::vector<float4> rays_p(2 * (size_t)n), rays_s(2 * (size_t)m), rays_d(2 * (size_t)m);
     bench.primary.download(rays_p.data(), rays_p.size() * sizeof(float4));
@@ -477,14 +535,22 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
             " \"cpu\": {\"primary\": {\"hits\": %zu, \"sum_t\": %.9e}, \"shadow\": {\"occluded\": "
             "%zu}, \"diffuse\": {\"hits\": %zu, \"sum_t\": %.9e}},\n"
             " \"rays_differing\": {\"primary\": %zu, \"shadow\": %zu, \"diffuse\": %zu}, "
-            "\"checksums_agree\": %s}\n",
+            "\"checksums_agree\": %s,\n"
+            " \"cwbvh\": {\"nodes\": %zu, \"node_mb\": %.4f, \"binary_node_mb\": %.4f, "
+            "\"build_ms\": %.3f, \"primary\": {%s}, \"shadow\": {%s}, \"diffuse\": {%s}, "
+            "\"rays_differing_from_binary\": {\"primary\": %zu, \"shadow\": %zu, \"diffuse\": "
+            "%zu}}}\n",
             in.scene.c_str(), ctx.name().c_str(), sm, tri_count, in.width, in.height, in.repeat,
             k.persistent ? "true" : "false", bvh.stats.build_ms + bvh.stats.convert_ms,
             bvh.stats.node_count, bvh.stats.sah_cost, rate(rate_primary).c_str(), gpu.primary_hits,
             gpu.primary_sum_t, rate(rate_shadow).c_str(), gpu.shadow_rays, gpu.occluded,
             rate(rate_diffuse).c_str(), gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t,
             cpu.primary_hits, cpu.primary_sum_t, cpu.occluded, cpu.diffuse_hits, cpu.diffuse_sum_t,
-            differ_p, differ_s, differ_d, differences.empty() ? "true" : "false");
+            differ_p, differ_s, differ_d, differences.empty() ? "true" : "false",
+            cwbvh.stats.node_count, cw_mb, binary_mb,
+            cwbvh.stats.build_ms + cwbvh.stats.convert_ms, rate(cw_primary).c_str(),
+            rate(cw_shadow).c_str(), rate(cw_diffuse).c_str(), cw_differ_p, cw_differ_s,
+            cw_differ_d);
         return 0;
     }
     auto rate_text = [](const Rate& r) {
@@ -507,6 +573,22 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
                 gpu.shadow_rays, gpu.occluded);
     std::printf("diffuse %s rays=%zu hits=%zu sum_t=%.6e\n", rate_text(rate_diffuse).c_str(),
                 gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t);
+    std::printf("compressed wide layout (cwbvh): %zu nodes, %.2f MB of nodes (binary %.2f MB), "
+                "build %.1f ms; %s\n",
+                cwbvh.stats.node_count, cw_mb, binary_mb,
+                cwbvh.stats.build_ms + cwbvh.stats.convert_ms, k.describe_cwbvh.c_str());
+    auto ratio_to_binary = [](const Rate& a, const Rate& b) {
+        return b.median > 0 ? a.median / b.median : 0.0;
+    };
+    std::printf("cwbvh primary %s (%.3fx binary)\n", rate_text(cw_primary).c_str(),
+                ratio_to_binary(cw_primary, rate_primary));
+    std::printf("cwbvh shadow %s (%.3fx binary)\n", rate_text(cw_shadow).c_str(),
+                ratio_to_binary(cw_shadow, rate_shadow));
+    std::printf("cwbvh diffuse %s (%.3fx binary)\n", rate_text(cw_diffuse).c_str(),
+                ratio_to_binary(cw_diffuse, rate_diffuse));
+    std::printf("cwbvh results differing from the binary layout's: primary %zu, shadow %zu, "
+                "diffuse %zu\n",
+                cw_differ_p, cw_differ_s, cw_differ_d);
     std::printf(
         "cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
         "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",

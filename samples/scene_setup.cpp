@@ -59,13 +59,17 @@ PinholeFrame pinhole_frame(const scene::Camera& c, float aspect) {
     return {U * (half_height * aspect), V * half_height, W};
 }
 
-scene::Image image_from_output(const Buffer& output) {
+scene::Image image_from_output(const Buffer& output, unsigned layer) {
     scene::Image image;
     image.width = output.size().x;
     image.height = output.size().y;
-    const float4* pixels = output.data<float4>();
-    image.pixels.resize(size_t(image.width) * image.height);
-    for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = make_float3(pixels[i]);
+    if (layer >= std::max(1u, output.size().z))
+        throw Error("image_from_output: layer " + std::to_string(layer) + " of a buffer of " +
+                    std::to_string(output.size().z) + " layers");
+    const size_t count = size_t(image.width) * image.height;
+    const float4* pixels = output.data<float4>() + count * layer;
+    image.pixels.resize(count);
+    for (size_t i = 0; i < count; ++i) image.pixels[i] = make_float3(pixels[i]);
     return image;
 }
 

@@ -57,8 +57,9 @@ struct PinholeFrame {
 };
 PinholeFrame pinhole_frame(const scene::Camera& camera, float aspect);
 
-/// The float4 output buffer of a launch as a linear RGB image.
-scene::Image image_from_output(const Buffer& output);
+/// The float4 output buffer of a launch as a linear RGB image: its layer `layer` (z) when it
+/// has several.
+scene::Image image_from_output(const Buffer& output, unsigned layer = 0);
 
 /// Diffuse maps as texture samplers (bilinear, repeating), each file loaded once; a
 /// material without one ("") gets a 1x1 white texel, so programs always sample a texture.

@@ -82,13 +82,20 @@ samples)
         compare "$out/$name.cpu.png" "$out/$name.cuda.png" "$args"
     done
     ;;
+igi_quick)
+    echo "== bench igi Sponza 800x600, 180 VPLs: reflection layer on (default) and off (the paper)"
+    for layer in 1 0; do
+        LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda \
+            --scene bench/scenes/sponza-igi.json --frames 50 --vpls 180 --reflection-layer $layer
+    done
+    ;;
 igi)
     echo "== bench igi: Cornell box and Sponza (3 point lights, two mirror pools), 800x600"
     $R $B/bin/lucent bench igi --backend cuda --scene cornell --frames 50
     LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda \
         --scene bench/scenes/sponza-igi.json --frames 50
     LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent bench igi --backend cuda \
-        --scene bench/scenes/sponza-igi.json --frames 50 --vpls 180 --json > "$out/bench_igi_sponza.json"
+        --scene bench/scenes/sponza-igi.json --frames 50 --json > "$out/bench_igi_sponza.json"
     LUCENT_SCENE_PATH=/work/shared/scenes $R $B/bin/lucent render --sample igi --backend cuda \
         --scene bench/scenes/sponza-igi.json --size 800x600 --out "$out/igi_sponza.png" --repeat 50
     ;;
@@ -170,6 +177,23 @@ profile_igi)
         --section WarpStateStats --section MemoryWorkloadAnalysis \
         $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
         --size 800x600 --repeat 3 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -90
+    ;;
+profile_igi_pass)
+    # One pass of an IGI frame with all three accelerations, Sponza 800x600, under ncu. Seven
+    # launches a frame (VPL generation, direct, indirect, the sum of its VPL slices,
+    # discontinuity, upsampling, composition); launches 1-3 of each entry try the launch
+    # shapes, so frame 4 starts at launch 21: IGI_LAUNCH=22 (default) is its direct pass, 23
+    # its indirect pass.
+    echo "== ncu: IGI launch ${IGI_LAUNCH:-22} with all three accelerations, Sponza 800x600"
+    LUCENT_SCENE_PATH=/work/shared/scenes LUCENT_NVRTC_OPTIONS="-lineinfo" ncu \
+        --kernel-name lucent_megakernel --launch-skip ${IGI_LAUNCH:-22} --launch-count 1 \
+        --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
+        --section SourceCounters -f -o /tmp/igi_pass \
+        $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
+        --size 800x600 --set imperfect_visibility=1 --set downsample=4 --set interleave=3 \
+        --repeat 5 --out /tmp/p.png 2>&1 | tail -3
+    ncu -i /tmp/igi_pass.ncu-rep --print-summary none 2>&1 | grep -vE "^==PROF==|^ +-+$" | \
+        grep -E "Duration|Registers|Occupancy|Warp Cycles|Issued|Eligible|Stall|Block Limit|Threads|Grid" | head -40
     ;;
 hotspots)
     echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"

@@ -46,14 +46,32 @@ std::vector<igi::PointLight> point_emitters(const scene::Scene& input, int side)
     return lights;
 }
 
+/// Each triangle's bounding box, lo and hi (two float4), for the boxes graph of imperfect
+/// visibility (igi::BoxRecord).
+std::shared_ptr<Buffer> triangle_boxes(Context& ctx, const scene::Mesh& mesh) {
+    std::vector<float4> boxes;
+    boxes.reserve(2 * mesh.indices.size());
+    for (const uint3& t : mesh.indices) {
+        const float3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+        boxes.push_back(make_float4(fminf(a, fminf(b, c)), 0.0f));
+        boxes.push_back(make_float4(fmaxf(a, fmaxf(b, c)), 0.0f));
+    }
+    auto buffer = ctx.create_buffer<float4>(BufferType::kInput, unsigned(boxes.size()));
+    buffer->upload(boxes);
+    return buffer;
+}
+
 IgiConfig read_config(const RenderSettings& settings, const SampleInfo& info) {
     IgiConfig c;
     c.paths = unsigned(get_int_option(settings, info, "vpls", 1, 65536));
     c.bounces = unsigned(get_int_option(settings, info, "bounces", 1, 8));
     c.downsample = unsigned(get_int_option(settings, info, "downsample", 1, 16));
     c.interleave = unsigned(get_int_option(settings, info, "interleave", 1, 8));
+    c.layers = get_int_option(settings, info, "reflection_layer", 0, 1) ? 2u : 1u;
     c.width = settings.width;
     c.height = settings.height;
+    const int slices = get_int_option(settings, info, "vpl_slices", 0, 64);
+    c.slices = slices > 0 ? unsigned(slices) : auto_indirect_slices(c);
     return c;
 }
 
@@ -96,6 +114,8 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx["bounces"] = config.bounces;
     ctx["downsample"] = config.downsample;
     ctx["interleave"] = config.interleave;
+    ctx["reflection_layer"] = config.layers > 1 ? 1u : 0u;
+    ctx["slices"] = config.slices;
     ctx["depth_threshold"] = depth_threshold;
     ctx["normal_threshold"] = normal_threshold;
     ctx["sigma"] = sigma;
@@ -129,13 +149,12 @@ RenderResult render_igi(const RenderSettings& settings) {
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_intersect));
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
     box_material->set_name("box");
-    auto add_boxes = [&](const scene::Mesh& mesh, const MeshBuffers& buffers) {
+    auto add_boxes = [&](const scene::Mesh& mesh, const MeshBuffers&) {
         auto box_geometry = ctx.create_geometry();
         box_geometry->set_primitive_count(unsigned(mesh.indices.size()));
         box_geometry->set_bounding_box_program(box_bounds);
         box_geometry->set_intersection_program(box_intersect);
-        (*box_geometry)["positions"] = buffers.positions;
-        (*box_geometry)["triangles"] = buffers.triangles;
+        (*box_geometry)["boxes"] = triangle_boxes(ctx, mesh);
         auto box_instance = ctx.create_geometry_instance();
         box_instance->set_geometry(box_geometry);
         box_instance->add_material(box_material);
@@ -160,7 +179,10 @@ RenderResult render_igi(const RenderSettings& settings) {
     (*camera)["U"] = frame.U;
     (*camera)["V"] = frame.V;
     auto indirect = ctx.create_program(LUCENT_PROGRAM(igi_indirect));
-    (*indirect)["indirect"] = images.indirect;
+    (*indirect)["indirect"] = config.slices > 1 ? images.indirect_slices : images.indirect;
+    auto indirect_sum = ctx.create_program(LUCENT_PROGRAM(igi_indirect_sum));
+    (*indirect_sum)["indirect_slices"] = images.indirect_slices;
+    (*indirect_sum)["indirect"] = images.indirect;
     auto discontinuity = ctx.create_program(LUCENT_PROGRAM(igi_discontinuity));
     (*discontinuity)["indirect"] = images.indirect;
     (*discontinuity)["merged"] = images.merged;
@@ -178,6 +200,7 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_generation_program(igi::kDiscontinuityEntry, discontinuity);
     ctx.set_ray_generation_program(igi::kUpsampleEntry, upsample);
     ctx.set_ray_generation_program(igi::kComposeEntry, compose);
+    ctx.set_ray_generation_program(igi::kIndirectSumEntry, indirect_sum);
     ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi_miss)));
     out.stages.push_back({"scene setup", ms_since(setup_start),
                           input.name + ", " + std::to_string(input.triangle_count()) +
@@ -192,6 +215,11 @@ RenderResult render_igi(const RenderSettings& settings) {
         out.layers["position"] = image_from_output(*images.gbuffer_position);
         out.layers["indirect"] = image_from_output(*images.irradiance_at_full_resolution(config));
         out.layers["indirect_low"] = image_from_output(*images.indirect);
+        if (config.layers > 1) {  // the first reflected hits (the reflection layer)
+            out.layers["reflected_weight"] = image_from_output(*images.gbuffer_albedo, 1);
+            out.layers["reflected_indirect"] =
+                image_from_output(*images.irradiance_at_full_resolution(config), 1);
+        }
     }
     return out;
 }
@@ -217,6 +245,12 @@ const SampleInfo& igi_sample_info() {
             {"interleave", "1",
              "M: VPLs split into M x M subsets over M x M pixel tiles, merged by the "
              "discontinuity buffer (1..8)"},
+            {"vpl_slices", "0",
+             "threads sharing a pixel's VPLs in the indirect pass; 0: as many as give "
+             "about 2^20 work items (0..64)"},
+            {"reflection_layer", "1",
+             "1: the first reflected hit's indirect light is a G-buffer layer of its own, "
+             "downsampled and interleaved like the primary hit's; 0: inline, as in the paper"},
             {"depth_threshold", "0.1",
              "discontinuity buffer: largest relative depth difference of neighbours (0..10)"},
             {"normal_threshold", "0.9",

@@ -48,6 +48,7 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
         {"imperfect_visibility", c.imperfect ? "1" : "0"},
         {"downsample", c.downsample ? std::to_string(options.downsample) : "1"},
         {"interleave", c.interleave ? std::to_string(options.interleave) : "1"},
+        {"reflection_layer", options.reflection_layer ? "1" : "0"},
     };
     const RenderResult result = igi_sample_info().render(settings);
     Row row{c.name, vpls, 0, {}, result.backend};
@@ -62,9 +63,9 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
 void print_json(const IgiBenchOptions& options, const std::vector<Row>& rows) {
     std::printf(
         "{\"benchmark\": \"igi\", \"scene\": \"%s\", \"backend\": \"%s\", \"width\": %u, "
-        "\"height\": %u, \"frames\": %u, \"rows\": [",
+        "\"height\": %u, \"frames\": %u, \"reflection_layer\": %s, \"rows\": [",
         options.scene.c_str(), rows.empty() ? "" : rows[0].backend.c_str(), options.width,
-        options.height, options.frames);
+        options.height, options.frames, options.reflection_layer ? "true" : "false");
     for (size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
         std::printf(
@@ -84,9 +85,12 @@ void print_json(const IgiBenchOptions& options, const std::vector<Row>& rows) {
 }
 
 void print_table(const IgiBenchOptions& options, const std::vector<Row>& rows) {
-    std::printf("igi: %s, %ux%u on %s, median of %u frames; stage shares in %% of the frame\n",
-                options.scene.c_str(), options.width, options.height,
-                rows.empty() ? "?" : rows[0].backend.c_str(), options.frames);
+    std::printf(
+        "igi: %s, %ux%u on %s, median of %u frames, reflection layer %s; stage shares in %% of "
+        "the frame\n",
+        options.scene.c_str(), options.width, options.height,
+        rows.empty() ? "?" : rows[0].backend.c_str(), options.frames,
+        options.reflection_layer ? "on" : "off (inline, as in the paper)");
     std::printf("%-22s %5s %9s %9s %7s %7s %8s %7s %7s %7s\n", "configuration", "VPLs", "frames/s",
                 "frame ms", "VPLgen", "direct", "indirect", "discont", "upsamp", "compose");
     for (const Row& r : rows) {

@@ -20,6 +20,9 @@ struct IgiBenchOptions {
     unsigned frames = 10;                // timed after one warm-up frame
     std::vector<unsigned> vpls{30, 90, 180};
     unsigned downsample = 4, interleave = 3;  // the paper's windows
+    // The first reflected hits' indirect light as a G-buffer layer of its own (the sample's
+    // reflection_layer option); false: inline, as in the paper.
+    bool reflection_layer = true;
     bool json = false;
     /// Called as configurations complete (done, total); may be empty.
     std::function<void(unsigned, unsigned)> progress;

@@ -14,22 +14,36 @@ std::shared_ptr<Buffer> IgiImages::irradiance_at_full_resolution(const IgiConfig
     return config.interleave > 1 ? merged : indirect;
 }
 
+unsigned auto_indirect_slices(const IgiConfig& config) {
+    const unsigned long long pixels =
+        1ull * config.low_width() * config.low_height() * config.layers;
+    const unsigned per_subset = std::max(
+        1u, (config.paths * config.bounces + config.interleave * config.interleave - 1) /
+                (config.interleave * config.interleave));
+    const unsigned long long wanted = (kIndirectWorkItems + pixels - 1) / pixels;
+    return unsigned(std::clamp<unsigned long long>(wanted, 1, per_subset));
+}
+
 IgiImages create_igi_images(Context& ctx, const IgiConfig& config) {
     const unsigned w = config.width, h = config.height;
     const unsigned lw = config.low_width(), lh = config.low_height();
-    auto image = [&ctx](unsigned width, unsigned height,
+    // layers = 0: a 2D image.
+    auto image = [&ctx](unsigned width, unsigned height, unsigned layers = 0,
                         BufferType type = BufferType::kInputOutput) {
-        return ctx.create_buffer<float4>(type, width, height);
+        return ctx.create_buffer<float4>(type, width, height, layers);
     };
+    const unsigned layers = config.layers;
     IgiImages images;
     images.direct = image(w, h);
-    images.gbuffer_position = image(w, h);
-    images.gbuffer_normal = image(w, h);
-    images.gbuffer_albedo = image(w, h);
-    images.indirect = image(lw, lh);
-    images.merged = config.interleave > 1 ? image(lw, lh) : image(1, 1);
-    images.upsampled = config.downsample > 1 ? image(w, h) : image(1, 1);
-    images.output = image(w, h, BufferType::kOutput);
+    images.gbuffer_position = image(w, h, layers);
+    images.gbuffer_normal = image(w, h, layers);
+    images.gbuffer_albedo = image(w, h, layers);
+    images.indirect = image(lw, lh, layers);
+    images.indirect_slices = image(config.slices > 1 ? lw : 1, config.slices > 1 ? lh : 1,
+                                   config.slices > 1 ? layers * config.slices : 1);
+    images.merged = config.interleave > 1 ? image(lw, lh, layers) : image(1, 1, layers);
+    images.upsampled = config.downsample > 1 ? image(w, h, layers) : image(1, 1, layers);
+    images.output = image(w, h, 0, BufferType::kOutput);
     ctx["direct"] = images.direct;
     ctx["gbuffer_position"] = images.gbuffer_position;
     ctx["gbuffer_normal"] = images.gbuffer_normal;
@@ -54,22 +68,27 @@ LaunchReport launch_frame(Context& ctx, const IgiConfig& config,
                           std::array<double, kIgiStageNames.size()>& ms) {
     ms.fill(0.0);
     LaunchReport frame;
-    auto run = [&](unsigned stage, unsigned entry, unsigned width, unsigned height) {
-        ctx.launch(entry, width, height);
+    auto run = [&](unsigned stage, unsigned entry, unsigned width, unsigned height,
+                   unsigned layers = 1) {
+        ctx.launch(entry, width, height, layers);
         const LaunchReport& report = ctx.last_launch();
         if (stage == 0) {
             frame = report;
             frame.exceptions.clear();
         }
         add_exceptions(frame, report);
-        ms[stage] = report.launch_ms;
+        ms[stage] += report.launch_ms;
     };
     run(0, igi::kVplEntry, config.paths, 1);
     run(1, igi::kDirectEntry, config.width, config.height);
-    run(2, igi::kIndirectEntry, config.low_width(), config.low_height());
+    run(2, igi::kIndirectEntry, config.low_width(), config.low_height(),
+        config.layers * config.slices);
+    if (config.slices > 1)
+        run(2, igi::kIndirectSumEntry, config.low_width(), config.low_height(), config.layers);
     if (config.interleave > 1)
-        run(3, igi::kDiscontinuityEntry, config.low_width(), config.low_height());
-    if (config.downsample > 1) run(4, igi::kUpsampleEntry, config.width, config.height);
+        run(3, igi::kDiscontinuityEntry, config.low_width(), config.low_height(), config.layers);
+    if (config.downsample > 1)
+        run(4, igi::kUpsampleEntry, config.width, config.height, config.layers);
     run(5, igi::kComposeEntry, config.width, config.height);
     return frame;
 }

@@ -5,6 +5,13 @@
 // is a stage of its own (at 1/N resolution, with interleaved VPL subsets), merged by the
 // discontinuity buffer, upsampled by Eq. (2) and composed with the direct image; hits further
 // down the specular tree get their indirect inline.
+//
+// Beyond the paper: with the reflection layer (option reflection_layer=1) the hit of the first
+// specular bounce is separated too, as the paper's §4 suggests ("storing the hitpoints on a
+// buffer") and its conclusion asks for ("improving such secondary irradiance calculations"):
+// the G-buffer and the indirect images get a second layer (z = 1) holding that hit, weighted
+// by the mirror's Ks, and every indirect pass runs over both layers, so downsampling and
+// interleaving apply to reflected surfaces as well. Deeper hits stay inline.
 #pragma once
 
 #include "lucent/device.h"
@@ -21,7 +28,8 @@ enum : unsigned {
     kDiscontinuityEntry = 3,  // merges the interleaved VPL subsets (seed §4.3)
     kUpsampleEntry = 4,       // joint bilateral upsampling, Eq. (2) (seed §4.2)
     kComposeEntry = 5,        // direct + rho / pi x indirect irradiance
-    kEntryCount = 6
+    kIndirectSumEntry = 6,    // adds up the indirect pass's VPL slices
+    kEntryCount = 7
 };
 
 /// A light the particles start from and the direct stage samples. Isotropic when `normal`
@@ -60,14 +68,22 @@ struct HitAttributes {
     float3 geometric_normal;  // object space, not normalised
 };
 
-/// The radiance ray's payload. At the primary hit (depth 0) the closest hit leaves the
-/// indirect term out and hands the G-buffer of Fig. 3 back instead: position, distance,
-/// normal and rho.
+/// One layer of the G-buffer of Fig. 3 at a hit: position, normal, the weight of its
+/// irradiance in the pixel (rho for the primary hit, Ks rho for a reflected one) and the
+/// distance along the eye path (< 0: no hit).
+struct Surfel {
+    float3 position, normal, albedo;
+    float distance;
+};
+
+/// The radiance ray's payload. At the primary hit (depth 0), and with the reflection layer at
+/// the first reflected hit (depth 1), the closest hit leaves the indirect term out and hands
+/// the G-buffer layer back instead: `surfel` for its own hit, `reflected` for the hit of its
+/// reflection ray (depth 0 only).
 struct RadiancePayload {
     float3 color;
     int depth;
-    float3 position, normal, albedo;
-    float distance;  // along the primary ray; < 0: it missed
+    Surfel surfel, reflected;
 };
 /// The shadow ray types' declared payload: their rays go through lucent::occluded(), which
 /// runs no program and carries none.
@@ -129,6 +145,8 @@ struct GBuffer {
     lucent::BufferView<float4> albedo;    // rho
 };
 
+/// The G-buffer's images are width x height x layers: layer 0 the primary hits, layer 1
+/// (with the reflection layer) the first reflected hits.
 struct CameraRecord {
     float3 eye, U, V, W;
     lucent::BufferView<float4> direct;  // direct + specular (+ inline indirect below the tree)
@@ -158,15 +176,20 @@ struct SurfaceRecord {
     lucent::Handle top_object;
     unsigned imperfect_visibility;
     lucent::Handle vpl_shadow_object;
+    unsigned reflection_layer;  // 1: the first reflected hit is G-buffer layer 1
 };
 LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
-              imperfect_visibility, vpl_shadow_object)
+              imperfect_visibility, vpl_shadow_object, reflection_layer)
 
+// The passes below run over launch_index().z, the G-buffer layer; their images have as many.
+// The indirect pass alone splits each layer's VPLs into `slices` (its z is layer x slices +
+// slice), so that a low-resolution image still gives the GPU enough threads; the sum pass
+// then adds the slices up.
 struct IndirectRecord {
     lucent::BufferView<const float4> gbuffer_position, gbuffer_normal;
     lucent::BufferView<float4> indirect;  // 1/downsample resolution: irradiance, w = 1 if valid
     lucent::BufferView<const Vpl> vpls;
-    unsigned downsample, interleave;
+    unsigned downsample, interleave, slices;
     float min_d;
     float scene_epsilon;
     lucent::Handle top_object;
@@ -174,7 +197,15 @@ struct IndirectRecord {
     lucent::Handle vpl_shadow_object;
 };
 LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, downsample,
-              interleave, min_d, scene_epsilon, top_object, imperfect_visibility, vpl_shadow_object)
+              interleave, slices, min_d, scene_epsilon, top_object, imperfect_visibility,
+              vpl_shadow_object)
+
+struct IndirectSumRecord {
+    lucent::BufferView<const float4> indirect_slices;  // layers x slices deep
+    lucent::BufferView<float4> indirect;               // layers deep
+    unsigned slices;
+};
+LUCENT_RECORD(IndirectSumRecord, indirect_slices, indirect, slices)
 
 struct DiscontinuityRecord {
     lucent::BufferView<const float4> gbuffer_position, gbuffer_normal;
@@ -213,6 +244,14 @@ struct MeshRecord {
     lucent::BufferView<const uint3> triangles;
 };
 LUCENT_RECORD(MeshRecord, positions, triangles)
+
+/// The crude geometry of imperfect visibility: each triangle's box, lo and hi, two float4
+/// per triangle (made on the host), so a test reads one box rather than an index and three
+/// vertices.
+struct BoxRecord {
+    lucent::BufferView<const float4> boxes;
+};
+LUCENT_RECORD(BoxRecord, boxes)
 
 template <class Record>
 LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
@@ -258,10 +297,10 @@ LUCENT_HD inline float3 indirect(const IndirectParams& p, float3 x, float3 n, un
 }
 
 /// The full-resolution pixel whose G-buffer stands for low-resolution pixel q: the centre
-/// of its N x N block, clamped to the image.
-LUCENT_HD inline uint2 representative_pixel(uint2 q, unsigned downsample, uint2 full_size) {
-    return make_uint2(lc_min(q.x * downsample + downsample / 2, full_size.x - 1),
-                      lc_min(q.y * downsample + downsample / 2, full_size.y - 1));
+/// of its N x N block, clamped to the image; the same layer.
+LUCENT_HD inline uint3 representative_pixel(uint3 q, unsigned downsample, uint2 full_size) {
+    return make_uint3(lc_min(q.x * downsample + downsample / 2, full_size.x - 1),
+                      lc_min(q.y * downsample + downsample / 2, full_size.y - 1), q.z);
 }
 
 LUCENT_HD inline float3 xyz(float4 v) {
@@ -329,16 +368,21 @@ LUCENT_RAY_GENERATION(igi_camera, igi::CameraRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
     const float sx = 2.0f * (p.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (p.y + 0.5f) / n.y;
     igi::RadiancePayload prd{};
-    prd.distance = -1.0f;
+    prd.surfel.distance = -1.0f;
+    prd.reflected.distance = -1.0f;
     lucent::trace(rec.top_object,
                   lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
                                    igi::kRadianceRay, 0.0f),
                   prd);
-    const uint2 pixel = make_uint2(p.x, p.y);
-    rec.direct[pixel] = make_float4(prd.color, 1.0f);
-    rec.gbuffer_position[pixel] = make_float4(prd.position, prd.distance);
-    rec.gbuffer_normal[pixel] = make_float4(prd.normal, 0.0f);
-    rec.gbuffer_albedo[pixel] = make_float4(prd.albedo, 0.0f);
+    rec.direct[make_uint2(p.x, p.y)] = make_float4(prd.color, 1.0f);
+    const unsigned layers = rec.gbuffer_position.size.z;
+    for (unsigned layer = 0; layer < layers; ++layer) {
+        const igi::Surfel& s = layer == 0 ? prd.surfel : prd.reflected;
+        const uint3 at = make_uint3(p.x, p.y, layer);
+        rec.gbuffer_position[at] = make_float4(s.position, s.distance);
+        rec.gbuffer_normal[at] = make_float4(s.normal, 0.0f);
+        rec.gbuffer_albedo[at] = make_float4(s.albedo, 0.0f);
+    }
 }
 
 LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::HitAttributes) {
@@ -361,23 +405,31 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
                              light.position))
                 color += albedo * intensity * (c / d2);
         }
-        // The primary hit's indirect term is a stage of its own; deeper hits get it here.
-        if (prd.depth > 0) color += albedo * igi::indirect(igi::indirect_params(rec), origin, n);
     }
-    if (prd.depth == 0) {
-        prd.position = origin;
-        prd.normal = n;
-        prd.albedo = rec.Kd;
-        prd.distance = lucent::t_hit();
-    }
+    // The primary hit's indirect term is a stage of its own, and so is the first reflected
+    // hit's with the reflection layer: those hits hand their G-buffer layer back. Deeper hits
+    // get it here.
+    const bool separated = prd.depth == 0 || (prd.depth == 1 && rec.reflection_layer != 0u);
+    if (separated)
+        prd.surfel = igi::Surfel{origin, n, rec.Kd, lucent::t_hit()};
+    else if (max_component(rec.Kd) > 0.0f)
+        color += albedo * igi::indirect(igi::indirect_params(rec), origin, n);
     if (max_component(rec.Ks) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
         igi::RadiancePayload reflected{};
         reflected.depth = prd.depth + 1;
+        reflected.surfel.distance = -1.0f;
         lucent::trace(
             rec.top_object,
             lucent::make_ray(origin, reflect(normalize(ray.direction), n), igi::kRadianceRay, 0.0f),
             reflected);
         color += rec.Ks * reflected.color;
+        if (prd.depth == 0 && reflected.surfel.distance >= 0.0f) {
+            // Layer 1: the reflected hit, its irradiance seen through the mirror's Ks, at its
+            // distance along the eye path (what the discontinuity buffer compares).
+            prd.reflected = reflected.surfel;
+            prd.reflected.albedo = rec.Ks * reflected.surfel.albedo;
+            prd.reflected.distance += lucent::t_hit();
+        }
     }
     prd.color = color;
 }
@@ -395,20 +447,34 @@ LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {
 // ---- the indirect stage: Eq. (1) at the primary hits (seed §4.2, §4.3) --------------------
 LUCENT_RAY_GENERATION(igi_indirect, igi::IndirectRecord) {
     const uint3 q = lucent::launch_index();
-    const uint2 low = make_uint2(q.x, q.y);
-    const uint2 full =
-        igi::representative_pixel(low, rec.downsample, igi::size2(rec.gbuffer_position));
+    const unsigned layer = q.z / rec.slices, slice = q.z % rec.slices;
+    const uint3 full = igi::representative_pixel(make_uint3(q.x, q.y, layer), rec.downsample,
+                                                 igi::size2(rec.gbuffer_position));
     const float4 position = rec.gbuffer_position[full];
     if (position.w < 0.0f) {
-        rec.indirect[low] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+        rec.indirect[q] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
         return;
     }
     // Interleaved sampling: pixel (x, y) of each M x M tile takes VPL subset x + M y, every
-    // M^2-th VPL; M^2 times its sum estimates the whole set's.
+    // M^2-th VPL; M^2 times its sum estimates the whole set's. Slice s of S takes every S-th
+    // VPL of the subset, from its s-th.
     const unsigned m = rec.interleave, subset = (q.x % m) + m * (q.y % m);
-    const float3 e = igi::indirect(igi::indirect_params(rec), igi::xyz(position),
-                                   igi::xyz(rec.gbuffer_normal[full]), subset, m * m);
-    rec.indirect[low] = make_float4(e * float(m * m), 1.0f);
+    const float3 e =
+        igi::indirect(igi::indirect_params(rec), igi::xyz(position),
+                      igi::xyz(rec.gbuffer_normal[full]), subset + m * m * slice,
+                      m * m * rec.slices);
+    rec.indirect[q] = make_float4(e * float(m * m), 1.0f);
+}
+
+// The slices of a pixel's VPLs, added up: the indirect irradiance of each layer.
+LUCENT_RAY_GENERATION(igi_indirect_sum, igi::IndirectSumRecord) {
+    const uint3 q = lucent::launch_index();
+    float4 sum = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+    for (unsigned s = 0; s < rec.slices; ++s) {
+        const float4 part = rec.indirect_slices[make_uint3(q.x, q.y, q.z * rec.slices + s)];
+        sum = make_float4(sum.x + part.x, sum.y + part.y, sum.z + part.z, part.w);
+    }
+    rec.indirect[q] = sum;
 }
 
 // The discontinuity buffer (seed §4.3): a pixel averages the irradiance of the neighbours of
@@ -416,8 +482,8 @@ LUCENT_RAY_GENERATION(igi_indirect, igi::IndirectRecord) {
 LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
     const uint3 q = lucent::launch_index(), size = lucent::launch_size();
     const uint2 full_size = igi::size2(rec.gbuffer_position);
-    const uint2 centre = make_uint2(q.x, q.y);
-    const uint2 c_full = igi::representative_pixel(centre, rec.downsample, full_size);
+    const uint3 centre = q;
+    const uint3 c_full = igi::representative_pixel(centre, rec.downsample, full_size);
     const float4 c_position = rec.gbuffer_position[c_full];
     if (c_position.w < 0.0f) {
         rec.merged[centre] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
@@ -431,8 +497,8 @@ LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
         for (int dx = -radius; dx <= radius; ++dx) {
             const int x = int(q.x) + dx, y = int(q.y) + dy;
             if (x < 0 || y < 0 || x >= int(size.x) || y >= int(size.y)) continue;
-            const uint2 nb = make_uint2(unsigned(x), unsigned(y));
-            const uint2 nb_full = igi::representative_pixel(nb, rec.downsample, full_size);
+            const uint3 nb = make_uint3(unsigned(x), unsigned(y), q.z);
+            const uint3 nb_full = igi::representative_pixel(nb, rec.downsample, full_size);
             const float4 position = rec.gbuffer_position[nb_full];
             const bool is_centre = dx == 0 && dy == 0;  // always counts, whatever the thresholds
             if (!is_centre) {
@@ -451,8 +517,8 @@ LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
 // low-resolution neighbours q of p, times the cosine between the full-resolution normals at p~
 // and at q~, normalised.
 LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
-    const uint3 p = lucent::launch_index();
-    const uint2 full = make_uint2(p.x, p.y), full_size = igi::size2(rec.gbuffer_position);
+    const uint3 p = lucent::launch_index(), full = p;
+    const uint2 full_size = igi::size2(rec.gbuffer_position);
     const uint2 low_size = igi::size2(rec.low);
     if (rec.gbuffer_position[full].w < 0.0f) {
         rec.full[full] = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
@@ -469,8 +535,8 @@ LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
     for (int y = y0 - 1; y <= y0 + 2; ++y)
         for (int x = x0 - 1; x <= x0 + 2; ++x) {
             if (x < 0 || y < 0 || x >= int(low_size.x) || y >= int(low_size.y)) continue;
-            const uint2 q = make_uint2(unsigned(x), unsigned(y));
-            const uint2 q_full = igi::representative_pixel(q, rec.downsample, full_size);
+            const uint3 q = make_uint3(unsigned(x), unsigned(y), p.z);
+            const uint3 q_full = igi::representative_pixel(q, rec.downsample, full_size);
             if (rec.gbuffer_position[q_full].w < 0.0f) continue;  // background: no irradiance
             const float d2 = (float(x) - cx) * (float(x) - cx) + (float(y) - cy) * (float(y) - cy);
             const float3 value = igi::xyz(rec.low[q]);
@@ -488,28 +554,27 @@ LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
     rec.full[full] = make_float4(k > 0.0f ? sum / k : nearest, 1.0f);
 }
 
-// Composition (seed Fig. 3): the direct image plus rho / pi times the indirect irradiance.
+// Composition (seed Fig. 3): the direct image plus, for each G-buffer layer, its weight (rho,
+// or Ks rho through a mirror) / pi times its indirect irradiance.
 LUCENT_RAY_GENERATION(igi_compose, igi::ComposeRecord) {
     const uint3 p = lucent::launch_index();
-    const uint2 pixel = make_uint2(p.x, p.y);
-    const float3 rho = igi::xyz(rec.gbuffer_albedo[pixel]);
-    const float3 color =
-        igi::xyz(rec.direct[pixel]) + rho * (1.0f / 3.14159265f) * igi::xyz(rec.indirect[pixel]);
-    rec.output[pixel] = make_float4(color, 1.0f);
+    float3 color = igi::xyz(rec.direct[make_uint2(p.x, p.y)]);
+    for (unsigned layer = 0; layer < rec.gbuffer_albedo.size.z; ++layer) {
+        const uint3 at = make_uint3(p.x, p.y, layer);
+        color += igi::xyz(rec.gbuffer_albedo[at]) * (1.0f / 3.14159265f) *
+                 igi::xyz(rec.indirect[at]);
+    }
+    rec.output[make_uint2(p.x, p.y)] = make_float4(color, 1.0f);
 }
 
 // ---- the crude scene of imperfect visibility: one box per triangle -------------------------
-LUCENT_BOUNDING_BOX(igi_triangle_box_bounds, igi::MeshRecord) {
-    const uint3 t = rec.triangles[prim];
-    const float3 a = rec.positions[t.x], b = rec.positions[t.y], c = rec.positions[t.z];
-    box.lo = fminf(a, fminf(b, c));
-    box.hi = fmaxf(a, fmaxf(b, c));
+LUCENT_BOUNDING_BOX(igi_triangle_box_bounds, igi::BoxRecord) {
+    box.lo = igi::xyz(rec.boxes[2 * prim]);
+    box.hi = igi::xyz(rec.boxes[2 * prim + 1]);
 }
 
-LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttributes) {
-    const uint3 t = rec.triangles[prim];
-    const float3 a = rec.positions[t.x], b = rec.positions[t.y], c = rec.positions[t.z];
-    const float3 lo = fminf(a, fminf(b, c)), hi = fmaxf(a, fmaxf(b, c));
+LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::BoxRecord, igi::HitAttributes) {
+    const float4 lo4 = rec.boxes[2 * prim], hi4 = rec.boxes[2 * prim + 1];
     const lucent::Ray& ray = lucent::current_ray();
     // Slab test over the whole line; a flat box (an axis-aligned triangle) still stops rays
     // that cross its plane. A box that holds either end of the segment does not stop it: a
@@ -518,7 +583,7 @@ LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttribu
     float t0 = -1e30f, t1 = 1e30f;
     const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
     const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-    const float l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+    const float l[3] = {lo4.x, lo4.y, lo4.z}, h[3] = {hi4.x, hi4.y, hi4.z};
     for (int k = 0; k < 3; ++k) {
         if (d[k] == 0.0f) {
             if (o[k] < l[k] || o[k] > h[k]) return;
@@ -535,8 +600,6 @@ LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::MeshRecord, igi::HitAttribu
         if (t0 > t1) return;
     }
     if (t0 <= ray.tmin || t1 >= ray.tmax) return;
-    if (lucent::potential_intersection(t0)) {
-        attr.geometric_normal = cross(b - a, c - a);
-        lucent::report_intersection(0);
-    }
+    // Occlusion queries (the only rays traced here) run no hit program: no attributes.
+    if (lucent::potential_intersection(t0)) lucent::report_intersection(0);
 }

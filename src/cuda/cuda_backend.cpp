@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include "core/backend.h"
 #include "cuda/cuda_backend.h"
@@ -34,32 +35,35 @@ struct LaunchShape {
     int grid = 1;      // blocks: resident blocks per SM x SMs
 };
 
-/// The two shapes the backend chooses between for each entry point and launch size.
-/// Measured on the H100 (docs/performance.md): IGI, the path tracer and the fog run 2 to 2.7
-/// times faster with every block the registers allow resident; the Whitted sample, whose
-/// deep recursion keeps large trace frames in local memory, runs 1.2 times faster with one
-/// block per SM and all of L1 for them. Neither is right for every program, so the first
-/// launches try both.
-enum : int { kOccupancyFirst = 0, kL1First = 1 };
+/// The shapes the backend chooses between for each entry point and launch size: one per
+/// count of resident blocks per SM, from every block the registers allow (shape 0,
+/// "occupancy first") down to one (all of L1 but 8 KB), each with the smallest carveout
+/// that holds that many blocks, so the rest of the SM's memory is L1. Measured
+/// (docs/performance.md): IGI, the path tracer and the fog run 2 to 2.7 times faster with
+/// every block resident; the Whitted sample, whose deep recursion keeps large trace frames
+/// in local memory, runs fastest with two blocks per SM (H200: 1,079 frames/s, against 943
+/// with one block and 758 with four). No count is right for every program, so the first
+/// launches try each.
+constexpr int kOccupancyFirst = 0;
 
-/// Per entry point and launch size: launch 1 runs the occupancy-first shape (and warms up),
-/// launch 2 the L1-first, launch 3 the occupancy-first again; from then on, the faster of
-/// launches 2 and 3, per launch index (a device of several runs a different share of each
-/// launch).
+/// Per entry point and launch size: launch 1 runs shape 0 (and warms up), launches 2 to n
+/// shapes 1 to n - 1, launch n + 1 shape 0 again; from then on, the fastest of those n,
+/// per launch index (a device of several runs a different share of each launch).
 struct ShapeTuning {
     unsigned launches = 0;
-    double ms[2] = {0, 0};
+    std::vector<double> ms;  // per shape, per launch index
     int choice = -1;
 
+    explicit ShapeTuning(size_t shapes = 1) : ms(shapes, 0.0) {}
     int next_shape() const {
         if (choice >= 0) return choice;
-        return launches == 1 ? kL1First : kOccupancyFirst;
+        return int(launches % ms.size());
     }
     void record(int shape, double ms_per_index) {
         if (choice >= 0) return;
-        if (launches >= 1) ms[shape] = ms_per_index;
-        if (++launches == 3)
-            choice = ms[kL1First] < ms[kOccupancyFirst] ? kL1First : kOccupancyFirst;
+        if (launches >= 1) ms[size_t(shape)] = ms_per_index;
+        if (++launches == ms.size() + 1)
+            choice = int(std::min_element(ms.begin(), ms.end()) - ms.begin());
     }
 };
 
@@ -134,9 +138,16 @@ class CudaBackend final : public core::Backend {
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
         // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
         m_tuning_key = {spec.entry, p.launch_count};
-        m_shape = m_fixed_shape ? kOccupancyFirst : m_tuning[m_tuning_key].next_shape();
-        apply_shape(m_shapes[m_shape]);
-        const unsigned threads = unsigned(std::max(m_shapes[0].grid, m_shapes[1].grid)) * kBlock;
+        if (m_fixed_shape) {
+            m_shape = kOccupancyFirst;
+        } else {
+            auto tuning = m_tuning.try_emplace(m_tuning_key, m_shapes.size()).first;
+            m_shape = tuning->second.next_shape();
+        }
+        apply_shape(m_shapes[size_t(m_shape)]);
+        int largest_grid = 0;
+        for (const LaunchShape& shape : m_shapes) largest_grid = std::max(largest_grid, shape.grid);
+        const unsigned threads = unsigned(largest_grid) * kBlock;
         if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
             m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
@@ -229,7 +240,7 @@ class CudaBackend final : public core::Backend {
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
         if (!m_fixed_shape && m_indices > 0)
-            m_tuning[m_tuning_key].record(m_shape, kernel_ms / double(m_indices));
+            m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
         std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
         m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
@@ -321,10 +332,10 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
                                          "_ZN6lucent3gpu6paramsE"),
               "find the launch parameters");
-        // Two launch shapes (see LaunchShape and ShapeTuning). Occupancy first: as many
-        // blocks per SM as the registers allow, with just the shared memory they need (the
-        // runtime's per-thread state, 5 KB a block) and the rest as L1. L1 first: shared
-        // memory for one block, everything else L1 for the trace frames in local memory.
+        // The launch shapes (see LaunchShape and ShapeTuning): for each count of blocks per
+        // SM up to what the registers allow, just the shared memory those blocks need (the
+        // runtime's per-thread state, 5 KB a block) and the rest as L1 for the trace frames
+        // in local memory.
         const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
         m_fixed_shape = fixed != nullptr;
         int static_shared = 0, reserved = 0, shared_per_sm = 0;
@@ -334,12 +345,28 @@ class CudaBackend final : public core::Backend {
         m_driver.cuDeviceGetAttribute(
             &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
         const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
-        const int needed = by_registers * (static_shared + reserved);
-        const int fit = shared_per_sm > 0
-                            ? std::min(100, (100 * needed + shared_per_sm - 1) / shared_per_sm + 1)
-                            : 100;
-        m_shapes[kOccupancyFirst] = {fixed ? std::atoi(fixed) : fit, 0};
-        m_shapes[kL1First] = {0, 0};
+        auto carveout_for = [&](int blocks) {  // the smallest that holds `blocks`
+            if (blocks <= 1) return 0;
+            const int needed = blocks * (static_shared + reserved);
+            return shared_per_sm > 0
+                       ? std::min(100, (100 * needed + shared_per_sm - 1) / shared_per_sm + 1)
+                       : 100;
+        };
+        m_shapes.clear();
+        if (fixed) {
+            m_shapes.push_back({std::atoi(fixed), 0});
+        } else {
+            std::vector<int> counts_seen;
+            for (int blocks = by_registers; blocks >= 1; --blocks) {
+                const int carveout = carveout_for(blocks);
+                const int resident = resident_blocks(carveout);
+                if (std::find(counts_seen.begin(), counts_seen.end(), resident) !=
+                    counts_seen.end())
+                    continue;  // the configuration's granularity gave a count already tried
+                counts_seen.push_back(resident);
+                m_shapes.push_back({carveout, 0});
+            }
+        }
         for (LaunchShape& shape : m_shapes)
             shape.grid = resident_blocks(shape.carveout) * m_sm_count;
         m_applied = {-1, 0};
@@ -397,7 +424,8 @@ class CudaBackend final : public core::Backend {
     int m_sm = 0, m_sm_count = 0;
     std::unique_ptr<GpuScene> m_scene;
     std::unique_ptr<DisplayEncoder> m_display;  // made by the first display_frame
-    LaunchShape m_shapes[2], m_applied{-1, 0};
+    std::vector<LaunchShape> m_shapes{LaunchShape{}};  // shape 0: occupancy first
+    LaunchShape m_applied{-1, 0};
     bool m_fixed_shape = false;
     std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
     const core::CompiledScene* m_last_scene = nullptr;

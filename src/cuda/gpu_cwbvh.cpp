@@ -163,4 +163,10 @@ GpuCwbvh build_gpu_cwbvh(std::span<const float3> positions, std::span<const uint
     return out;
 }
 
+void upload_gpu_cwbvh(const GpuCwbvh& bvh, GpuCwbvhDevice& device) {
+    device.nodes.upload(std::span<const float4>(bvh.nodes));
+    device.triangles.upload(std::span<const float4>(bvh.triangles));
+    device.triangle_ids.upload(std::span<const uint32_t>(bvh.triangle_ids));
+}
+
 }  // namespace lucent::cuda

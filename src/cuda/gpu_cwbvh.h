@@ -48,4 +48,16 @@ struct CwbvhAxisGrid {
 };
 CwbvhAxisGrid cwbvh_axis_grid(float lo, float hi);
 
+/// A GpuCwbvh in device memory.
+struct GpuCwbvhDevice {
+    DeviceBuffer nodes, triangles, triangle_ids;
+    /// Device pointers, to pass to kernels by value.
+    gpu::GpuCwbvhView view() const {
+        return {nodes.as<float4>(), triangles.as<float4>(), triangle_ids.as<unsigned>()};
+    }
+};
+
+/// Uploads (synchronously) into `device`, reusing its buffers when the sizes match.
+void upload_gpu_cwbvh(const GpuCwbvh& bvh, GpuCwbvhDevice& device);
+
 }  // namespace lucent::cuda
