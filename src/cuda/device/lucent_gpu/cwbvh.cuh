@@ -76,6 +76,18 @@ LUCENT_HD inline int cwbvh_popc(unsigned x) {
     return __builtin_popcount(x);
 #endif
 }
+/// Byte i of `word` as a float, exactly: the float whose bits are 2^23's with the byte as its
+/// low mantissa bits is 2^23 + q, so one subtraction gives q without an integer-to-float
+/// conversion (a quarter-rate instruction on the GPU, and six per child).
+LUCENT_HD inline float cwbvh_byte_float(unsigned word, int i) {
+    const unsigned bits = 0x4B000000u | cwbvh_byte(word, i);
+#if LUCENT_GPU_CODE
+    return __uint_as_float(bits) - 8388608.0f;
+#else
+    return __builtin_bit_cast(float, bits) - 8388608.0f;
+#endif
+}
+
 /// The grid step 2^(e - 127) of a biased exponent e in 1..254.
 LUCENT_HD inline float cwbvh_step(unsigned biased_exponent) {
 #if LUCENT_GPU_CODE
@@ -184,20 +196,54 @@ LUCENT_HD inline unsigned cwbvh_lowest_bit(unsigned x) {
 /// The hit mask of a node's children (the paper's): a node child in slot i that the ray
 /// enters sets bit 24 + (i ^ oct_inv), a leaf child its triangles' bits (one each, from its
 /// offset). Taking node bits highest first then visits the children roughly front to back.
+///
+/// The test is GpuBvhTraversal::slab's, reorganised for eight children: per axis, the words
+/// of the near planes (lo where the direction is positive, hi where negative) are chosen
+/// once per node rather than once per child, and all eight slots are tested without a
+/// branch (an empty slot's box is inside out, so it is never entered, and its meta is 0).
 LUCENT_HD inline unsigned cwbvh_intersect_children(const GpuCwbvhNode& node, const GpuCwbvhRay& ray,
                                                    unsigned oct_inv) {
+    // slab() subtracts olo for lo planes and ohi for hi planes: the near offset is the lo
+    // one where the direction is positive.
+    const bool nx = ray.idx < 0.0f, ny = ray.idy < 0.0f, nz = ray.idz < 0.0f;
+    const float onx = nx ? ray.ohix : ray.olox, ofx = nx ? ray.olox : ray.ohix;
+    const float ony = ny ? ray.ohiy : ray.oloy, ofy = ny ? ray.oloy : ray.ohiy;
+    const float onz = nz ? ray.ohiz : ray.oloz, ofz = nz ? ray.oloz : ray.ohiz;
     unsigned hits = 0;
-    for (int i = 0; i < kCwbvhArity; ++i) {
-        const unsigned meta = node.slot_meta(i);
-        if (meta == 0u) continue;
-        float3 lo, hi;
-        node.child_box(i, lo, hi);
-        float t_near, t_far;
-        GpuBvhTraversal::slab(lo.x, hi.x, lo.y, hi.y, lo.z, hi.z, ray, t_near, t_far);
-        if (!(t_near <= t_far)) continue;
-        const unsigned bit = (meta & 31u) ^ ((node.inner >> i) & 1u ? oct_inv : 0u);
-        hits |= (meta >> 5) << bit;
-    }
+    // Slots 4 * word .. 4 * word + 3, whose planes are in word `word` of each axis's lo and hi
+    // words: the near planes' word is the hi one where the direction is negative.
+    auto four_slots = [&](int word) {
+        const unsigned near_x = nx ? node.q[0][2 + word] : node.q[0][word];
+        const unsigned far_x = nx ? node.q[0][word] : node.q[0][2 + word];
+        const unsigned near_y = ny ? node.q[1][2 + word] : node.q[1][word];
+        const unsigned far_y = ny ? node.q[1][word] : node.q[1][2 + word];
+        const unsigned near_z = nz ? node.q[2][2 + word] : node.q[2][word];
+        const unsigned far_z = nz ? node.q[2][word] : node.q[2][2 + word];
+#if LUCENT_GPU_CODE
+#pragma unroll
+#endif
+        for (int byte = 0; byte < 4; ++byte) {
+            auto plane = [&](unsigned w, float origin, float step) {
+                return fmaf(cwbvh_byte_float(w, byte), step, origin);  // exact (file comment)
+            };
+            const float tnx = fmaf(plane(near_x, node.origin.x, node.step.x), ray.idx, -onx);
+            const float tfx = fmaf(plane(far_x, node.origin.x, node.step.x), ray.idx, -ofx);
+            const float tny = fmaf(plane(near_y, node.origin.y, node.step.y), ray.idy, -ony);
+            const float tfy = fmaf(plane(far_y, node.origin.y, node.step.y), ray.idy, -ofy);
+            const float tnz = fmaf(plane(near_z, node.origin.z, node.step.z), ray.idz, -onz);
+            const float tfz = fmaf(plane(far_z, node.origin.z, node.step.z), ray.idz, -ofz);
+            const float t_near = fmaxf(fmaxf(tnx, tny), fmaxf(tnz, ray.tmin));
+            const float t_far = fminf(fminf(tfx, tfy), fminf(tfz, ray.tmax)) * kGpuFarScale;
+            if (t_near <= t_far) {
+                const int i = 4 * word + byte;
+                const unsigned meta = cwbvh_byte(node.meta[word], byte);
+                const unsigned bit = (meta & 31u) ^ ((node.inner >> i) & 1u ? oct_inv : 0u);
+                hits |= (meta >> 5) << bit;
+            }
+        }
+    };
+    four_slots(0);
+    four_slots(1);
     return hits;
 }
 
