@@ -27,7 +27,7 @@ for lib in $(ldd "$out"/bin/* | awk '/=>/ {print $3}' | sort -u); do cp -L "$lib
 cp -L /lib64/ld-linux-x86-64.so.2 "$out/lib/"
 scenes=../shared/scenes
 if [ -d "$scenes" ]; then
-  tar czf "$out/scenes.tgz" -C "$scenes" sponza.obj sibenik.obj bunny.obj dragon.obj cameras.txt
+  tar czf "$out/scenes.tgz" -C "$scenes" sponza.obj sibenik.obj bunny.obj dragon.obj cornell cameras.txt
 fi
 cat > "$out/run" <<'RUN'
 #!/bin/sh

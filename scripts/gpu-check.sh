@@ -215,9 +215,11 @@ hotspots)
     ls -la "$out"; head -c 600 "$out/source.err"
     ;;
 bench)
-    for s in sponza sibenik bunny dragon; do
+    for s in sponza sibenik bunny dragon cornell/CornellBox-Original; do
         echo "== bench rays --backend cuda $s"
-        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj
+        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
+        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9 \
+            --json > "$out/rays-cuda-$(basename $s .obj).json"
     done
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj
     ;;
