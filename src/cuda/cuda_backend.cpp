@@ -15,6 +15,7 @@
 #include "cuda/display_frame.h"
 #include "cuda/driver_api.h"
 #include "cuda/gpu_scene.h"
+#include "cuda/launch_shapes.h"
 #include "cuda/megakernel_compiler.h"
 #include "lucent/error.h"
 
@@ -28,44 +29,7 @@ constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
 /// 1 to kMaxPiecesInFlight, for experiments.
 constexpr unsigned kPiecesInFlight = 4, kMaxPiecesInFlight = 8;
 
-/// How the megakernel is launched: the share of the SM's on-chip memory given to shared
-/// memory (the rest is L1) and the persistent grid that share lets run at once.
-struct LaunchShape {
-    int carveout = 0;  // percent of the largest shared-memory configuration
-    int grid = 1;      // blocks: resident blocks per SM x SMs
-};
-
-/// The shapes the backend chooses between for each entry point and launch size: one per
-/// count of resident blocks per SM, from every block the registers allow (shape 0,
-/// "occupancy first") down to one (all of L1 but 8 KB), each with the smallest carveout
-/// that holds that many blocks, so the rest of the SM's memory is L1. Measured
-/// (docs/performance.md): IGI, the path tracer and the fog run 2 to 2.7 times faster with
-/// every block resident; the Whitted sample, whose deep recursion keeps large trace frames
-/// in local memory, runs fastest with two blocks per SM (H200: 1,079 frames/s, against 943
-/// with one block and 758 with four). No count is right for every program, so the first
-/// launches try each.
-constexpr int kOccupancyFirst = 0;
-
-/// Per entry point and launch size: launch 1 runs shape 0 (and warms up), launches 2 to n
-/// shapes 1 to n - 1, launch n + 1 shape 0 again; from then on, the fastest of those n,
-/// per launch index (a device of several runs a different share of each launch).
-struct ShapeTuning {
-    unsigned launches = 0;
-    std::vector<double> ms;  // per shape, per launch index
-    int choice = -1;
-
-    explicit ShapeTuning(size_t shapes = 1) : ms(shapes, 0.0) {}
-    int next_shape() const {
-        if (choice >= 0) return choice;
-        return int(launches % ms.size());
-    }
-    void record(int shape, double ms_per_index) {
-        if (choice >= 0) return;
-        if (launches >= 1) ms[size_t(shape)] = ms_per_index;
-        if (++launches == ms.size() + 1)
-            choice = int(std::min_element(ms.begin(), ms.end()) - ms.begin());
-    }
-};
+constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
 
 class CudaBackend final : public core::Backend {
   public:
@@ -332,10 +296,9 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
                                          "_ZN6lucent3gpu6paramsE"),
               "find the launch parameters");
-        // The launch shapes (see LaunchShape and ShapeTuning): for each count of blocks per
-        // SM up to what the registers allow, just the shared memory those blocks need (the
-        // runtime's per-thread state, 5 KB a block) and the rest as L1 for the trace frames
-        // in local memory.
+        // The launch shapes (launch_shapes.h): for each count of blocks per SM up to what the
+        // registers allow, just the shared memory those blocks need (the runtime's per-thread
+        // state, 5 KB a block) and the rest as L1 for the trace frames in local memory.
         const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
         m_fixed_shape = fixed != nullptr;
         int static_shared = 0, reserved = 0, shared_per_sm = 0;
@@ -345,27 +308,14 @@ class CudaBackend final : public core::Backend {
         m_driver.cuDeviceGetAttribute(
             &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
         const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
-        auto carveout_for = [&](int blocks) {  // the smallest that holds `blocks`
-            if (blocks <= 1) return 0;
-            const int needed = blocks * (static_shared + reserved);
-            return shared_per_sm > 0
-                       ? std::min(100, (100 * needed + shared_per_sm - 1) / shared_per_sm + 1)
-                       : 100;
-        };
         m_shapes.clear();
         if (fixed) {
             m_shapes.push_back({std::atoi(fixed), 0});
         } else {
-            std::vector<int> counts_seen;
-            for (int blocks = by_registers; blocks >= 1; --blocks) {
-                const int carveout = carveout_for(blocks);
-                const int resident = resident_blocks(carveout);
-                if (std::find(counts_seen.begin(), counts_seen.end(), resident) !=
-                    counts_seen.end())
-                    continue;  // the configuration's granularity gave a count already tried
-                counts_seen.push_back(resident);
+            const SharedMemoryNeeds needs{static_shared, reserved, shared_per_sm};
+            for (int carveout : launch_shape_carveouts(
+                     by_registers, needs, [&](int c) { return resident_blocks(c); }))
                 m_shapes.push_back({carveout, 0});
-            }
         }
         for (LaunchShape& shape : m_shapes)
             shape.grid = resident_blocks(shape.carveout) * m_sm_count;
