@@ -1,6 +1,8 @@
 #include "cuda/gpu_scene.h"
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstring>
 #include <set>
 
@@ -27,8 +29,12 @@ const Acceleration& acceleration_of(const core::CompiledNode& node) {
     return *static_cast<const GeometryGroup*>(node.source)->acceleration();
 }
 
+/// Appends `bvh`'s nodes and leaf order. `refs`, kept as long as `order`, gets each leaf
+/// slot's primitive resolved by `resolve` (GeometryGroups), or a placeholder (Groups).
 void append_bvh(const accel::Bvh& bvh, std::vector<gpu::GpuBvhNode>& nodes,
-                std::vector<unsigned>& order, gpu::GpuBvh& out) {
+                std::vector<unsigned>& order, std::vector<gpu::GpuPrimRef>& refs,
+                gpu::GpuBvh& out,
+                const std::function<gpu::GpuPrimRef(unsigned)>& resolve = {}) {
     if (bvh.empty()) {
         out = {~0u, 0};
         return;
@@ -36,6 +42,8 @@ void append_bvh(const accel::Bvh& bvh, std::vector<gpu::GpuBvhNode>& nodes,
     out = {unsigned(nodes.size()), unsigned(order.size())};
     for (const accel::BvhNode& n : bvh.nodes()) nodes.push_back({n.lo, n.first, n.hi, n.count});
     order.insert(order.end(), bvh.prim_order().begin(), bvh.prim_order().end());
+    for (unsigned ref : bvh.prim_order())
+        refs.push_back(resolve ? resolve(ref) : gpu::GpuPrimRef{0, 0});
 }
 }  // namespace
 
@@ -173,6 +181,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
     // Nodes, their children and acceleration structures.
     std::vector<gpu::GpuNode> nodes;
     std::vector<unsigned> children, accel_instances, accel_prim_first, order;
+    std::vector<gpu::GpuPrimRef> prim_refs;
     std::vector<gpu::GpuBvhNode> bvh_nodes;
     std::vector<gpu::GpuBvh> bvhs;
     std::vector<gpu::GpuGeometryAccel> accels;
@@ -190,7 +199,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
         if (n.kind == NodeKind::kGroup && !n.brute_force) {
             g.accel = unsigned(bvhs.size());
             bvhs.emplace_back();
-            append_bvh(n.child_bvh, bvh_nodes, order, bvhs.back());
+            append_bvh(n.child_bvh, bvh_nodes, order, prim_refs, bvhs.back());
         } else if (n.kind == NodeKind::kGeometryGroup) {
             const core::GeometryAccel& ga = *n.geometry;
             gpu::GpuGeometryAccel a{};
@@ -216,7 +225,15 @@ void GpuScene::update(const core::CompiledScene& scene) {
                 a.bvh = {~0u, 0};
                 if (mirror.empty) a.triangles_only = 0, a.prim_total = 0;  // nothing to hit
             } else {
-                append_bvh(ga.bvh, bvh_nodes, order, a.bvh);
+                // A global primitive ref counts through the instances in order: instance k
+                // holds refs prim_first[k] .. prim_first[k + 1] - 1.
+                auto resolve = [&](unsigned ref) {
+                    const auto k = unsigned(
+                        std::upper_bound(ga.prim_first.begin(), ga.prim_first.end(), ref) -
+                        ga.prim_first.begin() - 1);
+                    return gpu::GpuPrimRef{n.instances[k], ref - ga.prim_first[k]};
+                };
+                append_bvh(ga.bvh, bvh_nodes, order, prim_refs, a.bvh, resolve);
             }
             g.accel = unsigned(accels.size());
             accels.push_back(a);
@@ -228,6 +245,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
     put(m_children, children);
     put(m_bvh_nodes, bvh_nodes);
     put(m_prim_order, order);
+    put(m_prim_refs, prim_refs);
     put(m_bvhs, bvhs);
     put(m_accels, accels);
     put(m_accel_instances, accel_instances);
@@ -246,6 +264,7 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_params.children = m_children.as<unsigned>();
     m_params.bvh_nodes = m_bvh_nodes.as<gpu::GpuBvhNode>();
     m_params.prim_order = m_prim_order.as<unsigned>();
+    m_params.prim_refs = m_prim_refs.as<gpu::GpuPrimRef>();
     m_params.bvhs = m_bvhs.as<gpu::GpuBvh>();
     m_params.accels = m_accels.as<gpu::GpuGeometryAccel>();
     m_params.accel_instances = m_accel_instances.as<unsigned>();

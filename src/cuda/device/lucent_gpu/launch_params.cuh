@@ -40,7 +40,16 @@ struct GpuBvhNode {
 
 struct GpuBvh {
     unsigned node_offset;  // into bvh_nodes; ~0u when empty
-    unsigned prim_offset;  // into prim_order
+    unsigned prim_offset;  // into prim_order (and, for a GeometryGroup, prim_refs)
+};
+
+/// A GeometryGroup's primitive in the order its BVH's leaves hold them, already resolved:
+/// the instance (index into LaunchParams::instances) and the primitive within it. Saves the
+/// generic traversal a search of the accel's instances and two dependent loads per
+/// primitive it visits.
+struct GpuPrimRef {
+    unsigned instance;
+    unsigned prim;
 };
 
 struct GpuGeometryAccel {
@@ -89,6 +98,7 @@ struct LaunchParams {
     const unsigned* children;
     const GpuBvhNode* bvh_nodes;
     const unsigned* prim_order;
+    const GpuPrimRef* prim_refs;  // beside prim_order; unused entries for Group BVHs
     const GpuBvh* bvhs;
     const GpuGeometryAccel* accels;
     const unsigned* accel_instances;

@@ -183,10 +183,7 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
 #endif
 #if LUCENT_GPU_GENERIC_GEOMETRY
     WatertightRay wray = make_watertight_ray(origin, direction);
-    auto visit = [&](unsigned ref) {
-        unsigned k = locate(ga, ref);
-        unsigned local = ref - params.accel_prim_first[ga.prim_first_offset + k];
-        unsigned instance_index = params.accel_instances[ga.instance_offset + k];
+    auto visit_resolved = [&](unsigned instance_index, unsigned local) {
         const GpuInstance& inst = params.instances[instance_index];
         if (inst.triangles) {
             uint3 t = triangle_of(inst, local);
@@ -207,12 +204,16 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     };
     if (ga.brute_force || ga.bvh.node_offset == ~0u) {
         if (ga.brute_force)
-            for (unsigned ref = 0; ref < ga.prim_total; ++ref)
-                if (visit(ref)) return;
+            for (unsigned ref = 0; ref < ga.prim_total; ++ref) {
+                const unsigned k = locate(ga, ref);
+                if (visit_resolved(params.accel_instances[ga.instance_offset + k],
+                                   ref - params.accel_prim_first[ga.prim_first_offset + k]))
+                    return;
+            }
         return;
     }
     const GpuBvhNode* nodes = params.bvh_nodes + ga.bvh.node_offset;
-    const unsigned* order = params.prim_order + ga.bvh.prim_offset;
+    const GpuPrimRef* refs = params.prim_refs + ga.bvh.prim_offset;
     float3 inv = make_float3(1.0f / direction.x, 1.0f / direction.y, 1.0f / direction.z);
     unsigned stack[64];
     int top = 0;
@@ -221,8 +222,10 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
         const GpuBvhNode n = nodes[stack[--top]];
         if (!box_overlaps(n, origin, inv, tmin, f.closest)) continue;
         if (n.count > 0) {
-            for (unsigned i = 0; i < n.count; ++i)
-                if (visit(order[n.first + i])) return;
+            for (unsigned i = 0; i < n.count; ++i) {
+                const GpuPrimRef r = refs[n.first + i];
+                if (visit_resolved(r.instance, r.prim)) return;
+            }
         } else {
             stack[top++] = n.first + 1;
             stack[top++] = n.first;
