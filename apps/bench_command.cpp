@@ -205,10 +205,7 @@ int run_bench_tea_command(const BenchTeaArgs& args) {
     options.device = args.device;
     options.seed = args.seed;
     options.json = args.json;
-    ProgressBar bar("bench tea", "MB");
-    if (!args.json)
-        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
-    return samples::run_tea_bench(options);
+    return run_with_progress_bar("bench tea", "MB", options, samples::run_tea_bench);
 }
 
 }  // namespace lucent::cli

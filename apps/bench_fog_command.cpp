@@ -42,12 +42,7 @@ int run_bench_fog_command(const BenchFogArgs& args) {
     options.height = size.height;
     options.frames = args.frames;
     options.json = args.json;
-    ProgressBar bar("bench fog", "frames");
-    if (!args.json)
-        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
-    const int code = samples::run_fog_bench(options);
-    bar.finish();
-    return code;
+    return run_with_progress_bar("bench fog", "frames", options, samples::run_fog_bench);
 }
 
 }  // namespace lucent::cli

@@ -70,12 +70,7 @@ int run_bench_igi_command(const BenchIgiArgs& args) {
     options.interleave = args.interleave;
     options.reflection_layer = args.reflection_layer != 0;
     options.json = args.json;
-    ProgressBar bar("bench igi", "configurations");
-    if (!args.json)
-        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
-    const int code = samples::run_igi_bench(options);
-    bar.finish();
-    return code;
+    return run_with_progress_bar("bench igi", "configurations", options, samples::run_igi_bench);
 }
 
 }  // namespace lucent::cli

@@ -51,12 +51,7 @@ int run_bench_present_command(const BenchPresentArgs& args) {
     options.height = size.height;
     options.frames = args.frames;
     options.json = args.json;
-    ProgressBar bar("bench present", "frames");
-    if (!args.json)
-        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
-    const int code = viewer::run_present_bench(options);
-    bar.finish();
-    return code;
+    return run_with_progress_bar("bench present", "frames", options, viewer::run_present_bench);
 #else
     (void)args;
     throw Error(

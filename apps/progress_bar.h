@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <string>
+#include <utility>
 
 namespace lucent::cli {
 
@@ -23,5 +24,15 @@ class ProgressBar {
     bool m_drawn = false;
     std::chrono::steady_clock::time_point m_start, m_last;
 };
+
+/// Runs `bench(options)` (a `lucent bench` subcommand) with a progress bar fed from
+/// options.progress, except for JSON output, which stays one clean object. Returns its code.
+template <class Options, class Bench>
+int run_with_progress_bar(const char* label, const char* unit, Options& options, Bench&& bench) {
+    ProgressBar bar(label, unit);
+    if (!options.json)
+        options.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
+    return std::forward<Bench>(bench)(options);  // the bar's destructor clears its line
+}
 
 }  // namespace lucent::cli

@@ -137,6 +137,11 @@ struct Rate {
     double median = 0, min = 0, max = 0;
 };
 
+/// a's median Mrays/s over b's (0 when b has none).
+double median_ratio(const Rate& a, const Rate& b) {
+    return b.median > 0 ? a.median / b.median : 0.0;
+}
+
 Rate rate_of(const std::vector<double>& mrays) {
     Rate r;
     if (mrays.empty()) return r;
@@ -583,15 +588,12 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
                 "build %.1f ms; %s\n",
                 cwbvh.stats.node_count, cw_mb, binary_mb,
                 cwbvh.stats.build_ms + cwbvh.stats.convert_ms, k.describe_cwbvh.c_str());
-    auto ratio_to_binary = [](const Rate& a, const Rate& b) {
-        return b.median > 0 ? a.median / b.median : 0.0;
-    };
     std::printf("cwbvh primary %s (%.3fx binary)\n", rate_text(cw_primary).c_str(),
-                ratio_to_binary(cw_primary, rate_primary));
+                median_ratio(cw_primary, rate_primary));
     std::printf("cwbvh shadow %s (%.3fx binary)\n", rate_text(cw_shadow).c_str(),
-                ratio_to_binary(cw_shadow, rate_shadow));
+                median_ratio(cw_shadow, rate_shadow));
     std::printf("cwbvh diffuse %s (%.3fx binary)\n", rate_text(cw_diffuse).c_str(),
-                ratio_to_binary(cw_diffuse, rate_diffuse));
+                median_ratio(cw_diffuse, rate_diffuse));
     std::printf("cwbvh results differing from the binary layout's: primary %zu, shadow %zu, "
                 "diffuse %zu; of them another distance: primary %zu, diffuse %zu (the rest: "
                 "another triangle at the same distance)\n",
@@ -694,9 +696,6 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
     const double lo = *std::min_element(gpu_ms.begin(), gpu_ms.end());
     const double hi = *std::max_element(gpu_ms.begin(), gpu_ms.end());
     const double host = median_of(host_ms);
-    auto ratio = [](const Rate& a, const Rate& b) {
-        return b.median > 0 ? a.median / b.median : 0.0;
-    };
     if (in.json) {
         std::printf(
             "{\"scene\": \"%s\", \"backend\": \"cuda\", \"device\": \"%s\", \"triangles\": %zu, "
@@ -735,11 +734,11 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
         std::printf("rays %ux%u (BENCH.md sets), Mrays/s, GPU-built tree / host SAH tree:\n",
                     in.width, in.height);
         std::printf("primary %.2f / %.2f (%.3fx)\n", rates_hploc.primary.median,
-                    rates_sah.primary.median, ratio(rates_hploc.primary, rates_sah.primary));
+                    rates_sah.primary.median, median_ratio(rates_hploc.primary, rates_sah.primary));
         std::printf("shadow %.2f / %.2f (%.3fx)\n", rates_hploc.shadow.median,
-                    rates_sah.shadow.median, ratio(rates_hploc.shadow, rates_sah.shadow));
+                    rates_sah.shadow.median, median_ratio(rates_hploc.shadow, rates_sah.shadow));
         std::printf("diffuse %.2f / %.2f (%.3fx)\n", rates_hploc.diffuse.median,
-                    rates_sah.diffuse.median, ratio(rates_hploc.diffuse, rates_sah.diffuse));
+                    rates_sah.diffuse.median, median_ratio(rates_hploc.diffuse, rates_sah.diffuse));
         std::printf(
             "hits: %zu of %zu rays differ between the trees (primary %zu, shadow %zu, "
             "diffuse %zu)\n",

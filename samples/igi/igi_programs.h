@@ -138,15 +138,10 @@ struct GenerateRecord {
 };
 LUCENT_RECORD(GenerateRecord, lights, vpls, bounces, scene_epsilon, top_object)
 
-/// The full-resolution G-buffer of the direct stage (seed Fig. 3).
-struct GBuffer {
-    lucent::BufferView<float4> position;  // xyz, w = distance along the primary ray (< 0: miss)
-    lucent::BufferView<float4> normal;    // xyz
-    lucent::BufferView<float4> albedo;    // rho
-};
-
-/// The G-buffer's images are width x height x layers: layer 0 the primary hits, layer 1
-/// (with the reflection layer) the first reflected hits.
+/// The full-resolution G-buffer of the direct stage (seed Fig. 3): position (w: the distance
+/// along the eye path, < 0: no hit), normal and the irradiance's weight, each image width x
+/// height x layers: layer 0 the primary hits, layer 1 (with the reflection layer) the first
+/// reflected hits.
 struct CameraRecord {
     float3 eye, U, V, W;
     lucent::BufferView<float4> direct;  // direct + specular (+ inline indirect below the tree)

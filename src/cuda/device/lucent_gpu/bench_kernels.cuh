@@ -40,15 +40,23 @@ __device__ inline unsigned bench_hash(unsigned a) {
     return a;
 }
 
+/// The next ray of each lane in `mask` (which must all call this): one atomic on the global
+/// counter for the whole group, from its lowest lane (Aila-Laine Sec. 3.3).
+__device__ inline unsigned bench_claim_rays(unsigned mask, unsigned* counter) {
+    const unsigned lane = threadIdx.x & 31u;
+    const int leader = __ffs(mask) - 1;
+    unsigned base = 0;
+    if ((int)lane == leader) base = atomicAdd(counter, (unsigned)__popc(mask));
+    base = __shfl_sync(mask, base, leader);
+    return base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+}
+
 /// Traces rays[0, count) with query kQuery and writes each ray's result with store(i, tr).
 template <int kQuery, class Store>
 __device__ inline void bench_trace(const GpuTriangleBvhView& bvh, const float4* __restrict__ rays,
                                    unsigned count, unsigned* counter, Store&& store) {
     GpuNoFilter none;
 #if LUCENT_BENCH_PERSISTENT
-    (void)0;
-    const unsigned lane = threadIdx.x & 31u;
-    const unsigned lanes_below = (1u << lane) - 1u;
     GpuBvhStack stack;
     GpuBvhTraversal tr;
     tr.finish();
@@ -58,12 +66,7 @@ __device__ inline void bench_trace(const GpuTriangleBvhView& bvh, const float4* 
         const unsigned need_mask = __ballot_sync(__activemask(), need);
         if (need) {
             if (ray != 0xffffffffu) store(ray, tr);
-            // One atomic per warp for all lanes that need a ray (Aila-Laine Sec. 3.3).
-            const int leader = __ffs(need_mask) - 1;
-            unsigned base = 0;
-            if ((int)lane == leader) base = atomicAdd(counter, (unsigned)__popc(need_mask));
-            base = __shfl_sync(need_mask, base, leader);
-            ray = base + (unsigned)__popc(need_mask & lanes_below);
+            ray = bench_claim_rays(need_mask, counter);
             if (ray >= count) break;
             const float4 o = __ldg(rays + 2 * ray);
             const float4 d = __ldg(rays + 2 * ray + 1);
@@ -104,14 +107,8 @@ __device__ inline void bench_trace_cwbvh(const GpuCwbvhView& bvh, const float4* 
         store(ray, found, hit);
     };
 #if LUCENT_BENCH_PERSISTENT
-    const unsigned lane = threadIdx.x & 31u;
     for (;;) {
-        const unsigned active = __activemask();
-        const int leader = __ffs(active) - 1;
-        unsigned base = 0;
-        if ((int)lane == leader) base = atomicAdd(counter, (unsigned)__popc(active));
-        base = __shfl_sync(active, base, leader);
-        const unsigned ray = base + (unsigned)__popc(active & ((1u << lane) - 1u));
+        const unsigned ray = bench_claim_rays(__activemask(), counter);
         if (ray >= count) break;
         trace_one(ray);
     }
