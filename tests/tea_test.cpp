@@ -99,9 +99,9 @@ TEST(TeaPrograms, LaunchFillsTheBufferWithTheStreamOfEachKey) {
 #endif
     lucent::Context ctx(options);
     ctx.set_entry_point_count(3);
-    ctx.set_ray_generation_program(0, ctx.create_program(LUCENT_PROGRAM(tea_fixed_key)));
-    ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(tea_device_key)));
-    ctx.set_ray_generation_program(2, ctx.create_program(LUCENT_PROGRAM(tea_copy)));
+    ctx.set_ray_generation_program(0, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_fixed_key)));
+    ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_device_key)));
+    ctx.set_ray_generation_program(2, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_copy)));
     auto out = ctx.create_buffer<uint2>(lucent::BufferType::kOutput, 1000);
     auto first_block = ctx.create_buffer<unsigned>(lucent::BufferType::kInput, 1);
     auto source = ctx.create_buffer<uint2>(lucent::BufferType::kInput, 1000);

@@ -387,13 +387,16 @@ TEST_F(ValidationTest, MapWithAnotherElementTypeIsRejected) {
                  "upload of 3 into 8");
 }
 
-TEST_F(ValidationTest, UnknownProgramNameIsRejectedWithTheKnownNamesOrHowToDefineOne) {
-    const std::string message = expect_error([&] { ctx.create_program("no_such_program"); },
-                                             {"no_such_program"}, "create_program");
-    EXPECT_TRUE(mentions_any(message, {"common_cast", "vat_shade", "LUCENT_"})) << message;
-    expect_error([&] { find_program("no_such_program"); }, {"no_such_program"}, "find_program");
-    // A registered name works by string too.
-    EXPECT_EQ(ctx.create_program("vat_shade")->kind(), ProgramKind::kClosestHit);
+TEST_F(ValidationTest, UnknownProgramNameIsRejectedWithTheContextsModulesOrHowToAddOne) {
+    Context fresh;
+    std::string message = expect_error([&] { fresh.create_program("vat_shade"); },
+                                       {"vat_shade"}, "create_program before add_module");
+    EXPECT_TRUE(mentions_any(message, {"add_module"})) << message;
+    fresh.add_module("test_validation");
+    message = expect_error([&] { fresh.create_program("no_such_program"); },
+                           {"no_such_program", "test_validation"}, "create_program");
+    // A program of an added module works by its name.
+    EXPECT_EQ(fresh.create_program("vat_shade")->kind(), ProgramKind::kClosestHit);
 }
 
 }  // namespace

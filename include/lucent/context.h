@@ -167,8 +167,24 @@ class Context : public VariableScope {
     /// Only this launch index prints (-1 in a coordinate means any).
     void set_print_launch_index(int x, int y = -1, int z = -1);
 
+    // ---- program modules (lucent/module.h) -------------------------------------
+    /// Makes the module `name`, compiled into this binary, available to create_program
+    /// by name; its GPU text is what lucent_add_programs embedded. Throws Error listing the
+    /// modules there are when none has this name.
+    const ModuleInfo& add_module(std::string_view name);
+    /// The same with the module's text given at run time (its LUCENT_MODULE names the
+    /// module). Throws Error when this binary embeds a different text for it, or when its
+    /// C++ side is not compiled in.
+    const ModuleInfo& add_module(ModuleSource source);
+    /// The modules this context knows: added, or the modules of the programs it created.
+    std::vector<const ModuleInfo*> added_modules() const;
+
     // ---- object creation ------------------------------------------------------
-    std::shared_ptr<Program> create_program(std::string_view registered_name);
+    /// The program `name` of one of this context's modules (add_module); Error when no
+    /// module or two have it (then name the module: create_program(module, name)).
+    std::shared_ptr<Program> create_program(std::string_view name);
+    std::shared_ptr<Program> create_program(const ModuleInfo& module, std::string_view name);
+    /// The program of a LUCENT_PROGRAM(ns::name); its module is added to this context.
     std::shared_ptr<Program> create_program(const ProgramDesc& desc);
     template <class T>
     std::shared_ptr<Buffer> create_buffer(BufferType type, unsigned width, unsigned height = 0,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "lucent/device/api.h"
+#include "lucent/device/module.h"
 #include "lucent/device/program.h"
 #include "lucent/device/reflect.h"
 #include "lucent/device/tea.h"

@@ -5,11 +5,9 @@
 #include <string_view>
 
 #include "lucent/device/program.h"
+#include "lucent/module.h"
 #include "lucent/object.h"
 #include "lucent/variables.h"
-
-/// The ProgramDesc of a program defined with a LUCENT_* macro, by its C++ name.
-#define LUCENT_PROGRAM(name) lucent_program_desc_##name()
 
 namespace lucent {
 
@@ -27,9 +25,5 @@ class Program : public ContextObject, public VariableScope {
   private:
     const ProgramDesc* m_desc;
 };
-
-/// The registered program with this name (defined by a LUCENT_* macro in any linked
-/// module), or an Error listing the names that exist.
-const ProgramDesc& find_program(std::string_view name);
 
 }  // namespace lucent

@@ -42,7 +42,7 @@ RenderResult render_direct(const RenderSettings& settings) {
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 
     DiffuseTextures texture_for(ctx);
-    auto lambert = ctx.create_program(LUCENT_PROGRAM(direct_lambert));
+    auto lambert = ctx.create_program(LUCENT_PROGRAM(direct::direct_lambert));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -53,21 +53,21 @@ RenderResult render_direct(const RenderSettings& settings) {
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(direct_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(direct::direct_attributes));
     auto top = mesh_group(ctx, input, attributes, materials);
     ctx["top_object"] = top;
 
     const PinholeFrame frame =
         pinhole_frame(input.camera, float(settings.width) / float(settings.height));
     auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
-    auto camera = ctx.create_program(LUCENT_PROGRAM(direct_camera));
+    auto camera = ctx.create_program(LUCENT_PROGRAM(direct::direct_camera));
     (*camera)["eye"] = input.camera.eye;
     (*camera)["W"] = frame.W;
     (*camera)["U"] = frame.U;
     (*camera)["V"] = frame.V;
     (*camera)["output"] = output;
     ctx.set_ray_generation_program(0, camera);
-    auto miss = ctx.create_program(LUCENT_PROGRAM(direct_miss));
+    auto miss = ctx.create_program(LUCENT_PROGRAM(direct::direct_miss));
     (*miss)["background"] = make_float3(0.0f);
     ctx.set_miss_program(direct::kRadianceRay, miss);
     out.stages.push_back(

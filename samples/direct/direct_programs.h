@@ -7,6 +7,9 @@
 
 namespace direct {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(direct, lucent::kUsesOccluded)
+
 struct RadiancePayload {
     float3 color;
 };
@@ -73,7 +76,6 @@ LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 p, float3 tar
                : 1.0f;
 }
 
-}  // namespace direct
 
 LUCENT_RAY_GENERATION(direct_camera, direct::CameraRecord) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
@@ -149,4 +151,4 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
     prd.color = color;
 }
 
-
+}  // namespace direct

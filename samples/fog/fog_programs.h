@@ -16,6 +16,9 @@
 
 namespace fog {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(fog)
+
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
 struct PointLight {
@@ -173,7 +176,6 @@ LUCENT_HD inline float2 box_span(float3 lo, float3 hi, float3 o, float3 d) {
     return make_float2(lc_max(near.x, lc_max(near.y, near.z)), lc_min(far.x, lc_min(far.y, far.z)));
 }
 
-}  // namespace fog
 
 // ---- camera, miss ------------------------------------------------------------------------
 LUCENT_RAY_GENERATION(fog_camera, fog::CameraRecord) {
@@ -427,3 +429,5 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
     prd.color = rec.fog_color * (1.0f - transmittance) + behind.color * transmittance;
     prd.distance = behind.distance;
 }
+
+}  // namespace fog

@@ -128,8 +128,8 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
     // Sebald Fig. 4: this device's key from its identifier and the seed.
     ctx["noise_key"] = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
 
-    auto phong = ctx.create_program(LUCENT_PROGRAM(fog_phong));
-    auto opaque = ctx.create_program(LUCENT_PROGRAM(fog_opaque_shadow));
+    auto phong = ctx.create_program(LUCENT_PROGRAM(fog::fog_phong));
+    auto opaque = ctx.create_program(LUCENT_PROGRAM(fog::fog_opaque_shadow));
     auto floor_material = ctx.create_material();
     floor_material->set_name("floor tiles");
     floor_material->set_closest_hit(fog::kRadianceRay, phong);
@@ -155,14 +155,14 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
     auto glass_material = ctx.create_material();
     glass_material->set_name("crystal");
     glass_material->set_closest_hit(fog::kRadianceRay,
-                                    ctx.create_program(LUCENT_PROGRAM(fog_glass)));
+                                    ctx.create_program(LUCENT_PROGRAM(fog::fog_glass)));
     glass_material->set_any_hit(fog::kShadowRay,
-                                ctx.create_program(LUCENT_PROGRAM(fog_glass_shadow)));
+                                ctx.create_program(LUCENT_PROGRAM(fog::fog_glass_shadow)));
     (*glass_material)["ior"] = 1.5f;
     (*glass_material)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
     (*glass_material)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
 
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(fog_mesh_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(fog::fog_mesh_attributes));
     // The triangles in a GeometryGroup of their own: it gets the triangle BVH's fast
     // traversal, which a group holding the fog box (a custom primitive) would lose.
     auto solids = ctx.create_geometry_group();
@@ -196,9 +196,9 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         auto fog_material = ctx.create_material();
         fog_material->set_name("fog");
         fog_material->set_closest_hit(fog::kRadianceRay,
-                                      ctx.create_program(LUCENT_PROGRAM(fog_volume)));
+                                      ctx.create_program(LUCENT_PROGRAM(fog::fog_volume)));
         fog_material->set_any_hit(fog::kShadowRay,
-                                  ctx.create_program(LUCENT_PROGRAM(fog_volume_shadow)));
+                                  ctx.create_program(LUCENT_PROGRAM(fog::fog_volume_shadow)));
         (*fog_material)["density"] = options.density;
         (*fog_material)["step"] = options.step;
         (*fog_material)["noise_scale"] = options.noise_scale;
@@ -209,8 +209,8 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         auto fog_box = ctx.create_geometry();
         fog_box->set_name("fog box");
         fog_box->set_primitive_count(1);
-        fog_box->set_bounding_box_program(ctx.create_program(LUCENT_PROGRAM(fog_box_bounds)));
-        fog_box->set_intersection_program(ctx.create_program(LUCENT_PROGRAM(fog_box_intersect)));
+        fog_box->set_bounding_box_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_bounds)));
+        fog_box->set_intersection_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_intersect)));
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(fog_box);
         // On the instance: its intersection and its closest hit both read them.
@@ -228,7 +228,7 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         ctx["top_object"] = solids;
     }
 
-    auto miss = ctx.create_program(LUCENT_PROGRAM(fog_environment));
+    auto miss = ctx.create_program(LUCENT_PROGRAM(fog::fog_environment));
     DiffuseTextures textures(ctx);  // a white texel stands in when there is no map
     if (options.environment.empty()) {
         (*miss)["environment"] = textures("");
@@ -248,7 +248,7 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
 
     m->camera = ctx.create_buffer<fog::CameraFrame>(BufferType::kInput, 1);
     m->output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
-    auto camera = ctx.create_program(LUCENT_PROGRAM(fog_camera));
+    auto camera = ctx.create_program(LUCENT_PROGRAM(fog::fog_camera));
     (*camera)["camera"] = m->camera;
     (*camera)["output"] = m->output;
     ctx.set_ray_generation_program(0, camera);

@@ -128,8 +128,8 @@ RenderResult render_igi(const RenderSettings& settings) {
         ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
     ctx["vpls"] = vpls;
 
-    auto surface = ctx.create_program(LUCENT_PROGRAM(igi_surface));
-    auto particle = ctx.create_program(LUCENT_PROGRAM(igi_particle_hit));
+    auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
+    auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -141,12 +141,12 @@ RenderResult render_igi(const RenderSettings& settings) {
         (*material)["Ke"] = m.emission;
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(igi_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(igi::igi_attributes));
     // Imperfect visibility (seed §4.1): a second graph, one box per triangle as custom
     // primitives, traced only by VPL shadow rays.
     auto boxes = ctx.create_geometry_group();
-    auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_bounds));
-    auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi_triangle_box_intersect));
+    auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_bounds));
+    auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_intersect));
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
     box_material->set_name("box");
     auto add_boxes = [&](const scene::Mesh& mesh, const MeshBuffers&) {
@@ -173,35 +173,35 @@ RenderResult render_igi(const RenderSettings& settings) {
     const IgiImages images = create_igi_images(ctx, config);
     const PinholeFrame frame =
         pinhole_frame(input.camera, float(settings.width) / float(settings.height));
-    auto camera = ctx.create_program(LUCENT_PROGRAM(igi_camera));
+    auto camera = ctx.create_program(LUCENT_PROGRAM(igi::igi_camera));
     (*camera)["eye"] = input.camera.eye;
     (*camera)["W"] = frame.W;
     (*camera)["U"] = frame.U;
     (*camera)["V"] = frame.V;
-    auto indirect = ctx.create_program(LUCENT_PROGRAM(igi_indirect));
+    auto indirect = ctx.create_program(LUCENT_PROGRAM(igi::igi_indirect));
     (*indirect)["indirect"] = config.slices > 1 ? images.indirect_slices : images.indirect;
-    auto indirect_sum = ctx.create_program(LUCENT_PROGRAM(igi_indirect_sum));
+    auto indirect_sum = ctx.create_program(LUCENT_PROGRAM(igi::igi_indirect_sum));
     (*indirect_sum)["indirect_slices"] = images.indirect_slices;
     (*indirect_sum)["indirect"] = images.indirect;
-    auto discontinuity = ctx.create_program(LUCENT_PROGRAM(igi_discontinuity));
+    auto discontinuity = ctx.create_program(LUCENT_PROGRAM(igi::igi_discontinuity));
     (*discontinuity)["indirect"] = images.indirect;
     (*discontinuity)["merged"] = images.merged;
-    auto upsample = ctx.create_program(LUCENT_PROGRAM(igi_upsample));
+    auto upsample = ctx.create_program(LUCENT_PROGRAM(igi::igi_upsample));
     (*upsample)["low"] = config.interleave > 1 ? images.merged : images.indirect;
     (*upsample)["full"] = images.upsampled;
-    auto compose = ctx.create_program(LUCENT_PROGRAM(igi_compose));
+    auto compose = ctx.create_program(LUCENT_PROGRAM(igi::igi_compose));
     (*compose)["indirect"] = images.irradiance_at_full_resolution(config);
     (*compose)["output"] = images.output;
     ctx.set_entry_point_count(igi::kEntryCount);
     ctx.set_ray_generation_program(igi::kDirectEntry, camera);
     ctx.set_ray_generation_program(igi::kVplEntry,
-                                   ctx.create_program(LUCENT_PROGRAM(igi_generate_vpls)));
+                                   ctx.create_program(LUCENT_PROGRAM(igi::igi_generate_vpls)));
     ctx.set_ray_generation_program(igi::kIndirectEntry, indirect);
     ctx.set_ray_generation_program(igi::kDiscontinuityEntry, discontinuity);
     ctx.set_ray_generation_program(igi::kUpsampleEntry, upsample);
     ctx.set_ray_generation_program(igi::kComposeEntry, compose);
     ctx.set_ray_generation_program(igi::kIndirectSumEntry, indirect_sum);
-    ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi_miss)));
+    ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi::igi_miss)));
     out.stages.push_back({"scene setup", ms_since(setup_start),
                           input.name + ", " + std::to_string(input.triangle_count()) +
                               " triangles, " + std::to_string(lights.size()) + " point emitters"});

@@ -18,6 +18,9 @@
 
 namespace igi {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(igi, lucent::kUsesOccluded)
+
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2, kVplShadowRay = 3 };
 
 /// The passes of a frame, one entry point each (seed Fig. 3).
@@ -307,7 +310,6 @@ LUCENT_HD inline uint2 size2(const lucent::BufferView<T>& b) {
     return make_uint2(b.size.x, b.size.y);
 }
 
-}  // namespace igi
 
 // ---- VPL generation: one thread per light path --------------------------------------------
 LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
@@ -598,3 +600,5 @@ LUCENT_INTERSECTION(igi_triangle_box_intersect, igi::BoxRecord, igi::HitAttribut
     // Occlusion queries (the only rays traced here) run no hit program: no attributes.
     if (lucent::potential_intersection(t0)) lucent::report_intersection(0);
 }
+
+}  // namespace igi

@@ -102,10 +102,10 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
     ctx["scene_epsilon"] = epsilon;
 
     std::shared_ptr<Program> closest_hits[] = {
-        ctx.create_program(LUCENT_PROGRAM(pt_lambert)),
-        ctx.create_program(LUCENT_PROGRAM(pt_metal)),
-        ctx.create_program(LUCENT_PROGRAM(pt_dielectric)),
-        ctx.create_program(LUCENT_PROGRAM(pt_coated)),
+        ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_lambert)),
+        ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_metal)),
+        ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_dielectric)),
+        ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_coated)),
     };
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
@@ -120,7 +120,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
         (*material)["ior"] = m.ior;
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(pt_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_attributes));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
     PathScene out;
@@ -128,7 +128,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
     out.accum =
         ctx.create_buffer<float4>(BufferType::kInputOutput, settings.width, settings.height);
     out.output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
-    out.miss = ctx.create_program(LUCENT_PROGRAM(pt_miss));
+    out.miss = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_miss));
     (*out.miss)["environment"] = make_float3(options.environment);
     ctx.set_miss_program(pathtracer::kRadianceRay, out.miss);
     out.note = input.name + ", " + std::to_string(input.triangle_count()) + " triangles";
@@ -149,7 +149,7 @@ RenderResult render_pathtracer(const RenderSettings& settings) {
 
     const PinholeFrame frame =
         pinhole_frame(scene.camera, float(settings.width) / float(settings.height));
-    auto camera = ctx.create_program(LUCENT_PROGRAM(pt_camera));
+    auto camera = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_camera));
     (*camera)["eye"] = scene.camera.eye;
     (*camera)["W"] = frame.W;
     (*camera)["U"] = frame.U;

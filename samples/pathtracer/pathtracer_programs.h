@@ -11,6 +11,9 @@
 
 namespace pathtracer {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(pathtracer, lucent::kUsesOccluded)
+
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
 struct PointLight {
@@ -290,7 +293,6 @@ struct ViewCameraRecord {
 LUCENT_RECORD(ViewCameraRecord, camera, accum, output, top_object, max_depth, rr_depth, nee, seed,
               exposure, reinhard)
 
-}  // namespace pathtracer
 
 LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
     pathtracer::trace_pixel(rec);
@@ -344,3 +346,5 @@ LUCENT_ATTRIBUTE(pt_attributes, pathtracer::MeshRecord, pathtracer::HitAttribute
     attr.geometric_normal =
         cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
 }
+
+}  // namespace pathtracer

@@ -20,7 +20,7 @@ class PathSession final : public InteractiveSession {
         m_scene = build_path_scene(m_ctx, settings, m_options);
         m_frame = m_ctx.create_buffer<pathtracer::ViewFrame>(BufferType::kInput, 1);
         m_frame->set_name("view camera");
-        m_camera = m_ctx.create_program(LUCENT_PROGRAM(pt_view_camera));
+        m_camera = m_ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_view_camera));
         (*m_camera)["camera"] = m_frame;
         (*m_camera)["accum"] = m_scene.accum;
         (*m_camera)["output"] = m_scene.output;

@@ -101,7 +101,7 @@ RenderResult render_radiosity(const RenderSettings& settings) {
         ctx.create_buffer<radiosity::Vpl>(BufferType::kInputOutput, photons * options.bounces);
 
     DiffuseTextures texture_for(ctx);
-    auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity_surface));
+    auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_surface));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -113,7 +113,7 @@ RenderResult render_radiosity(const RenderSettings& settings) {
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(radiosity_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_attributes));
     auto top = mesh_group(ctx, input, attributes, materials);
     ctx["top_object"] = top;
 
@@ -127,15 +127,15 @@ RenderResult render_radiosity(const RenderSettings& settings) {
     // What shading reads: the scattered VPLs, or their merged grid (refilled below).
     auto merged = ctx.create_buffer<radiosity::Vpl>(BufferType::kInput, 1);
 
-    auto photon_program = ctx.create_program(LUCENT_PROGRAM(radiosity_photons));
+    auto photon_program = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_photons));
     (*photon_program)["vpls"] = scattered;
     const PinholeFrame frame = pinhole_frame(input.camera, float(w) / float(h));
-    auto gbuffer = ctx.create_program(LUCENT_PROGRAM(radiosity_gbuffer));
+    auto gbuffer = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_gbuffer));
     (*gbuffer)["eye"] = input.camera.eye;
     (*gbuffer)["W"] = frame.W;
     (*gbuffer)["U"] = frame.U;
     (*gbuffer)["V"] = frame.V;
-    auto shade = ctx.create_program(LUCENT_PROGRAM(radiosity_shade));
+    auto shade = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_shade));
     (*shade)["eye"] = input.camera.eye;
     (*shade)["output"] = output;
     (*shade)["vpls"] = options.merge ? merged : scattered;

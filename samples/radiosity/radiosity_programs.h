@@ -9,6 +9,9 @@
 
 namespace radiosity {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(radiosity, lucent::kUsesOccluded)
+
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kPhotonRay = 2 };
 enum : unsigned { kPhotonEntry = 0, kGBufferEntry = 1, kShadeEntry = 2, kEntryCount = 3 };
 
@@ -171,7 +174,6 @@ LUCENT_HD inline float3 vpl_irradiance(const ShadeRecord& rec, float3 x, float3 
     return sum;
 }
 
-}  // namespace radiosity
 
 // ---- photons from the area lights ----------------------------------------------------------
 LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
@@ -291,3 +293,5 @@ LUCENT_RAY_GENERATION(radiosity_shade, radiosity::ShadeRecord) {
     }
     rec.output[pixel] = make_float4(color, 1.0f);
 }
+
+}  // namespace radiosity

@@ -8,6 +8,9 @@
 
 namespace tea_sample {
 
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(tea)
+
 struct FixedKeyRecord {
     lucent::BufferView<uint2> out;
     unsigned rounds;
@@ -29,7 +32,6 @@ struct CopyRecord {
 };
 LUCENT_RECORD(CopyRecord, out, source)
 
-}  // namespace tea_sample
 
 LUCENT_RAY_GENERATION(tea_fixed_key, tea_sample::FixedKeyRecord) {
     const unsigned i = lucent::launch_index().x;
@@ -46,3 +48,5 @@ LUCENT_RAY_GENERATION(tea_copy, tea_sample::CopyRecord) {
     const unsigned i = lucent::launch_index().x;
     rec.out[i] = rec.source[i];
 }
+
+}  // namespace tea_sample

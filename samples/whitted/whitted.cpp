@@ -69,7 +69,7 @@ RenderResult render_whitted(const RenderSettings& settings) {
     auto output = build_whitted_scene(ctx, options, settings.width, settings.height);
 
     const WhittedLayout& layout = whitted_layout();
-    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted_camera));
+    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_camera));
     const CameraFrame frame = camera_frame(layout, float(settings.width) / float(settings.height));
     (*camera)["eye"] = layout.eye;
     (*camera)["U"] = frame.U;
@@ -127,11 +127,11 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     ctx["output_buffer"] = output;
 
     ctx.set_entry_point_count(1);
-    auto exception = ctx.create_program(LUCENT_PROGRAM(whitted_exception));
+    auto exception = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_exception));
     (*exception)["bad_color"] = make_float3(1.0f, 0.0f, 1.0f);
     ctx.set_exception_program(0, exception);
 
-    auto miss = ctx.create_program(LUCENT_PROGRAM(whitted_miss));
+    auto miss = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_miss));
     (*miss)["bg_color"] = layout.background;
     ctx.set_miss_program(whitted::kRadianceRay, miss);
 
@@ -140,9 +140,9 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     floor->set_name("floor");
     floor->set_primitive_count(1);
     floor->set_intersection_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_parallelogram_intersect)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_parallelogram_intersect)));
     floor->set_bounding_box_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_parallelogram_bounds)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_parallelogram_bounds)));
     {
         const float3 anchor = make_float3(-20.0f, layout.floor_height, -22.0f);
         const float3 v1 = make_float3(0.0f, 0.0f, 40.0f);  // (v1 x v2) points up
@@ -158,23 +158,23 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     metal_sphere->set_name("metal sphere");
     metal_sphere->set_primitive_count(1);
     metal_sphere->set_intersection_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_sphere_intersect)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_sphere_intersect)));
     metal_sphere->set_bounding_box_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_sphere_bounds)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_sphere_bounds)));
 
     auto glass_sphere = ctx.create_geometry();
     glass_sphere->set_name("glass sphere");
     glass_sphere->set_primitive_count(1);
     glass_sphere->set_intersection_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_shell_intersect)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_shell_intersect)));
     glass_sphere->set_bounding_box_program(
-        ctx.create_program(LUCENT_PROGRAM(whitted_shell_bounds)));
+        ctx.create_program(LUCENT_PROGRAM(whitted::whitted_shell_bounds)));
     (*glass_sphere)["center"] = layout.glass_center;
     (*glass_sphere)["radius_outer"] = layout.glass_radius;
     (*glass_sphere)["radius_inner"] = layout.glass_radius - layout.glass_thickness;
 
     // ---- materials ------------------------------------------------------------------------
-    auto opaque_shadow = ctx.create_program(LUCENT_PROGRAM(whitted_opaque_shadow));
+    auto opaque_shadow = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_opaque_shadow));
 
     // Checker floor: the colours of Whitted's red and yellow checkers, 1 x 1 unit squares,
     // from a 2 x 2 texture with nearest filtering and repeat wrap.
@@ -194,7 +194,7 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     auto floor_material = ctx.create_material();
     floor_material->set_name("checker floor");
     floor_material->set_closest_hit(whitted::kRadianceRay,
-                                    ctx.create_program(LUCENT_PROGRAM(whitted_checker_radiance)));
+                                    ctx.create_program(LUCENT_PROGRAM(whitted::whitted_checker_radiance)));
     floor_material->set_any_hit(whitted::kShadowRay, opaque_shadow);
     (*floor_material)["checker"] = checker;
     (*floor_material)["checker_scale"] = make_float2(20.0f, 20.0f);  // 40 x 40 squares
@@ -205,7 +205,7 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     auto metal_material = ctx.create_material();
     metal_material->set_name("metal");
     metal_material->set_closest_hit(whitted::kRadianceRay,
-                                    ctx.create_program(LUCENT_PROGRAM(whitted_metal_radiance)));
+                                    ctx.create_program(LUCENT_PROGRAM(whitted::whitted_metal_radiance)));
     metal_material->set_any_hit(whitted::kShadowRay, opaque_shadow);
     (*metal_material)["Ka"] = make_float3(0.2f, 0.5f, 0.5f);
     (*metal_material)["Kd"] = make_float3(0.2f, 0.7f, 0.8f);
@@ -216,8 +216,8 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     auto glass_material = ctx.create_material();
     glass_material->set_name("glass");
     glass_material->set_closest_hit(whitted::kRadianceRay,
-                                    ctx.create_program(LUCENT_PROGRAM(whitted_glass_radiance)));
-    auto glass_shadow = ctx.create_program(LUCENT_PROGRAM(whitted_glass_shadow));
+                                    ctx.create_program(LUCENT_PROGRAM(whitted::whitted_glass_radiance)));
+    auto glass_shadow = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_glass_shadow));
     // On the program's scope: the any-hit program sees it before the material's.
     (*glass_shadow)["shadow_attenuation"] = make_float3(layout.glass_shadow_transmission);
     glass_material->set_any_hit(whitted::kShadowRay, glass_shadow);

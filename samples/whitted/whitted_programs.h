@@ -8,13 +8,16 @@
 // Single source: compiled by g++ into the host (CPU backend) and by NVRTC for the GPU, so
 // it uses only lucent/device.h and the C math functions.
 //
-// Data types live in namespace `whitted`; the programs are global, prefixed `whitted_`,
-// because program names are looked up in one registry shared by every sample.
+// Everything lives in namespace `whitted`, the namespace of its module: the host names a
+// program as LUCENT_PROGRAM(whitted::whitted_camera).
 #pragma once
 
 #include "lucent/device.h"
 
 namespace whitted {
+
+/// The module of this sample's programs (lucent/device/module.h).
+LUCENT_MODULE(whitted)
 
 using lucent::BufferView;
 using lucent::Handle;
@@ -338,7 +341,6 @@ struct ViewCameraRecord {
 };
 LUCENT_RECORD(ViewCameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold)
 
-}  // namespace whitted
 
 LUCENT_RAY_GENERATION(whitted_camera, whitted::CameraRecord) {
     whitted::render_pixel(rec);
@@ -593,3 +595,5 @@ LUCENT_ANY_HIT(whitted_opaque_shadow, lucent::NoRecord, whitted::ShadowPayload,
     prd.attenuation = make_float3(0.0f);
     lucent::terminate_ray();
 }
+
+}  // namespace whitted

@@ -20,7 +20,7 @@ class WhittedSession final : public InteractiveSession {
         m_output = build_whitted_scene(m_ctx, m_options, settings.width, settings.height);
         m_frame = m_ctx.create_buffer<whitted::ViewFrame>(BufferType::kInput, 1);
         m_frame->set_name("view camera");
-        m_camera = m_ctx.create_program(LUCENT_PROGRAM(whitted_view_camera));
+        m_camera = m_ctx.create_program(LUCENT_PROGRAM(whitted::whitted_view_camera));
         (*m_camera)["camera"] = m_frame;
         (*m_camera)["antialiasing"] = m_options.antialiasing;
         (*m_camera)["aa_threshold"] = m_options.aa_threshold;

@@ -3,6 +3,7 @@
 // Everything here is flat arrays indexed by integers, so the CUDA backend can upload it.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "accel/triangle_accel.h"
 #include "lucent/context.h"
 #include "lucent/device/program.h"
+#include "lucent/module.h"
 
 namespace lucent::core {
 
@@ -127,6 +129,9 @@ struct CompiledScene {
     bool print_enabled = false;
     int3 print_index{-1, -1, -1};
     std::vector<int> enabled_exceptions;  // codes whose exception program runs
+    /// Module texts given to the Context at run time (the GPU backend's JIT reads them
+    /// before the texts embedded in the binary).
+    std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>> module_sources;
     bool exception_enabled(int code) const { return exception_code_enabled(enabled_exceptions, code); }
 };
 

@@ -273,11 +273,98 @@ void Context::set_print_launch_index(int x, int y, int z) {
     ++m_impl->shared->generation;
 }
 
+// ---- program modules ------------------------------------------------------------------
+namespace detail {
+std::string known_module_names();
+}
+
+namespace {
+core::ContextModule* known_module(core::ContextState& state, const ModuleInfo* info) {
+    for (core::ContextModule& m : state.modules)
+        if (m.info == info) return &m;
+    return nullptr;
+}
+}  // namespace
+
+const ModuleInfo& Context::add_module(std::string_view name) {
+    const ModuleInfo* info = find_module(name);
+    if (!info)
+        throw Error("Context::add_module: this program contains no module named '" +
+                    std::string(name) + "' (it has: " + detail::known_module_names() +
+                    "); include the module's header in one of the program's files");
+    if (!known_module(m_impl->state, info)) m_impl->state.modules.push_back({info, nullptr});
+    return *info;
+}
+
+const ModuleInfo& Context::add_module(ModuleSource source) {
+    const ModuleInfo* info = find_module(source.module);
+    if (!info)
+        throw Error("Context::add_module: " + source.main + " declares module '" + source.module +
+                    "', which is not compiled into this program (it has: " +
+                    detail::known_module_names() +
+                    "); its programs run on the CPU from the compiled header, so include " +
+                    source.main + " in one of the program's files");
+    if (const ModuleSource* embedded = embedded_module_source(source.module);
+        embedded && !embedded->same_text(source))
+        throw Error("Context::add_module: module '" + source.module + "' is given as " +
+                    source.main + " but this program embeds a different text for it, from " +
+                    embedded->main + "; rebuild the program, or drop the run-time source");
+    core::ContextModule* known = known_module(m_impl->state, info);
+    if (known && known->source && !known->source->same_text(source))
+        throw Error("Context::add_module: module '" + source.module + "' was given as " +
+                    known->source->main + " and now with a different text as " + source.main +
+                    "; a context holds one text per module");
+    auto shared = std::make_shared<const ModuleSource>(std::move(source));
+    if (known)
+        known->source = shared;
+    else
+        m_impl->state.modules.push_back({info, shared});
+    ++m_impl->shared->generation;  // the megakernel's text may change
+    return *info;
+}
+
+std::vector<const ModuleInfo*> Context::added_modules() const {
+    std::vector<const ModuleInfo*> list;
+    for (const core::ContextModule& m : m_impl->state.modules) list.push_back(m.info);
+    return list;
+}
+
 // ---- object creation -------------------------------------------------------------------
-std::shared_ptr<Program> Context::create_program(std::string_view registered_name) {
-    return create_program(find_program(registered_name));
+std::shared_ptr<Program> Context::create_program(std::string_view name) {
+    const ProgramDesc* found = nullptr;
+    std::string modules;
+    for (const core::ContextModule& m : m_impl->state.modules) {
+        modules += (modules.empty() ? "'" : ", '") + std::string(m.info->name()) + "'";
+        const ProgramDesc* desc = m.info->find(name);
+        if (desc && found)
+            throw Error("Context::create_program: program '" + std::string(name) +
+                        "' is defined by module '" + std::string(found->module->name()) +
+                        "' and by module '" + std::string(m.info->name()) +
+                        "'; name the module: create_program(module, name)");
+        if (desc) found = desc;
+    }
+    if (!found)
+        throw Error("Context::create_program: no module of this context defines a program '" +
+                    std::string(name) + "' (its modules: " +
+                    (modules.empty() ? std::string("none") : modules) +
+                    "); add the module that defines it with Context::add_module");
+    return create_program(*found);
+}
+std::shared_ptr<Program> Context::create_program(const ModuleInfo& module, std::string_view name) {
+    const ProgramDesc* desc = module.find(name);
+    if (!desc) {
+        std::string names;
+        for (const ProgramDesc* p : module.programs())
+            names += (names.empty() ? "" : ", ") + std::string(p->name);
+        throw Error("Context::create_program: module '" + std::string(module.name()) +
+                    "' has no program '" + std::string(name) +
+                    "' (its programs: " + (names.empty() ? "none" : names) + ")");
+    }
+    return create_program(*desc);
 }
 std::shared_ptr<Program> Context::create_program(const ProgramDesc& desc) {
+    if (desc.module && !known_module(m_impl->state, desc.module))
+        m_impl->state.modules.push_back({desc.module, nullptr});
     return std::make_shared<Program>(m_impl->shared, desc);
 }
 std::shared_ptr<Buffer> Context::create_buffer(BufferType type, const TypeInfo& element,

@@ -7,6 +7,7 @@
 
 #include "core/compiled_scene.h"
 #include "lucent/context.h"
+#include "lucent/module.h"
 
 namespace lucent::core {
 
@@ -15,8 +16,16 @@ struct EntryPoint {
     std::shared_ptr<Program> exception;
 };
 
+/// A module a context knows, with the text it was given at run time (else null: the GPU
+/// backend takes the text lucent_add_programs embedded).
+struct ContextModule {
+    const ModuleInfo* info = nullptr;
+    std::shared_ptr<const ModuleSource> source;
+};
+
 struct ContextState {
     const Context* context = nullptr;  // the Context's own variable scope
+    std::vector<ContextModule> modules;
     std::vector<EntryPoint> entries{1};
     std::vector<RayTypeDesc> ray_types;          // a gap has payload == nullptr
     std::vector<std::shared_ptr<Program>> miss;  // per ray type

@@ -53,6 +53,8 @@ void SceneCompiler::compile_graph() {
     scene.print_enabled = m_state.print_enabled;
     scene.print_index = m_state.print_index;
     scene.enabled_exceptions = m_state.enabled_exceptions;
+    for (const ContextModule& module : m_state.modules)
+        if (module.source) scene.module_sources[module.info] = module.source;
 
     for (unsigned r = 0; r < m_state.ray_types.size(); ++r)
         if (!m_state.ray_types[r].payload)

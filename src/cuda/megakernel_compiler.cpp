@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <set>
 
 namespace lucent::cuda {
 
@@ -29,7 +30,8 @@ ProgramTable build_program_table(const core::CompiledScene& scene) {
 Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTable& table) {
     Megakernel k;
     k.shape = kernel_shape(scene);
-    k.source = generate_megakernel(table, k.shape);
+    k.modules = bound_module_sources(table, scene.module_sources);
+    k.source = generate_megakernel(table, k.shape, k.modules);
     // LUCENT_DUMP_MEGAKERNEL=file: keep the generated source for inspection.
     if (const char* dump = std::getenv("LUCENT_DUMP_MEGAKERNEL")) {
         std::ofstream out(dump);
@@ -42,6 +44,10 @@ void compile_megakernel(Megakernel& k, int sm) {
     CompileRequest request =
         embedded_request("lucent_megakernel.cu", k.source,
                          {"--std=c++20", "-default-device", "--use_fast_math"}, sm);
+    std::set<std::string> names;  // two modules may include one file
+    for (const auto& module : k.modules)
+        for (const auto& [name, text] : module->files)
+            if (names.insert(name).second) request.headers.emplace_back(name, text);
     // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
     add_options_from_env(request, "LUCENT_NVRTC_OPTIONS");
     k.binary = compile_cubin(request);

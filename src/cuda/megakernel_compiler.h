@@ -15,6 +15,7 @@ ProgramTable build_program_table(const core::CompiledScene& scene);
 struct Megakernel {
     std::string source;
     KernelShape shape;
+    ModuleSourceList modules;  // the bound programs' module texts, headers of `source`
     CompileResult binary;
 };
 

@@ -5,7 +5,6 @@
 #include <string_view>
 #include <sstream>
 
-#include "cuda/embedded_sources.h"
 #include "lucent/error.h"
 
 namespace lucent::cuda {
@@ -151,23 +150,42 @@ void generate_callables(std::ostringstream& out, const std::vector<const Program
 
 }  // namespace
 
-std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape) {
-    // The program modules actually bound, each once.
-    std::set<std::string> modules;
-    bool occlusion = false;  // some bound module asks occluded(): keep its traversal checks
+ModuleSourceList bound_module_sources(
+    const ProgramTable& table,
+    const std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>>& given) {
+    ModuleSourceList modules;
+    std::set<const ModuleInfo*> seen;
     for (size_t k = 0; k <= size_t(ProgramKind::kCallable); ++k)
         for (const ProgramDesc* desc : table.programs(ProgramKind(k))) {
-            const EmbeddedSource* module = find_embedded_source(desc->file);
-            if (!module)
-                throw Error(std::string(program_kind_name(desc->kind)) + " program '" +
-                            std::string(desc->name) + "' is defined in " + desc->file +
-                            ", which the CUDA backend does not have as source; keep program "
-                            "modules in samples/<name>/<name>_programs.h (embedded at build "
-                            "time) or use --backend cpu");
-            modules.insert(std::string(module->name));
-            occlusion = occlusion || std::string_view(module->text).find("occluded(") !=
-                                         std::string_view::npos;
+            if (!seen.insert(desc->module).second) continue;
+            if (auto it = given.find(desc->module); it != given.end()) {
+                modules.push_back(it->second);
+                continue;
+            }
+            const std::string name = desc->module ? std::string(desc->module->name()) : "";
+            if (const ModuleSource* embedded = embedded_module_source(name)) {
+                // The embedded texts live as long as the program: a non-owning pointer.
+                modules.emplace_back(std::shared_ptr<const ModuleSource>(), embedded);
+                continue;
+            }
+            throw Error(std::string(program_kind_name(desc->kind)) + " program '" +
+                        std::string(desc->name) + "' of module '" + name + "' (" + desc->file +
+                        ") cannot run on the GPU: the CUDA backend has no text of the module. "
+                        "Embed it at build time with lucent_add_programs(<your target> HEADERS " +
+                        desc->file + ") in CMake, or give it at run time with "
+                        "context.add_module(lucent::ModuleSource::from_file(\"" + desc->file +
+                        "\")); or run on the CPU (--backend cpu)");
         }
+    return modules;
+}
+
+std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
+                                const ModuleSourceList& modules) {
+    // The GPU traversal keeps occluded()'s early exit only when a module declares it.
+    bool occlusion = false;
+    for (size_t k = 0; k <= size_t(ProgramKind::kCallable); ++k)
+        for (const ProgramDesc* desc : table.programs(ProgramKind(k)))
+            occlusion = occlusion || (desc->module && desc->module->uses(kUsesOccluded));
 
     std::ostringstream out;
     out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
@@ -183,7 +201,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
         << "#include \"lucent_gpu/runtime.cuh\"\n"
         << "#include \"lucent_gpu/invoke.cuh\"\n";
-    for (const std::string& m : modules) out << "#include \"" << m << "\"\n";
+    for (const auto& m : modules) out << "#include \"" << m->main << "\"\n";
 
     out << "\nnamespace lucent::gpu {\n";
     for (size_t k = 0; k < size_t(ProgramKind::kCallable); ++k) {

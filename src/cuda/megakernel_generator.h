@@ -1,10 +1,11 @@
 // Generates the CUDA source of one megakernel for a compiled scene (OptiX paper §4-5;
-// ARCHITECTURE §4): the engine's runtime and traversal, the program modules actually
+// docs/architecture.md): the engine's runtime and traversal, the program modules actually
 // bound, and switch statements that dispatch to them, specialised on what the scene uses.
 #pragma once
 
 #include <array>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,7 +43,16 @@ struct KernelShape {
 
 KernelShape kernel_shape(const core::CompiledScene& scene);
 
-/// The megakernel source; Error if a bound program's module is not embedded.
-std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape);
+/// The texts of the modules a table's programs come from: those given to the Context at
+/// run time (`given`), else those embedded by lucent_add_programs; Error naming the
+/// program, its file and the two ways to give a text when a module has neither.
+using ModuleSourceList = std::vector<std::shared_ptr<const ModuleSource>>;
+ModuleSourceList bound_module_sources(
+    const ProgramTable& table,
+    const std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>>& given);
+
+/// The megakernel source, including every module of `modules` (bound_module_sources).
+std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
+                                const ModuleSourceList& modules);
 
 }  // namespace lucent::cuda

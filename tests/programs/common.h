@@ -7,6 +7,10 @@
 
 namespace lucent_tests {
 using namespace lucent;
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace common_module {
+LUCENT_MODULE(test_common)
 
 /// What every test ray carries back: who handled it and what it saw.
 struct TestPayload {
@@ -137,4 +141,5 @@ LUCENT_CLOSEST_HIT(common_triangle_hit, IdRecord, TestPayload, TriangleAttribute
     prd.uv = attr.barycentrics;
 }
 
+}  // namespace common_module
 }  // namespace lucent_tests

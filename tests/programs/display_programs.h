@@ -5,6 +5,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace display_module {
+LUCENT_MODULE(test_display)
 
 struct CopyImageRecord {
     BufferView<float4> source;  // 2D, the launch's size
@@ -16,4 +20,5 @@ LUCENT_RAY_GENERATION(dt_copy_image, CopyImageRecord) {
     rec.image[make_uint2(i.x, i.y)] = rec.source[make_uint2(i.x, i.y)];
 }
 
+}  // namespace display_module
 }  // namespace lucent_tests

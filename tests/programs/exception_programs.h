@@ -5,6 +5,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace exception_module {
+LUCENT_MODULE(test_exception)
 
 // ---- recursion to a chosen depth ------------------------------------------------------
 struct DepthRecord {
@@ -136,4 +140,5 @@ LUCENT_RAY_GENERATION(et_throw_pattern, NoRecord) {
     if ((7u * i.x + 13u * i.y) % 101u == 5u) throw_exception(kCodeA, i.x);
 }
 
+}  // namespace exception_module
 }  // namespace lucent_tests

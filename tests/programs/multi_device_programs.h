@@ -6,6 +6,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace multi_device_module {
+LUCENT_MODULE(test_multi_device)
 
 struct PatternRecord {
     Handle top;
@@ -102,4 +106,5 @@ LUCENT_RAY_GENERATION(md_raise, RaiseRecord) {
     rec.done[make_uint2(i.x, i.y)] = 1u;
 }
 
+}  // namespace multi_device_module
 }  // namespace lucent_tests

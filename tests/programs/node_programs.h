@@ -5,6 +5,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace node_module {
+LUCENT_MODULE(test_node)
 
 // ---- selector visit programs --------------------------------------------------------
 /// Child 0 for rays going towards +x (or straight), child 1 for rays going towards -x.
@@ -94,4 +98,5 @@ LUCENT_ANY_HIT(nt_anyhit_record, NoRecord, TestPayload, SphereAttributes) {
     prd.uv = make_float2(current_ray().origin.z, current_ray().direction.z);
 }
 
+}  // namespace node_module
 }  // namespace lucent_tests

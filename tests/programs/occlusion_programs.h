@@ -6,6 +6,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace occlusion_module {
+LUCENT_MODULE(test_occlusion, lucent::kUsesOccluded)
 
 struct OcclusionQuery {
     float3 origin, direction;
@@ -35,4 +39,5 @@ LUCENT_ANY_HIT(occlusion_ignore_all, NoRecord, TestPayload, TriangleAttributes) 
     ignore_intersection();
 }
 
+}  // namespace occlusion_module
 }  // namespace lucent_tests

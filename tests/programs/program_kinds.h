@@ -5,6 +5,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace program_kinds_module {
+LUCENT_MODULE(test_program_kinds)
 
 // ---- ray generation over 1D/2D/3D grids ------------------------------------------
 struct IndexAndSize {
@@ -258,4 +262,5 @@ LUCENT_BOUNDING_BOX(pk_printing_sphere_bounds, SphereRecord) {
     box.hi = make_float3(s.x + s.w, s.y + s.w, s.z + s.w);
 }
 
+}  // namespace program_kinds_module
 }  // namespace lucent_tests

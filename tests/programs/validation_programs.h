@@ -5,6 +5,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace validation_module {
+LUCENT_MODULE(test_validation)
 
 /// A payload that is not the radiance ray type's.
 struct OtherPayload {
@@ -58,4 +62,5 @@ LUCENT_CALLABLE(vat_callable_float, NoRecord, float, (float v)) {
     return v;
 }
 
+}  // namespace validation_module
 }  // namespace lucent_tests

@@ -6,6 +6,10 @@
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
+// Each test module in its own inline namespace: its own LUCENT_MODULE, while the tests
+// still name its programs and types unqualified.
+inline namespace variable_module {
+LUCENT_MODULE(test_variable)
 
 struct VtPayload {
     int hit;  // -1 untouched, 0 miss, 1 closest hit
@@ -210,4 +214,5 @@ LUCENT_RAY_GENERATION(vt_all_kinds, AllKinds) {
     rec.all_out[0] = o;
 }
 
+}  // namespace variable_module
 }  // namespace lucent_tests

@@ -66,7 +66,18 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 /// Use it where a shadow any-hit would only say "blocked"; shadows that attenuate (glass)
 /// need trace() with an any-hit program. Much cheaper than trace(): on a GeometryGroup of
 /// triangles it is the bare any-hit traversal of the BVH.
-#if defined(__CUDACC_RTC__)
+/// A module that calls it declares so: LUCENT_MODULE(name, lucent::kUsesOccluded).
+#if defined(__CUDACC_RTC__) && defined(LUCENT_GPU_OCCLUSION) && !LUCENT_GPU_OCCLUSION
+// No module of this megakernel declares kUsesOccluded, so the traversal has no occlusion
+// path: a call is a compile error that says what to declare.
+template <class Undeclared = void>
+__device__ bool occluded(Handle, const Ray&) {
+    static_assert(sizeof(Undeclared) == 0,
+                  "occluded() is called by a module that does not declare it: write "
+                  "LUCENT_MODULE(name, lucent::kUsesOccluded)");
+    return false;
+}
+#elif defined(__CUDACC_RTC__)
 // In the megakernel the runtime defines it, inlined into each caller: its fast path is the
 // bare BVH traversal, and a call would cost the ABI's register saves on every shadow ray.
 __device__ __forceinline__ bool occluded(Handle root, const Ray& ray);

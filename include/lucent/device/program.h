@@ -11,6 +11,7 @@
 #pragma once
 
 #include "lucent/device/api.h"
+#include "lucent/device/module.h"
 #include "lucent/device/reflect.h"
 
 #if !LUCENT_GPU_CODE
@@ -43,6 +44,8 @@ struct ProgramDesc {
     const TypeInfo* signature;   // callables: R(Args...)
     void (*entry)();             // the thunk; its real type follows from `kind`
     std::string_view scope;      // enclosing namespaces, "" or "ns::inner::"
+    const ModuleInfo* module = nullptr;  // the module whose LUCENT_MODULE the program is in
+    void (*function)() = nullptr;        // the program's own function (LUCENT_PROGRAM lookup)
 };
 
 // Thunk signatures per kind (records, payloads and attributes type-erased).
@@ -56,8 +59,6 @@ using VisitFn = unsigned (*)(const void* rec);
 using AttributeFn = void (*)(const void* rec, unsigned prim, float2 barycentrics, void* attr);
 
 namespace detail {
-bool register_program(const ProgramDesc& desc);
-
 /// Sets desc.scope from the __PRETTY_FUNCTION__ of the descriptor function the macro
 /// defines beside the program ("... ns::lucent_program_desc_name()"), so code generated for
 /// the GPU can name the program as ::ns::name.
@@ -73,6 +74,12 @@ inline ProgramDesc with_scope(ProgramDesc desc, std::string_view pretty) {
 template <class F>
 void (*erase_fn(F f))() {
     return reinterpret_cast<void (*)()>(f);
+}
+/// Places a program's description in its module, with its function's address.
+inline ProgramDesc in_module(ProgramDesc desc, const ModuleInfo& module, void (*function)()) {
+    desc.module = &module;
+    desc.function = function;
+    return desc;
 }
 template <class Record>
 ProgramDesc make_desc(std::string_view name, ProgramKind kind, const char* file,
@@ -90,14 +97,18 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 }  // namespace detail
 }  // namespace lucent
 
-#define LUCENT_DECLARE_PROGRAM_(name, make)                            \
-    inline const ::lucent::ProgramDesc& lucent_program_desc_##name() { \
-        static const ::lucent::ProgramDesc desc =                      \
-            ::lucent::detail::with_scope(make, __PRETTY_FUNCTION__);   \
-        return desc;                                                   \
-    }                                                                  \
-    inline const bool lucent_program_registered_##name =               \
-        ::lucent::detail::register_program(lucent_program_desc_##name());
+// Each program's description lives in a function-local static (one per binary however many
+// files include the module) and is added to the module that lucent_this_module() finds by
+// ordinary name lookup: the LUCENT_MODULE of the enclosing namespace.
+#define LUCENT_DECLARE_PROGRAM_(name, make)                                             \
+    inline const ::lucent::ProgramDesc& lucent_program_desc_##name() {                  \
+        static const ::lucent::ProgramDesc desc = ::lucent::detail::in_module(          \
+            ::lucent::detail::with_scope(make, __PRETTY_FUNCTION__), lucent_this_module(), \
+            ::lucent::detail::erase_fn(&name));                                         \
+        return desc;                                                                    \
+    }                                                                                   \
+    inline const bool lucent_program_registered_##name =                                \
+        lucent_this_module().add(lucent_program_desc_##name());
 
 #define LUCENT_RAY_GENERATION(name, Record)                                                       \
     inline void name(const Record& rec);                                                          \

@@ -1,51 +1,8 @@
-// Name → ProgramDesc registry filled by the program macros at static-initialisation time.
-#include <map>
-#include <mutex>
-#include <string>
-#include <vector>
-
+// Names of program and field kinds, and the host handle of a program.
 #include "lucent/error.h"
 #include "lucent/program.h"
 
 namespace lucent {
-namespace {
-struct Registry {
-    std::mutex mutex;
-    std::multimap<std::string, const ProgramDesc*, std::less<>> by_name;
-};
-Registry& registry() {
-    static Registry r;  // function-local: safe during static initialisation
-    return r;
-}
-}  // namespace
-
-namespace detail {
-bool register_program(const ProgramDesc& desc) {
-    Registry& r = registry();
-    std::lock_guard lock(r.mutex);
-    r.by_name.emplace(std::string(desc.name), &desc);
-    return true;
-}
-}  // namespace detail
-
-const ProgramDesc& find_program(std::string_view name) {
-    Registry& r = registry();
-    std::lock_guard lock(r.mutex);
-    auto [first, last] = r.by_name.equal_range(name);
-    if (first == last) {
-        std::string known;
-        for (auto& [n, d] : r.by_name) known += (known.empty() ? "" : ", ") + n;
-        throw Error("no program named '" + std::string(name) +
-                    "' is registered; define it with a LUCENT_* program macro in a module "
-                    "that this binary includes (known programs: " +
-                    (known.empty() ? "none" : known) + ")");
-    }
-    if (std::next(first) != last)
-        throw Error("program name '" + std::string(name) + "' is defined in " +
-                    first->second->file + " and " + std::next(first)->second->file +
-                    "; rename one, or pass the program with LUCENT_PROGRAM(name)");
-    return *first->second;
-}
 
 const char* program_kind_name(ProgramKind kind) {
     switch (kind) {
