@@ -10,6 +10,7 @@
 #include "bench_present_command.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
+#include "lucent/version.h"
 #include "noise_command.h"
 #include "render_command.h"
 #include "samples/settings_error.h"
@@ -33,6 +34,13 @@ int main(int argc, char** argv) {
     using namespace lucent::cli;
     CLI::App app{"Lucent: an open, programmable ray-tracing engine", "lucent"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", std::string("lucent ") + lucent::version() +
+#if LUCENT_HAVE_CUDA
+                                          " (backends: cpu, cuda)"
+#else
+                                          " (backends: cpu)"
+#endif
+    );
     app.footer(
         "Examples:\n"
         "  lucent render --sample whitted --size 1024x1024 --out whitted.png\n"

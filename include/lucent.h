@@ -1,9 +1,4 @@
-// The Lucent host API: include this in applications.
+// The Lucent host API in one include (lucent/lucent.h).
 #pragma once
 
-#include "lucent/buffer.h"
-#include "lucent/context.h"
-#include "lucent/error.h"
-#include "lucent/nodes.h"
-#include "lucent/program.h"
-#include "lucent/variables.h"
+#include "lucent/lucent.h"

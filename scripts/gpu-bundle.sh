@@ -9,19 +9,34 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=.gpu-bundle
-build=build-gpu-bundle
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLUCENT_NATIVE=OFF \
-      -DCMAKE_CXX_FLAGS="-mavx2 -mfma -mf16c -mbmi -mbmi2 -mlzcnt -mpopcnt" \
-      -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON > /dev/null
-cmake --build "$build" -j"$(nproc)"
+# LUCENT_BUNDLE_BUILD=build bundles an existing build tree instead (quicker; its instruction
+# set must suit the GPU machine's processor).
+build=${LUCENT_BUNDLE_BUILD:-build-gpu-bundle}
+if [ -z "${LUCENT_BUNDLE_BUILD:-}" ]; then
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLUCENT_NATIVE=OFF \
+        -DCMAKE_CXX_FLAGS="-mavx2 -mfma -mf16c -mbmi -mbmi2 -mlzcnt -mpopcnt" \
+        -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON > /dev/null
+fi
+# Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
+suites="programs nodes variables exceptions validation occlusion whitted backend igi radiosity
+        fog pathtracer multi_device gpu_bvh_builder display modules"
+targets="lucent_cli lucent_embed_module"
+for t in $suites; do targets="$targets ${t}_test"; done
+cmake --build "$build" -j"$(nproc)" --target $targets
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
-# Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
-for t in programs nodes variables exceptions validation occlusion whitted backend igi radiosity \
-         fog pathtracer multi_device gpu_bvh_builder display; do
-  cp "$build/tests/${t}_test" "$out/bin/"
-done
+for t in $suites; do cp "$build/tests/${t}_test" "$out/bin/"; done
 cp "$build/lucent" "$out/bin/"
+# The examples, built as a user builds them: against the installed package.
+prefix="$PWD/$build/prefix"
+cmake --install "$build" --prefix "$prefix" > /dev/null
+for dir in examples/*/; do
+  name=$(basename "$dir")
+  cmake -S "$dir" -B "$build/examples/$name" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+        -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_FLAGS="-mavx2 -mfma" > /dev/null
+  cmake --build "$build/examples/$name" -j"$(nproc)"
+  cp "$build/examples/$name/$name" "$out/bin/example-$name"
+done
 strip --strip-unneeded "$out"/bin/*  # symbols are not needed there, and the carry is 64 MiB
 for lib in $(ldd "$out"/bin/* | awk '/=>/ {print $3}' | sort -u); do cp -L "$lib" "$out/lib/"; done
 cp -L /lib64/ld-linux-x86-64.so.2 "$out/lib/"

@@ -2,7 +2,7 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render samples tests igi pathtracer fog tea sanitizer bench builder present sweep profile
+# with steps: render examples samples tests igi pathtracer fog tea sanitizer bench builder present sweep profile
 # hotspots multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench).
 set -uo pipefail
@@ -41,6 +41,28 @@ render)
     $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose --repeat 500
     $R $B/bin/lucent render --sample whitted --backend cpu --size 1024x1024 --out "$out/whitted_cpu.png"
     compare "$out/whitted_cpu.png" "$out/whitted_cuda.png" whitted
+    ;;
+examples)
+    # The examples built against the installed package: GPU against CPU, and the JIT of a
+    # user's module cold, then from the disk cache.
+    rm -rf "$LUCENT_CACHE_DIR"
+    for e in first-program ambient-occlusion; do
+        echo "== example $e: cuda (cold JIT), cuda (cached), cpu"
+        $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
+        $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
+        $R $B/bin/example-$e --backend cpu --out "$out/${e}_cpu.png"
+        compare "$out/${e}_cpu.png" "$out/${e}_cuda.png" "$e"
+    done
+    echo "== example ray-queries: cuda, cpu"
+    $R $B/bin/example-ray-queries --backend cuda --out "$out/ray_queries_cuda.txt"
+    $R $B/bin/example-ray-queries --backend cpu --out "$out/ray_queries_cpu.txt"
+    if cmp -s "$out/ray_queries_cuda.txt" "$out/ray_queries_cpu.txt"; then
+        echo "ray-queries: CPU and GPU results identical"
+    else
+        echo "ray-queries: CPU and GPU results differ:"; diff "$out/ray_queries_cpu.txt" "$out/ray_queries_cuda.txt" | head -20
+    fi
+    echo "== modules_test on the GPU"
+    LUCENT_TEST_BACKEND=cuda $R $B/bin/modules_test 2>&1 | tail -3
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.

@@ -105,8 +105,12 @@ int main(int argc, char** argv) {
         write_if_changed(args.output, cpp.str());
         if (!args.depfile.empty()) {
             std::string deps = make_escaped(args.output) + ":";
-            for (const std::string& path : source.paths()) deps += " " + make_escaped(path);
-            write_if_changed(args.depfile, deps + "\n");
+            for (const std::string& path : source.paths()) {
+                deps += ' ';
+                deps += make_escaped(path);
+            }
+            deps += '\n';
+            write_if_changed(args.depfile, deps);
         }
     } catch (const lucent::Error& e) {
         std::cerr << "lucent-embed-module: " << e.what() << "\n";

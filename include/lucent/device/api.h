@@ -3,6 +3,7 @@
 #pragma once
 
 #include "lucent/device/device_slot.h"
+#include "lucent/device/module.h"
 #include "lucent/device/types.h"
 
 #if !LUCENT_GPU_CODE
@@ -72,7 +73,7 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 // path: a call is a compile error that says what to declare.
 template <class Undeclared = void>
 __device__ bool occluded(Handle, const Ray&) {
-    static_assert(sizeof(Undeclared) == 0,
+    static_assert(detail::dependent_false<Undeclared>,
                   "occluded() is called by a module that does not declare it: write "
                   "LUCENT_MODULE(name, lucent::kUsesOccluded)");
     return false;

@@ -28,6 +28,10 @@ enum ModuleUses : unsigned {
 };
 
 namespace detail {
+/// False, but only once T is known: a static_assert that fires when a template is used.
+template <class T>
+constexpr bool dependent_false = false;
+
 /// The flags LUCENT_MODULE's optional arguments name, or'ed together (none: 0).
 template <class... Flags>
 constexpr unsigned module_uses(Flags... flags) {
@@ -89,10 +93,10 @@ bool register_module(ModuleInfo& module);
 /// the build with the fix.
 template <class NoModuleDeclared = void>
 ::lucent::ModuleInfo& lucent_this_module() {
-    static_assert(sizeof(NoModuleDeclared) == 0,
+    static_assert(::lucent::detail::dependent_false<NoModuleDeclared>,
                   "Lucent: a program macro is used outside a module; declare "
                   "LUCENT_MODULE(name) in the namespace of your programs "
-                  "(include \"lucent/device.h\"; see docs/programming-model.md, 'Modules')");
+                  "(see docs/programming-model.md, 'Program modules')");
     return *static_cast<::lucent::ModuleInfo*>(nullptr);
 }
 
