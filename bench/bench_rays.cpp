@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "accel/cpu_isa.h"
 #include "accel/triangle_accel.h"
 #include "bench/bench_camera.h"
 #include "bench/bench_commands.h"
@@ -379,15 +380,19 @@ int run_bench_rays(const RaysOptions& options) {
         peer);
     const EngineResult& lucent = result.lucent;
     const EngineResult& embree = result.peer;
+    // The traversal variant that ran (cpu_isa.h): the variants' figures are far apart, so
+    // every record says which one it is.
+    const char* cpu_isa = accel::cpu_isa_name(accel::active_cpu_isa());
     const std::string differences =
         peer ? checksum_differences(lucent, embree, "lucent", "embree") : "";
 
     if (options.json) {
         std::printf(
             "{\"scene\": \"%s\", \"triangles\": %zu, \"width\": %u, \"height\": %u, "
-            "\"threads\": %u, \"repeat\": %d, \"build_ms\": %.3f,\n \"lucent\": %s",
+            "\"threads\": %u, \"cpu_isa\": \"%s\", \"repeat\": %d, \"build_ms\": %.3f,\n "
+            "\"lucent\": %s",
             options.scene.c_str(), mesh.indices.size(), options.width, options.height, threads,
-            options.repeat, stats.build_ms, json_engine(lucent).c_str());
+            cpu_isa, options.repeat, stats.build_ms, json_engine(lucent).c_str());
         if (peer)
             std::printf(
                 ",\n \"embree\": %s,\n \"embree_build_ms\": %.3f, "
@@ -401,6 +406,9 @@ int run_bench_rays(const RaysOptions& options) {
     std::printf("scene %s: %zu triangles, %ux%u, %u threads, median of %d repeats\n",
                 options.scene.c_str(), mesh.indices.size(), options.width, options.height, threads,
                 options.repeat);
+    std::printf(
+        "cpu isa %s (the traversal's variant; LUCENT_CPU_ISA=scalar|avx2|avx512 picks one)\n",
+        cpu_isa);
     std::printf("build %.2f ms (sah %.2f, %zu wide nodes, %zu leaves, %zu of them 5-8 triangles)\n",
                 stats.build_ms, stats.sah_cost, stats.node_count, stats.leaf_count,
                 stats.large_leaf_count);

@@ -1,21 +1,27 @@
 // Acceleration structures against brute force: the binary Bvh (generic traversal, refit,
 // depth bound), TriangleAccel (closest, any, filtered, refit, watertightness) on random
-// soups and on the benchmark scenes, and the OBJ loader's errors.
+// soups and on the benchmark scenes, the choice of the traversal's instruction-set variant,
+// and the OBJ loader's errors. tests/CMakeLists.txt runs the TriangleAccel and CpuIsa tests
+// again on each variant the CPU supports, chosen with LUCENT_CPU_ISA.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/cpu_isa.h"
 #include "accel/triangle_accel.h"
+#include "accel/triangle_traverse.h"
 #include "lucent/device/triangle_intersect.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
@@ -649,6 +655,51 @@ TEST(TriangleAccelScenes, BunnyEqualsBruteForce) {
 }
 TEST(TriangleAccelScenes, SponzaEqualsBruteForce) {
     check_scene("sponza.obj");
+}
+
+// ---- the traversal's instruction-set variants (cpu_isa.h) -------------------------------
+
+/// The variant LUCENT_CPU_ISA asks for, if any.
+std::optional<CpuIsa> requested_isa() {
+    const char* env = std::getenv("LUCENT_CPU_ISA");
+    return env ? parse_cpu_isa(env) : std::nullopt;
+}
+
+/// A run for a variant this CPU lacks would test another one under its name, so it ends
+/// before the tests with 77, which ctest reports as skipped (SKIP_RETURN_CODE).
+struct SkipUnsupportedIsa : ::testing::Environment {
+    void SetUp() override {
+        const std::optional<CpuIsa> isa = requested_isa();
+        if (!isa || cpu_isa_supported(*isa)) return;
+        std::printf("LUCENT_CPU_ISA=%s: this build or this CPU lacks it, skipped\n",
+                    cpu_isa_name(*isa));
+        std::fflush(stdout);
+        std::exit(77);
+    }
+};
+[[maybe_unused]] ::testing::Environment* const skip_unsupported_isa =
+    ::testing::AddGlobalTestEnvironment(new SkipUnsupportedIsa);
+
+TEST(CpuIsa, TheRequestedVariantRunsOrElseTheBest) {
+    CpuIsa best = CpuIsa::kScalar;
+    for (CpuIsa isa : kCpuIsas)
+        if (cpu_isa_supported(isa)) best = isa;
+    const CpuIsa expected = requested_isa().value_or(best);
+    EXPECT_STREQ(cpu_isa_name(active_cpu_isa()), cpu_isa_name(expected));
+}
+
+TEST(CpuIsa, EachVariantHasTheCodePathsItsNameSays) {
+    // What the variant's compile flags let triangle_traverse.cpp's #if's enable.
+    const char* expected[] = {"scalar", "avx2 fma", "avx2 fma avx512vl"};
+    for (CpuIsa isa : kCpuIsas)
+        if (cpu_isa_supported(isa))
+            EXPECT_STREQ(traverse_variant(isa).paths, expected[int(isa)]) << cpu_isa_name(isa);
+}
+
+TEST(CpuIsa, NamesRoundTrip) {
+    for (CpuIsa isa : kCpuIsas) EXPECT_EQ(parse_cpu_isa(cpu_isa_name(isa)), isa);
+    EXPECT_FALSE(parse_cpu_isa("sse4"));
+    EXPECT_FALSE(parse_cpu_isa(""));
 }
 
 // ---- the OBJ loader -------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -260,6 +261,26 @@ TEST_F(CliTest, BenchBuildBadSubdivideOrSizeNamesTheFlag) {
     EXPECT_EQ(run.exit_code, 2) << run.output;
     EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
     EXPECT_TRUE(dir_is_empty());
+}
+
+TEST_F(CliTest, BenchRaysNamesTheTraversalVariantThatRan) {
+    {
+        std::ofstream obj(path("quad.obj"));
+        obj << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+    }
+    const std::string args = "bench rays --scene '" + path("quad.obj") +
+                             "' --eye 0.5,0.5,2 --look 0.5,0.5,0 --up 0,1,0 --fov 45 "
+                             "--light 0.5,0.5,3 --size 16x16 --repeat 1 --no-peer";
+    CliRun run = run_cli(args);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("cpu isa "), std::string::npos) << run.output;
+    // LUCENT_CPU_ISA picks the variant; every build has the scalar one. Set for the one
+    // command (ctest runs each test in a process of its own).
+    setenv("LUCENT_CPU_ISA", "scalar", 1);
+    run = run_cli(args + " --json");
+    unsetenv("LUCENT_CPU_ISA");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("\"cpu_isa\": \"scalar\""), std::string::npos) << run.output;
 }
 
 namespace {

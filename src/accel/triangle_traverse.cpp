@@ -2,13 +2,22 @@
 // children of a node (AVX2) and one watertight test for the up to eight triangles of a leaf
 // (four lanes with SSE or eight with AVX, and FMA), the same arithmetic as
 // lucent/device/triangle_intersect.h. Occlusion rays push children with AVX-512 where the
-// build has it. Builds without AVX2/FMA (or with LUCENT_ACCEL_SCALAR, as accel_scalar_test
-// does) fall back to scalar loops over the same layout and the same arithmetic.
+// flags allow it. Without AVX2/FMA (or with LUCENT_ACCEL_SCALAR) it falls back to scalar
+// loops over the same layout and the same arithmetic.
+//
+// This file is compiled once per instruction-set variant (cmake/isa_variants.cmake): each
+// copy has its own flags and puts its entry points in namespace LUCENT_ISA_VARIANT
+// (isa_scalar, isa_avx2, isa_avx512), and triangle_traverse_dispatch.cpp calls the one the
+// CPU runs. Everything else here has internal linkage, so the copies cannot be mixed up; the
+// test accel_isa_symbols checks that no copy defines any other external symbol (an inline
+// function of a header emitted with AVX-512 instructions could otherwise be picked by the
+// linker for the whole program).
 #include <algorithm>
 #include <bit>
 #include <cmath>
 
 #include "accel/triangle_accel.h"
+#include "accel/triangle_traverse.h"
 #include "accel/wide_bvh.h"
 #include "lucent/device/triangle_intersect.h"
 
@@ -19,7 +28,11 @@
 #define LUCENT_ACCEL_SIMD 0
 #endif
 
-namespace lucent::accel {
+#ifndef LUCENT_ISA_VARIANT
+#error "compiled only through cmake/isa_variants.cmake, which names the variant"
+#endif
+
+namespace lucent::accel::LUCENT_ISA_VARIANT {
 
 namespace {
 
@@ -376,8 +389,7 @@ enum class Query { kClosest, kAny, kFiltered };
 /// children nearest first and drop stack entries beyond the current closest hit.
 template <Query kQuery>
 bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
-              float tmax, TriangleHit* hit, HitDecision (*thunk)(void*, const TriangleHit&),
-              void* filter) {
+              float tmax, TriangleHit* hit, FilterThunk thunk, void* filter) {
     const RayState r(origin, direction, tmin);
     RayEnd end(tmax);
     uint32_t stack_ref[kStackSize + kWideArity];  // push_children may write 8 past the top
@@ -527,20 +539,32 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
 
 }  // namespace
 
-bool TriangleAccel::intersect(float3 origin, float3 direction, float tmin, float tmax,
-                              TriangleHit& hit) const {
-    return traverse<Query::kClosest>(*m_impl, origin, direction, tmin, tmax, &hit, nullptr,
-                                     nullptr);
+bool intersect(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
+               float tmax, TriangleHit& hit) {
+    return traverse<Query::kClosest>(accel, origin, direction, tmin, tmax, &hit, nullptr, nullptr);
 }
 
-bool TriangleAccel::occluded(float3 origin, float3 direction, float tmin, float tmax) const {
-    return traverse<Query::kAny>(*m_impl, origin, direction, tmin, tmax, nullptr, nullptr, nullptr);
+bool occluded(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
+              float tmax) {
+    return traverse<Query::kAny>(accel, origin, direction, tmin, tmax, nullptr, nullptr, nullptr);
 }
 
-bool TriangleAccel::intersect_filtered_impl(float3 origin, float3 direction, float tmin, float tmax,
-                                            TriangleHit& hit, FilterThunk thunk,
-                                            void* filter) const {
-    return traverse<Query::kFiltered>(*m_impl, origin, direction, tmin, tmax, &hit, thunk, filter);
+bool intersect_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
+                        float tmin, float tmax, TriangleHit& hit, FilterThunk thunk, void* filter) {
+    return traverse<Query::kFiltered>(accel, origin, direction, tmin, tmax, &hit, thunk, filter);
 }
 
-}  // namespace lucent::accel
+extern const TraverseVariant kTraverse = {
+    intersect,
+    occluded,
+    intersect_filtered,
+#if !LUCENT_ACCEL_SIMD
+    "scalar",
+#elif defined(__AVX512VL__)
+    "avx2 fma avx512vl",
+#else
+    "avx2 fma",
+#endif
+};
+
+}  // namespace lucent::accel::LUCENT_ISA_VARIANT
