@@ -56,17 +56,25 @@ examples)
     echo "== example ray-queries: cuda, cpu"
     $R $B/bin/example-ray-queries --backend cuda --out "$out/ray_queries_cuda.txt"
     $R $B/bin/example-ray-queries --backend cpu --out "$out/ray_queries_cpu.txt"
-    if cmp -s "$out/ray_queries_cuda.txt" "$out/ray_queries_cpu.txt"; then
-        echo "ray-queries: CPU and GPU results identical"
-    else
-        echo "ray-queries: CPU and GPU results differ:"; diff "$out/ray_queries_cpu.txt" "$out/ray_queries_cuda.txt" | head -20
-    fi
+    # Visibility and triangle answers must be equal; distances within 1e-4 relative (the GPU's
+    # fast-math division and FMAs round differently).
+    python3 - "$out/ray_queries_cpu.txt" "$out/ray_queries_cuda.txt" <<'PY'
+import sys
+rows = [[l.split() for l in open(f) if not l.startswith("#")] for f in sys.argv[1:]]
+cpu, gpu = rows
+exact = sum(1 for a, b in zip(cpu, gpu) if len(a) == 2 and a != b)
+tri = sum(1 for a, b in zip(cpu, gpu) if len(a) == 3 and a[2] != b[2])
+far = sum(1 for a, b in zip(cpu, gpu) if len(a) == 3 and
+          abs(float(a[1]) - float(b[1])) > 1e-4 * max(1.0, abs(float(a[1]))))
+print(f"ray-queries CPU vs GPU: {len(cpu)} answers; {exact} visibility, {tri} triangle and "
+      f"{far} distance answers differ (distance tolerance 1e-4 relative)")
+PY
     echo "== modules_test on the GPU"
     LUCENT_TEST_BACKEND=cuda $R $B/bin/modules_test 2>&1 | tail -3
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs nodes variables exceptions validation occlusion whitted backend igi radiosity fog pathtracer; do
+    for t in programs nodes variables exceptions validation occlusion whitted backend igi radiosity fog pathtracer modules; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do

@@ -215,6 +215,9 @@ int main(int argc, char** argv) {
             std::printf("jit-check: megakernel compiled for sm_%d in %.0f ms%s\n",
                         args.options.jit_check_sm, report.jit_ms,
                         report.jit_cached ? " (from the cache)" : "");
+        else if (report.jit_ms > 0)  // the GPU compiled this module into its megakernel
+            std::printf("megakernel: %.1f ms, %s\n", report.jit_ms,
+                        report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile");
         std::printf("mesh: %s, %zu triangles\n",
                     args.mesh.empty() ? "built-in scene" : args.mesh.c_str(), mesh.indices.size());
         std::printf("image: %ux%u, %u samples per pixel, mean value %.4f\n", kWidth, kHeight,
