@@ -35,6 +35,7 @@ function(lucent_add_programs target)
 
   get_target_property(type ${target} TYPE)
   set(out_dir "${CMAKE_CURRENT_BINARY_DIR}/lucent_modules/${target}")
+  file(MAKE_DIRECTORY "${out_dir}")
   set(include_dirs "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
   foreach(header ${ARG_HEADERS})
     get_filename_component(header "${header}" ABSOLUTE)

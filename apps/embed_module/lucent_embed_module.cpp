@@ -7,6 +7,7 @@
 //
 // The generated file also includes the header, so the module's programs are compiled for
 // the CPU backend and registered with their module in the same target.
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -79,6 +80,10 @@ void write_if_changed(const std::string& path, const std::string& text) {
     std::ostringstream old;
     if (in) old << in.rdbuf();
     if (in && old.str() == text) return;  // unchanged: nothing downstream rebuilds
+    // Make's generators do not create an output's folder as Ninja does.
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!folder.empty()) std::filesystem::create_directories(folder, ec);
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out << text;
     if (!out) throw lucent::Error("cannot write " + path);
