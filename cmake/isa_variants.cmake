@@ -9,7 +9,7 @@
 # variants' objects in.
 #
 #   scalar  the build's own flags with the SIMD paths compiled out (LUCENT_ACCEL_SCALAR):
-#           any CPU; what accel_scalar_test's scalar.* tests run
+#           any CPU; what the tests accel_scalar.* run (tests/CMakeLists.txt)
 #   avx2    -march=x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C): Haswell, Zen 1 and
 #           later; the whole level rather than -mavx2 -mfma, as BMI's tzcnt and blsr are
 #           in every child-mask loop, and the dispatcher checks for the same level

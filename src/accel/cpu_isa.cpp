@@ -15,14 +15,14 @@ namespace {
 /// FMA, BMI1/2, LZCNT, MOVBE, F16C; x86-64-v4: v3 and AVX-512 F, VL, BW, DQ, CD), so the
 /// check is for the whole level. libgcc's check includes the OS's consent (XCR0) for the
 /// AVX and AVX-512 register state.
-bool cpu_has_level([[maybe_unused]] int level) {
-#if defined(__x86_64__) || defined(__i386__)
+[[maybe_unused]] bool cpu_has_level([[maybe_unused]] int level) {
+#if defined(__x86_64__)
     __builtin_cpu_init();  // in case the first query runs in a static constructor
-#if (defined(__clang__) && __clang_major__ >= 16) || (!defined(__clang__) && __GNUC__ >= 12)
+#if !defined(__clang__) && __GNUC__ >= 12
     return level == 3 ? __builtin_cpu_supports("x86-64-v3") : __builtin_cpu_supports("x86-64-v4");
 #else
-    // Older compilers lack the level names; these features imply the rest of each level
-    // on every CPU made.
+    // Compilers without the level names: these features imply the rest of each level on
+    // every CPU made.
     const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
                     __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
     if (level == 3) return v3;
