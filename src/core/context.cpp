@@ -8,6 +8,7 @@
 #include "core/backend.h"
 #include "lucent/device/tea.h"
 #include "core/context_state.h"
+#include "core/module_registry.h"
 #include "core/scene_compiler.h"
 #if LUCENT_HAVE_CUDA
 #include "cuda/cuda_backend.h"
@@ -274,10 +275,6 @@ void Context::set_print_launch_index(int x, int y, int z) {
 }
 
 // ---- program modules ------------------------------------------------------------------
-namespace detail {
-std::string known_module_names();
-}
-
 namespace {
 core::ContextModule* known_module(core::ContextState& state, const ModuleInfo* info) {
     for (core::ContextModule& m : state.modules)

@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 
+#include "core/module_registry.h"
 #include "lucent/error.h"
 #include "lucent/module.h"
 
@@ -111,7 +112,6 @@ const ModuleSource* embedded_module_source(std::string_view name) {
 }
 
 namespace detail {
-/// The names of this binary's modules, for messages ("a, b, c" or "none").
 std::string known_module_names() {
     Registry& r = registry();
     std::lock_guard lock(r.mutex);

@@ -1,5 +1,5 @@
-// Device-side sources compiled into the binary as text, for NVRTC: the device API headers,
-// the GPU runtime and traversal, and every sample's program module.
+// Device-side sources compiled into the library as text, for NVRTC: the device API headers
+// and the GPU runtime and traversal. Program modules bring their own (lucent/module.h).
 #pragma once
 
 #include <string_view>
@@ -13,8 +13,5 @@ struct EmbeddedSource {
 };
 
 const std::vector<EmbeddedSource>& embedded_sources();
-
-/// The source whose name equals `name` or ends with "/" + name, or null.
-const EmbeddedSource* find_embedded_source(std::string_view name);
 
 }  // namespace lucent::cuda

@@ -1,5 +1,5 @@
-// Generates the CUDA source of one megakernel for a compiled scene (OptiX paper §4-5;
-// docs/architecture.md): the engine's runtime and traversal, the program modules actually
+// Generates the CUDA source of one megakernel for a compiled scene (OptiX paper §4-5):
+// the engine's runtime and traversal, the program modules actually
 // bound, and switch statements that dispatch to them, specialised on what the scene uses.
 #pragma once
 
