@@ -5,7 +5,9 @@
 #include <fstream>
 
 #include "test_support.h"
+#include "tests/modules/undeclared_occlusion_programs.h"
 #include "tests/modules/unembedded_programs.h"
+#include "tests/programs/occlusion_programs.h"
 #include "tests/programs/twin_a_programs.h"
 #include "tests/programs/twin_b_programs.h"
 
@@ -258,6 +260,28 @@ TEST(Modules, NvrtcErrorsNameTheModulesFileAndLine) {
     ctx.add_module(ModuleSource::from_file(path));
     expect_error([&] { run_fill(ctx); }, {"broken_programs.h(4)", "not_a_type"},
                  "an NVRTC error");
+}
+
+TEST(Modules, OccludedWithoutItsDeclarationIsRefusedOnTheCpuToo) {
+    ContextOptions cpu_only;
+    cpu_only.backend = BackendKind::kCpu;
+    Context ctx(cpu_only);
+    ctx.set_entry_point_count(1);
+    ctx.set_ray_type<TestPayload>(0, "radiance");
+    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_occlusion::shadow_probe));
+    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
+    (*probe)["out"] = out;
+    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
+    (*probe)["top"] = make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
+    ctx.set_ray_generation_program(0, probe);
+    expect_error([&] { ctx.launch(0, 1); }, {"occluded()", "kUsesOccluded"},
+                 "occluded() from an undeclared module on the CPU");
+    // Once a bound module declares it (the megakernel-wide rule the GPU follows), the call
+    // runs: the square blocks the probe.
+    material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
+    ctx.launch(0, 1);
+    EXPECT_EQ(read_buffer<unsigned>(*out)[0], 1u);
 }
 
 TEST(Modules, OccludedWithoutItsDeclarationDoesNotCompileForTheGpu) {

@@ -129,6 +129,9 @@ struct CompiledScene {
     bool print_enabled = false;
     int3 print_index{-1, -1, -1};
     std::vector<int> enabled_exceptions;  // codes whose exception program runs
+    /// Some bound program's module declares kUsesOccluded: occluded() may be called (the
+    /// GPU's megakernel has its occlusion path only then, and the CPU refuses it otherwise).
+    bool uses_occluded = false;
     /// Module texts given to the Context at run time (the GPU backend's JIT reads them
     /// before the texts embedded in the binary).
     std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>> module_sources;

@@ -83,6 +83,9 @@ CompiledProgram SceneCompiler::pack(const std::shared_ptr<Program>& program,
 
     const RecordInfo& info = *program->desc().record;
     out.desc = &program->desc();
+    // occluded() is there only when a module declares it: the same rule on both backends.
+    const ModuleInfo* module = out.desc->module;
+    m_scene->uses_occluded = m_scene->uses_occluded || (module && module->uses(kUsesOccluded));
     out.label = program->describe() + (owner.empty() ? "" : " of " + owner);
     out.record = std::make_shared<PackedRecord>();
     out.record->resize(info.size);

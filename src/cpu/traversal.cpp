@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "cpu/cpu_state.h"
+#include "lucent/error.h"
 #include "lucent/device/triangle_intersect.h"
 
 namespace lucent::cpu {
@@ -385,6 +386,9 @@ void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const vo
 
 bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
     const CompiledScene& scene = *ts.scene;
+    if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
+        throw Error("occluded() is called, but no module of this scene declares it; declare "
+                    "it in the module that calls it: LUCENT_MODULE(name, lucent::kUsesOccluded)");
     if (ray.ray_type >= scene.ray_types.size())
         throw ProgramException{kExceptionInvalidRayType, ray.ray_type};
     if (root.index >= scene.nodes.size())

@@ -34,6 +34,7 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
     shape.attribute_bytes = unsigned((attributes + 15) / 16 * 16);
     shape.exceptions = !scene.enabled_exceptions.empty();
     shape.print = scene.print_enabled;
+    shape.occlusion = scene.uses_occluded;
     shape.max_depth = scene.max_depth;
     return shape;
 }
@@ -181,12 +182,6 @@ ModuleSourceList bound_module_sources(
 
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
                                 const ModuleSourceList& modules) {
-    // The GPU traversal keeps occluded()'s early exit only when a module declares it.
-    bool occlusion = false;
-    for (size_t k = 0; k <= size_t(ProgramKind::kCallable); ++k)
-        for (const ProgramDesc* desc : table.programs(ProgramKind(k)))
-            occlusion = occlusion || (desc->module && desc->module->uses(kUsesOccluded));
-
     std::ostringstream out;
     out << "// Lucent megakernel: generated for one scene shape; do not edit.\n"
         << "#define LUCENT_GPU_GROUPS " << shape.groups << "\n"
@@ -196,7 +191,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
         << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
         << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
-        << "#define LUCENT_GPU_OCCLUSION " << occlusion << "\n"
+        << "#define LUCENT_GPU_OCCLUSION " << shape.occlusion << "\n"
         << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
         << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
         << "#include \"lucent_gpu/runtime.cuh\"\n"

@@ -37,6 +37,7 @@ struct KernelShape {
     bool triangle_groups = false;   // some group is made only of triangles (GPU triangle BVH)
     bool exceptions = false;        // any exception enabled (else bounds checks are compiled out)
     bool print = false;
+    bool occlusion = false;  // some bound module declares kUsesOccluded
     unsigned max_depth = 1;
     unsigned attribute_bytes = 16;
 };
