@@ -245,7 +245,6 @@ TEST(Modules, AModuleWithoutTextRunsOnTheCpuAndTheJitSaysHowToGiveIt) {
     Context given(megakernel_options());
     given.add_module(ModuleSource::from_file(kUnembeddedPath));
     EXPECT_EQ(run_fill(given), (std::vector<unsigned>{1, 8, 15, 22}));
-    EXPECT_GT(given.last_launch().jit_ms, 0.0);
 }
 
 TEST(Modules, NvrtcErrorsNameTheModulesFileAndLine) {

@@ -23,12 +23,6 @@ Registry& registry() {
     return r;
 }
 
-std::string module_names(const Registry& r) {
-    std::string names;
-    for (auto& [name, info] : r.modules) names += (names.empty() ? "" : ", ") + name;
-    return names.empty() ? "none" : names;
-}
-
 }  // namespace
 
 std::vector<const ProgramDesc*> ModuleInfo::programs() const {
@@ -113,9 +107,10 @@ const ModuleSource* embedded_module_source(std::string_view name) {
 
 namespace detail {
 std::string known_module_names() {
-    Registry& r = registry();
-    std::lock_guard lock(r.mutex);
-    return module_names(r);
+    std::string names;
+    for (const ModuleInfo* module : modules())
+        names += (names.empty() ? "" : ", ") + std::string(module->name());
+    return names.empty() ? "none" : names;
 }
 }  // namespace detail
 

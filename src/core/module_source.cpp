@@ -39,7 +39,7 @@ class Collector {
     /// Adds `path` (absolute, normal) with `text`: its quoted includes are resolved,
     /// rewritten to their absolute names and collected in turn.
     void add(const fs::path& path, const std::string& text) {
-        m_seen.insert(path.string());
+        m_seen.insert(path.string());  // the main file; an included one is marked when found
         size_t slot = m_out.files.size();
         m_out.files.emplace_back(path.string(), std::string());
         static const std::regex include_line(R"(^(\s*#\s*include\s*")([^"]+)(".*)$)");
@@ -51,19 +51,14 @@ class Collector {
             if (std::regex_match(line, m, include_line) && !is_lucent_header(m[2].str())) {
                 fs::path found = resolve(path, m[2].str(), number);
                 line = m[1].str() + found.string() + m[3].str();
-                if (!m_seen.count(found.string())) {
-                    m_seen.insert(found.string());
+                if (m_seen.insert(found.string()).second)
                     pending.emplace_back(found, path.string() + ":" + std::to_string(number));
-                }
             }
             rewritten += line;
             rewritten += '\n';
         }
         m_out.files[slot].second = std::move(rewritten);
-        for (auto& [file, from] : pending) {
-            m_seen.erase(file.string());  // add() marks it again
-            add(file, read_text(file, from));
-        }
+        for (auto& [file, from] : pending) add(file, read_text(file, from));
     }
 
   private:
