@@ -1,4 +1,4 @@
-// The kernel cache (ARCHITECTURE §4): a hit loads the stored CUBIN; a corrupt or stale
+// The kernel cache (docs/architecture.md, "The CUDA backend"): a hit loads the stored CUBIN; a corrupt or stale
 // entry is detected, never loaded, and rebuilt. Needs NVRTC, not a GPU.
 #include <gtest/gtest.h>
 

@@ -467,8 +467,8 @@ TEST_F(AnyHitTest, AnyHitSeesTheCandidatesBarycentricsForCutouts) {
 }
 
 TEST_F(AnyHitTest, AnyHitSeesAttributeProgramAttributes) {
-    // Attributes of an attribute program reach any-hit too (ARCHITECTURE: "run once for
-    // the closest hit and for each any-hit candidate").
+    // Attributes of an attribute program reach any-hit too (the attribute program runs once for
+    // the closest hit and once for each any-hit candidate).
     const std::vector<uint3> indices = {make_uint3(0, 1, 2)};
     auto triangles = make_triangles(
         ctx, {make_float3(0, 0, 2), make_float3(1, 0, 2), make_float3(0, 1, 2)}, indices);

@@ -1,4 +1,4 @@
-// Validation (ARCHITECTURE §2, §3): every wrong scene is rejected by validate() and by
+// Validation (docs/architecture.md, "Scene compile"): every wrong scene is rejected by validate() and by
 // launch() with a lucent::Error that names the object and says what to do; wrong API
 // calls throw at the call. Words are matched case-insensitively.
 #include <limits>
@@ -69,7 +69,7 @@ TEST_F(ValidationTest, MaterialWithoutClosestHitForAReachingRayTypeIsRejected) {
 }
 
 TEST_F(ValidationTest, RayTypeThatDoesNotExpectClosestHitAcceptsAnyHitOnlyMaterial) {
-    // Visibility rays work through any-hit and miss (ARCHITECTURE: expects_closest_hit).
+    // Visibility rays work through any-hit and miss (RayTypeDesc::expects_closest_hit false).
     ctx.set_ray_type<TestPayload>(0, "visibility", /*expects_closest_hit=*/false);
     auto material = ctx.create_material();
     material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(vat_anyhit_count)));

@@ -1,4 +1,4 @@
-// Variables (OptiX paper §3.2, ARCHITECTURE §2): the scope order each program kind
+// Variables (OptiX paper §3.2): the scope order each program kind
 // resolves its record through, a field of every FieldKind, and changes between launches.
 //
 // Scope order (innermost first):

@@ -56,8 +56,7 @@ class DisplayFrame {
 /// An OpenGL 2D texture that device display frames are copied into with CUDA–OpenGL
 /// interop (registered with the GPU of the first frame, again when a frame comes from
 /// another GPU), by a kernel writing through a surface: the draw then reads the texture
-/// with no further copy. (Copies by the copy engine, into a registered buffer object or
-/// into the texture's array, measured 0.33 ms per 1920x1080 frame on an H200.) Every call
+/// with no further copy (the copy engine's paths were slower: docs/performance.md). Every call
 /// needs the OpenGL context that owns the texture current on the calling thread, on the
 /// same GPU as the frames. Throws lucent::Error when that cannot be done (no CUDA, an
 /// OpenGL driver of another vendor): callers then upload rgba().

@@ -22,9 +22,9 @@ enum class Builder {
     kBinnedSah,  // binned SAH (Wald 2007): best traversal, rebuilt when marked dirty
     kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)
     // Triangles that change every frame: on the CUDA backend the BVH is built on the GPU
-    // (H-PLOC, Benthin et al. 2024; 0.3 ms for Sponza on an H200, traversal at 0.85-1.05x
-    // the binned-SAH tree's speed) and, with set_refit(true), refitted there; the host
-    // builds nothing for it unless a CPU device traces the scene too. Elsewhere: binned SAH.
+    // (H-PLOC, Benthin et al. 2024; build and trace figures in docs/performance.md) and,
+    // with set_refit(true), refitted there; the host builds nothing for it unless a CPU
+    // device traces the scene too. Elsewhere: binned SAH.
     kGpuHploc,
 };
 

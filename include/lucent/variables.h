@@ -1,6 +1,6 @@
 // Variables: values set by name on a scope (Context, Program, GeometryInstance, Material,
 // Geometry), resolved into each program's record when the scene is compiled, in the
-// OptiX scope order (paper §3; ARCHITECTURE §2).
+// OptiX scope order (OptiX paper §3.2).
 #pragma once
 
 #include <cstring>

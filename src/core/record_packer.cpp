@@ -1,4 +1,4 @@
-// Variable resolution and record packing (ARCHITECTURE §3): each field of a program's
+// Variable resolution and record packing (docs/architecture.md, "Scene compile"): each field of a program's
 // record is looked up by name through its scope chain at compile time and written into
 // the record, so programs never look a variable up at run time.
 #include <cstring>

@@ -1,4 +1,4 @@
-// The CUDA backend (ARCHITECTURE §4): at launch, if the compiled scene changed shape,
+// The CUDA backend (docs/architecture.md, "The CUDA backend"): at launch, if the compiled scene changed shape,
 // generate the megakernel, compile it with NVRTC (or load it from the disk cache), load it
 // with the driver API and run it with persistent threads.
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Gradient noise from TEA hashes (Perlin 1985, with the quintic fade of Perlin 2002; TEA as
-// its hash after Zafar et al. 2010 and Sebald, seed §3.2). Device code: g++, nvcc and NVRTC.
+// its hash after Zafar et al. 2010 and Sebald, §3.2). Device code: g++, nvcc and NVRTC.
 #pragma once
 
 #include "lucent/device/tea.h"

@@ -1,5 +1,5 @@
 // TEA, the Tiny Encryption Algorithm (Wheeler and Needham 1994), as a pseudorandom number
-// generator (Zafar et al. 2010; Sebald, seed §3.2), and per-device keys (Sebald, Fig. 4).
+// generator (Zafar et al. 2010; Sebald, §3.2), and per-device keys (Sebald, Fig. 4).
 // Device code: compiles with g++, nvcc and NVRTC.
 #pragma once
 

@@ -18,7 +18,7 @@
 // traversal"): boxes are only ever entered too often, never missed.
 //
 // The file compiles with g++ (host: the layout constants, and the same traversal run on
-// the CPU to check the layout, ARCHITECTURE "one CPU traversal per layout") and with NVRTC.
+// the CPU to check the layout: every layout has a CPU traversal checked against brute force) and with NVRTC.
 #pragma once
 
 #include "lucent/device/platform.h"
