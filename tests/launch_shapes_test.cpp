@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "cuda/launch_shapes.h"
+#include "cuda/backend/launch_shapes.h"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include "tests/programs/multi_device_programs.h"
 #include "tests/test_support.h"
 #if LUCENT_HAVE_CUDA
-#include "cuda/cuda_backend.h"
+#include "cuda/backend/cuda_backend.h"
 #endif
 
 namespace lucent_tests {
