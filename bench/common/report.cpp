@@ -18,7 +18,8 @@ Json rate_json(const Rate& rate) {
 }
 
 std::string json_text(const Json& document) {
-    return document.dump(2) + "\n";
+    // A path need not be UTF-8: its invalid bytes become U+FFFD rather than an exception.
+    return document.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 void print_json(const Json& document) {

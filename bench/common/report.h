@@ -21,7 +21,8 @@ double rounded(double value, int decimals);
 /// {"mrays": median, "min": .., "max": ..}, each to 4 places.
 Json rate_json(const Rate& rate);
 
-/// The document as printed: two-space indents, one key per line, then a newline.
+/// The document as printed: two-space indents, one key per line, then a newline; bytes
+/// of a string that are not UTF-8 are written as U+FFFD.
 std::string json_text(const Json& document);
 
 /// Writes json_text(document) to stdout.
