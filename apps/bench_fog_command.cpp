@@ -1,9 +1,9 @@
 // `lucent bench fog`: turns flags into FogBenchOptions; the measuring is in bench/fog.
 #include "bench_fog_command.h"
 
+#include "bench/fog/fog_bench.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
-#include "bench/fog/fog_bench.h"
 
 namespace lucent::cli {
 

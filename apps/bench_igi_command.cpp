@@ -1,9 +1,9 @@
 // `lucent bench igi`: turns flags into IgiBenchOptions; the measuring is in bench/igi.
 #include "bench_igi_command.h"
 
+#include "bench/igi/igi_bench.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
-#include "bench/igi/igi_bench.h"
 
 namespace lucent::cli {
 

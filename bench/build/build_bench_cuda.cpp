@@ -88,8 +88,8 @@ void print_text(const CudaBuildResult& r) {
     std::printf(
         "GPU build (%s) %.3f ms (min %.3f, max %.3f) %.1f Mtris/s sah=%.3f nodes=%zu depth=%u "
         "(GPU time of its kernels; the mesh upload %.2f ms is apart)\n",
-        r.hploc.builder, ms, r.gpu_ms.min, r.gpu_ms.max, r.triangles / ms * 1e-3,
-        r.hploc.sah_cost, r.hploc.node_count, r.hploc.depth, r.mesh_upload_ms);
+        r.hploc.builder, ms, r.gpu_ms.min, r.gpu_ms.max, r.triangles / ms * 1e-3, r.hploc.sah_cost,
+        r.hploc.node_count, r.hploc.depth, r.mesh_upload_ms);
     std::printf("GPU refit %.3f ms\n", r.refit_ms);
     std::printf(
         "host build (binned SAH + layout + upload) %.2f ms %.2f Mtris/s sah=%.3f nodes=%zu "
@@ -101,8 +101,8 @@ void print_text(const CudaBuildResult& r) {
         return;
     }
     const TreeRates &a = r.rates_hploc, &b = r.rates_sah;
-    std::printf("rays %ux%u (BENCH.md sets), Mrays/s, GPU-built tree / host SAH tree:\n",
-                in.width, in.height);
+    std::printf("rays %ux%u (BENCH.md sets), Mrays/s, GPU-built tree / host SAH tree:\n", in.width,
+                in.height);
     std::printf("primary %.2f / %.2f (%.3fx)\n", a.primary.median, b.primary.median,
                 bench::median_ratio(a.primary, b.primary));
     std::printf("shadow %.2f / %.2f (%.3fx)\n", a.shadow.median, b.shadow.median,
@@ -209,8 +209,7 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
     result.host_ms = bench::median_of(host_ms);
     result.host = sah_bvh.stats;
 
-    if (in.camera && result.triangles > 0)
-        compare_trees(api, ctx, in, sah_bvh, sah, hploc, result);
+    if (in.camera && result.triangles > 0) compare_trees(api, ctx, in, sah_bvh, sah, hploc, result);
     bench::report(result, in.json);
     return 0;
 }

@@ -39,12 +39,9 @@ Json to_json(const FogResult& result) {
                             {"median_ms", rounded(r.median_ms, 4)},
                             {"min_ms", rounded(r.min_ms, 4)},
                             {"max_ms", rounded(r.max_ms, 4)}});
-    return Json{{"benchmark", "fog"},
-                {"backend", result.rows[0].backend},
-                {"width", options.width},
-                {"height", options.height},
-                {"frames", options.frames},
-                {"rows", rows}};
+    return Json{{"benchmark", "fog"},       {"backend", result.rows[0].backend},
+                {"width", options.width},   {"height", options.height},
+                {"frames", options.frames}, {"rows", rows}};
 }
 
 void print_text(const FogResult& result) {

@@ -37,18 +37,17 @@ GpuBvhBuildOptions gpu_build_options() {
 CompileResult compile_trace_kernels(int sm, bool persistent) {
     // --fmad=false: ray generation rounds each operation as the host does; traversal and the
     // watertight test already spell out every fused multiply-add they use (fmaf).
-    CompileRequest req =
-        bench_kernel_request("lucent_bench_kernels.cu",
-                             "#include \"lucent_bench/trace_kernels.cuh\"\n",
-                         {"--std=c++17", "--fmad=false",
-                          "-DLUCENT_BENCH_PERSISTENT=" + std::string(persistent ? "1" : "0")},
-                         sm);
+    CompileRequest req = bench_kernel_request(
+        "lucent_bench_kernels.cu", "#include \"lucent_bench/trace_kernels.cuh\"\n",
+        {"--std=c++17", "--fmad=false",
+         "-DLUCENT_BENCH_PERSISTENT=" + std::string(persistent ? "1" : "0")},
+        sm);
     add_options_from_env(req, "LUCENT_BENCH_NVRTC_OPTIONS");
     return compile_cubin(req);
 }
 
 RayBench::RayBench(const DriverApi& api, const ContextScope& ctx, const RaySetsSpec& spec)
-: m_api(api), m_in(spec), m_start(api), m_stop(api) {
+    : m_api(api), m_in(spec), m_start(api), m_stop(api) {
     sm = ctx.sm();
     sm_count = ctx.attribute(CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT);
     k.persistent = env_flag("LUCENT_BENCH_PERSISTENT", true);

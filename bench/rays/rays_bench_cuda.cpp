@@ -215,8 +215,8 @@ Json to_json(const CudaRaysResult& r) {
         {"bvh_nodes", r.binary_stats.node_count},
         {"sah_cost", rounded(r.binary_stats.sah_cost, 4)},
         {"lucent", Json{{"primary", primary}, {"shadow", shadow}, {"diffuse", diffuse}}},
-        {"cpu", Json{{"primary", Json{{"hits", r.cpu.sums.primary_hits},
-                                      {"sum_t", r.cpu.sums.primary_sum_t}}},
+        {"cpu", Json{{"primary",
+                      Json{{"hits", r.cpu.sums.primary_hits}, {"sum_t", r.cpu.sums.primary_sum_t}}},
                      {"shadow", Json{{"occluded", r.cpu.sums.occluded}}},
                      {"diffuse", Json{{"hits", r.cpu.sums.diffuse_hits},
                                       {"sum_t", r.cpu.sums.diffuse_sum_t}}}}},
@@ -224,18 +224,17 @@ Json to_json(const CudaRaysResult& r) {
                                 {"shadow", r.cpu.differ_shadow},
                                 {"diffuse", r.cpu.differ_diffuse}}},
         {"checksums_agree", r.differences.empty()},
-        {"cwbvh",
-         Json{{"nodes", r.cwbvh_stats.node_count},
-              {"node_mb", rounded(r.cwbvh_mb, 4)},
-              {"binary_node_mb", rounded(r.binary_mb, 4)},
-              {"build_ms", rounded(r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms, 3)},
-              {"primary", rate_json(r.cwbvh.primary)},
-              {"shadow", rate_json(r.cwbvh.shadow)},
-              {"diffuse", rate_json(r.cwbvh.diffuse)},
-              {"rays_differing_from_binary",
-               Json{{"primary", d.primary}, {"shadow", d.shadow}, {"diffuse", d.diffuse}}},
-              {"distances_differing_from_binary",
-               Json{{"primary", d.primary_t}, {"diffuse", d.diffuse_t}}}}}};
+        {"cwbvh", Json{{"nodes", r.cwbvh_stats.node_count},
+                       {"node_mb", rounded(r.cwbvh_mb, 4)},
+                       {"binary_node_mb", rounded(r.binary_mb, 4)},
+                       {"build_ms", rounded(r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms, 3)},
+                       {"primary", rate_json(r.cwbvh.primary)},
+                       {"shadow", rate_json(r.cwbvh.shadow)},
+                       {"diffuse", rate_json(r.cwbvh.diffuse)},
+                       {"rays_differing_from_binary",
+                        Json{{"primary", d.primary}, {"shadow", d.shadow}, {"diffuse", d.diffuse}}},
+                       {"distances_differing_from_binary",
+                        Json{{"primary", d.primary_t}, {"diffuse", d.diffuse_t}}}}}};
 }
 
 void print_text(const CudaRaysResult& r) {
@@ -251,17 +250,17 @@ void print_text(const CudaRaysResult& r) {
     std::printf("build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u)\n",
                 r.binary_stats.build_ms, r.binary_stats.convert_ms, r.binary_stats.sah_cost,
                 r.binary_stats.node_count, r.binary_stats.leaf_count, r.binary_stats.depth);
-    std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(b.primary).c_str(),
-                gpu.primary_hits, gpu.primary_sum_t);
-    std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(b.shadow).c_str(),
-                gpu.shadow_rays, gpu.occluded);
+    std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(b.primary).c_str(), gpu.primary_hits,
+                gpu.primary_sum_t);
+    std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(b.shadow).c_str(), gpu.shadow_rays,
+                gpu.occluded);
     std::printf("diffuse %s rays=%zu hits=%zu sum_t=%.6e\n", rate_text(b.diffuse).c_str(),
                 gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t);
-    std::printf("compressed wide layout (cwbvh): %zu nodes, %.2f MB of nodes (binary %.2f MB), "
-                "build %.1f ms; %s\n",
-                r.cwbvh_stats.node_count, r.cwbvh_mb, r.binary_mb,
-                r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms,
-                r.kernels.describe_cwbvh.c_str());
+    std::printf(
+        "compressed wide layout (cwbvh): %zu nodes, %.2f MB of nodes (binary %.2f MB), "
+        "build %.1f ms; %s\n",
+        r.cwbvh_stats.node_count, r.cwbvh_mb, r.binary_mb,
+        r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms, r.kernels.describe_cwbvh.c_str());
     std::printf("cwbvh primary %s (%.3fx binary)\n", rate_text(cw.primary).c_str(),
                 bench::median_ratio(cw.primary, b.primary));
     std::printf("cwbvh shadow %s (%.3fx binary)\n", rate_text(cw.shadow).c_str(),
@@ -269,10 +268,11 @@ void print_text(const CudaRaysResult& r) {
     std::printf("cwbvh diffuse %s (%.3fx binary)\n", rate_text(cw.diffuse).c_str(),
                 bench::median_ratio(cw.diffuse, b.diffuse));
     const LayoutDifferences& d = r.cwbvh_vs_binary;
-    std::printf("cwbvh results differing from the binary layout's: primary %zu, shadow %zu, "
-                "diffuse %zu; of them another distance: primary %zu, diffuse %zu (the rest: "
-                "another triangle at the same distance)\n",
-                d.primary, d.shadow, d.diffuse, d.primary_t, d.diffuse_t);
+    std::printf(
+        "cwbvh results differing from the binary layout's: primary %zu, shadow %zu, "
+        "diffuse %zu; of them another distance: primary %zu, diffuse %zu (the rest: "
+        "another triangle at the same distance)\n",
+        d.primary, d.shadow, d.diffuse, d.primary_t, d.diffuse_t);
     std::printf(
         "cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
         "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",

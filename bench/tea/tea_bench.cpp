@@ -102,8 +102,10 @@ void print_text(const TeaResult& r) {
 int run_tea_bench(const TeaBenchOptions& options) {
     Context ctx(ContextOptions{options.backend, options.threads});
     ctx.set_entry_point_count(3);
-    ctx.set_ray_generation_program(0, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_fixed_key)));
-    ctx.set_ray_generation_program(1, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_device_key)));
+    ctx.set_ray_generation_program(0,
+                                   ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_fixed_key)));
+    ctx.set_ray_generation_program(1,
+                                   ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_device_key)));
     ctx.set_ray_generation_program(2, ctx.create_program(LUCENT_PROGRAM(tea_sample::tea_copy)));
     auto out = ctx.create_buffer<uint2>(BufferType::kOutput, kBlocksPerMegabyte);
     auto first_block = ctx.create_buffer<unsigned>(BufferType::kInput, 1);

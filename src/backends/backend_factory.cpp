@@ -47,8 +47,8 @@ std::unique_ptr<Backend> make_backend(const ContextOptions& options, std::string
             names.push_back(device_spec_name(device));
         }
         const unsigned count = unsigned(devices.size());
-        return make_multi_device_backend(std::move(devices), std::move(names),
-                                         options.piece_rows, worker_pool(count));
+        return make_multi_device_backend(std::move(devices), std::move(names), options.piece_rows,
+                                         worker_pool(count));
     }
     if (options.backend != BackendKind::kCpu) {
 #if LUCENT_HAVE_CUDA

@@ -73,8 +73,8 @@ void CudaGlTexture::copy_from(const DisplayFrame& frame) {
     ScopedContext scope(*d, device_frame->context());
     const DriverApi& api = *d;
     if (!resource) {
-        const CUresult r = api.cuGraphicsGLRegisterImage(
-            &resource, m_gl_texture, kGlTexture2D, CU_GRAPHICS_REGISTER_FLAGS_WRITE_DISCARD);
+        const CUresult r = api.cuGraphicsGLRegisterImage(&resource, m_gl_texture, kGlTexture2D,
+                                                         CU_GRAPHICS_REGISTER_FLAGS_WRITE_DISCARD);
         if (r != CUDA_SUCCESS) {
             resource = nullptr;
             const char* s = nullptr;
