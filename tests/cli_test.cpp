@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "samples/sample.h"
@@ -315,6 +316,69 @@ TEST_F(CliTest, BenchJsonOfAScenePathWithQuotesParsesBack) {
 }
 
 namespace {
+
+/// Every key path of a JSON document ("/rows[]/stage_ms"), arrays by their first element.
+void collect_key_paths(const nlohmann::json& node, const std::string& path,
+                       std::set<std::string>& out) {
+    if (node.is_object()) {
+        for (const auto& [key, value] : node.items()) {
+            out.insert(path + "/" + key);
+            collect_key_paths(value, path + "/" + key, out);
+        }
+    } else if (node.is_array() && !node.empty()) {
+        collect_key_paths(node.front(), path + "[]", out);
+    }
+}
+
+std::set<std::string> key_paths(const nlohmann::json& document) {
+    std::set<std::string> paths;
+    collect_key_paths(document, "", paths);
+    return paths;
+}
+
+std::string missing_from(const std::set<std::string>& a, const std::set<std::string>& b) {
+    std::string missing;
+    for (const std::string& key : a)
+        if (!b.count(key)) missing += " " + key;
+    return missing;
+}
+
+nlohmann::json recorded_result(const std::string& name) {
+    std::ifstream file(std::string(LUCENT_TESTS_DIR) + "/../docs/bench/" + name);
+    return nlohmann::json::parse(file);
+}
+
+// The JSON results keep the field names of the results recorded in docs/bench, which
+// scripts read: the same keys, at the same places.
+TEST(CliBenchJson, FogAndIgiKeepTheRecordedFieldNames) {
+    CliRun run = run_cli("bench fog --size 16x12 --frames 1 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::set<std::string> now = key_paths(nlohmann::json::parse(run.output));
+    std::set<std::string> recorded = key_paths(recorded_result("fog-cuda.json"));
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+
+    run = run_cli("bench igi --size 16x12 --frames 1 --vpls 4 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    now = key_paths(nlohmann::json::parse(run.output));
+    recorded = key_paths(recorded_result("igi-cuda-sponza.json"));
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+}
+
+TEST(CliBenchJson, RaysKeepsTheRecordedFieldNames) {
+    const std::string scene = std::string(LUCENT_SCENES_DIR) + "/bunny.obj";
+    if (!fs::exists(scene)) GTEST_SKIP() << scene << " is not here";
+    CliRun run = run_cli("bench rays --scene '" + scene + "' --size 32x24 --repeat 1 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json result = nlohmann::json::parse(run.output);
+    std::set<std::string> now = key_paths(result);
+    std::set<std::string> recorded = key_paths(recorded_result("rays-cpu-bunny.json"));
+    recorded.insert("/cpu_isa");  // added after that record was made
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    if (result.contains("embree"))  // a build with the peer gives every recorded field
+        EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+}
 
 // `lucent bench present` opens OpenGL through EGL without a window (Mesa's software device
 // here), shows frames the way `lucent view` does and reads the framebuffer back.
