@@ -3,12 +3,13 @@
 
 #include <filesystem>
 
-#include "bench/bench_commands.h"
+#include "bench/build/build_bench.h"
+#include "bench/rays/rays_bench.h"
+#include "bench/tea/tea_bench.h"
 #include "cli_parse.h"
 #include "lucent/context.h"
 #include "lucent/error.h"
 #include "progress_bar.h"
-#include "samples/tea/tea_bench.h"
 
 namespace lucent::cli {
 namespace {
@@ -197,7 +198,7 @@ int run_bench_build_command(const BenchBuildArgs& args) {
 }
 
 int run_bench_tea_command(const BenchTeaArgs& args) {
-    samples::TeaBenchOptions options;
+    bench::TeaBenchOptions options;
     options.backend = parse_backend("--backend", args.backend);
     options.threads = args.threads;
     options.megabytes = args.megabytes;
@@ -205,7 +206,7 @@ int run_bench_tea_command(const BenchTeaArgs& args) {
     options.device = args.device;
     options.seed = args.seed;
     options.json = args.json;
-    return run_with_progress_bar("bench tea", "MB", options, samples::run_tea_bench);
+    return run_with_progress_bar("bench tea", "MB", options, bench::run_tea_bench);
 }
 
 }  // namespace lucent::cli

@@ -1,4 +1,5 @@
-// `lucent bench rays` and `lucent bench build`: command-line front of bench/bench_commands.h.
+// `lucent bench rays`, `bench build` and `bench tea`: the command-line front of
+// bench/rays/rays_bench.h, bench/build/build_bench.h and bench/tea/tea_bench.h.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -1,9 +1,9 @@
-// `lucent bench fog`: turns flags into FogBenchOptions; the measuring is in samples/fog.
+// `lucent bench fog`: turns flags into FogBenchOptions; the measuring is in bench/fog.
 #include "bench_fog_command.h"
 
+#include "bench/fog/fog_bench.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
-#include "samples/fog/fog_bench.h"
 
 namespace lucent::cli {
 
@@ -33,7 +33,7 @@ CLI::App* add_bench_fog_command(CLI::App* bench, BenchFogArgs& args) {
 }
 
 int run_bench_fog_command(const BenchFogArgs& args) {
-    samples::FogBenchOptions options;
+    bench::FogBenchOptions options;
     options.backend = parse_backend("--backend", args.backend);
     options.devices = parse_devices("--devices", args.devices);
     options.threads = args.threads;
@@ -42,7 +42,7 @@ int run_bench_fog_command(const BenchFogArgs& args) {
     options.height = size.height;
     options.frames = args.frames;
     options.json = args.json;
-    return run_with_progress_bar("bench fog", "frames", options, samples::run_fog_bench);
+    return run_with_progress_bar("bench fog", "frames", options, bench::run_fog_bench);
 }
 
 }  // namespace lucent::cli

@@ -1,4 +1,4 @@
-// `lucent bench fog`: command-line front of samples/fog/fog_bench.h.
+// `lucent bench fog`: command-line front of bench/fog/fog_bench.h.
 #pragma once
 
 #include <CLI/CLI.hpp>

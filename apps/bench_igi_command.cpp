@@ -1,9 +1,9 @@
-// `lucent bench igi`: turns flags into IgiBenchOptions; the measuring is in samples/igi.
+// `lucent bench igi`: turns flags into IgiBenchOptions; the measuring is in bench/igi.
 #include "bench_igi_command.h"
 
+#include "bench/igi/igi_bench.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
-#include "samples/igi/igi_bench.h"
 
 namespace lucent::cli {
 
@@ -56,7 +56,7 @@ CLI::App* add_bench_igi_command(CLI::App* bench, BenchIgiArgs& args) {
 }
 
 int run_bench_igi_command(const BenchIgiArgs& args) {
-    samples::IgiBenchOptions options;
+    bench::IgiBenchOptions options;
     options.scene = args.scene;
     options.backend = parse_backend("--backend", args.backend);
     options.devices = parse_devices("--devices", args.devices);
@@ -70,7 +70,7 @@ int run_bench_igi_command(const BenchIgiArgs& args) {
     options.interleave = args.interleave;
     options.reflection_layer = args.reflection_layer != 0;
     options.json = args.json;
-    return run_with_progress_bar("bench igi", "configurations", options, samples::run_igi_bench);
+    return run_with_progress_bar("bench igi", "configurations", options, bench::run_igi_bench);
 }
 
 }  // namespace lucent::cli

@@ -1,4 +1,4 @@
-// `lucent bench igi`: command-line front of samples/igi/igi_bench.h.
+// `lucent bench igi`: command-line front of bench/igi/igi_bench.h.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -1,5 +1,5 @@
 // `lucent bench present`: turns flags into PresentBenchOptions; the measuring is in
-// apps/present (built with OpenGL and EGL).
+// bench/present (built with OpenGL and EGL).
 #include "bench_present_command.h"
 
 #include "cli_parse.h"
@@ -7,7 +7,7 @@
 #include "progress_bar.h"
 #include "samples/sample.h"
 #ifdef LUCENT_HAVE_PRESENT
-#include "present/present_bench.h"
+#include "bench/present/present_bench.h"
 #endif
 
 namespace lucent::cli {
@@ -42,7 +42,7 @@ CLI::App* add_bench_present_command(CLI::App* bench, BenchPresentArgs& args) {
 
 int run_bench_present_command(const BenchPresentArgs& args) {
 #ifdef LUCENT_HAVE_PRESENT
-    viewer::PresentBenchOptions options;
+    bench::PresentBenchOptions options;
     options.sample = samples::find_sample(args.sample).name;
     options.backend = parse_backend("--backend", args.backend);
     options.threads = args.threads;
@@ -51,7 +51,7 @@ int run_bench_present_command(const BenchPresentArgs& args) {
     options.height = size.height;
     options.frames = args.frames;
     options.json = args.json;
-    return run_with_progress_bar("bench present", "frames", options, viewer::run_present_bench);
+    return run_with_progress_bar("bench present", "frames", options, bench::run_present_bench);
 #else
     (void)args;
     throw Error(

@@ -1,4 +1,4 @@
-// `lucent bench present`: command-line front of apps/present/present_bench.h.
+// `lucent bench present`: command-line front of bench/present/present_bench.h.
 #pragma once
 
 #include <CLI/CLI.hpp>

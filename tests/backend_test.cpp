@@ -4,7 +4,7 @@
 
 #include "lucent/context.h"
 #if LUCENT_HAVE_CUDA
-#include "cuda/driver_api.h"
+#include "cuda/backend/driver_api.h"
 #endif
 
 namespace {

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "samples/sample.h"
@@ -223,13 +225,19 @@ namespace {
 TEST(CliBenchIgi, RunsEveryConfigurationForEveryVplCount) {
     CliRun run = run_cli("bench igi --size 32x24 --frames 1 --vpls 4,8 --json");
     ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json result = nlohmann::json::parse(run.output);
+    const nlohmann::json& rows = result.at("rows");
+    ASSERT_EQ(rows.size(), 8u) << run.output;
+    size_t row = 0;
     for (const char* c : {"canonical", "+imperfect visibility", "+downsampling", "+interleaving"})
-        for (const char* v : {"\"vpls\": 4", "\"vpls\": 8"})
-            EXPECT_NE(run.output.find("\"configuration\": \"" + std::string(c) + "\", " + v),
-                      std::string::npos)
-                << c << " " << v << "\n"
-                << run.output;
-    EXPECT_NE(run.output.find("\"discontinuity filter\""), std::string::npos) << run.output;
+        for (unsigned v : {4u, 8u}) {
+            EXPECT_EQ(rows[row].at("configuration"), c) << run.output;
+            EXPECT_EQ(rows[row].at("vpls"), v) << run.output;
+            ++row;
+        }
+    // Interleaving adds the discontinuity filter; the canonical frame has none.
+    EXPECT_FALSE(rows[0].at("stage_ms").contains("discontinuity filter")) << run.output;
+    EXPECT_TRUE(rows[6].at("stage_ms").contains("discontinuity filter")) << run.output;
 }
 
 TEST(CliBenchIgi, BadVplCountNamesTheFlagAndRange) {
@@ -283,7 +291,94 @@ TEST_F(CliTest, BenchRaysNamesTheTraversalVariantThatRan) {
     EXPECT_NE(run.output.find("\"cpu_isa\": \"scalar\""), std::string::npos) << run.output;
 }
 
+// A scene path is text like any other in the JSON: quotes and backslashes in it are escaped,
+// and the output parses back to the path.
+TEST_F(CliTest, BenchJsonOfAScenePathWithQuotesParsesBack) {
+    const std::string scene = path("my \"quoted\" scene\\1.obj");
+    {
+        std::ofstream obj(scene);
+        obj << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+    }
+    CliRun run = run_cli("bench rays --scene '" + scene +
+                         "' --eye 0.5,0.5,2 --look 0.5,0.5,0 --up 0,1,0 --fov 45 "
+                         "--light 0.5,0.5,3 --size 8x8 --repeat 1 --no-peer --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    nlohmann::json result;
+    ASSERT_NO_THROW(result = nlohmann::json::parse(run.output)) << run.output;
+    EXPECT_EQ(result.at("scene").get<std::string>(), scene);
+    EXPECT_EQ(result.at("triangles"), 2) << run.output;
+    EXPECT_GT(result.at("lucent").at("primary").at("hits").get<int>(), 0) << run.output;
+
+    run = run_cli("bench build --scene '" + scene + "' --repeat 1 --no-peer --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    ASSERT_NO_THROW(result = nlohmann::json::parse(run.output)) << run.output;
+    EXPECT_EQ(result.at("scene").get<std::string>(), scene);
+}
+
 namespace {
+
+/// Every key path of a JSON document ("/rows[]/stage_ms"), arrays by their first element.
+void collect_key_paths(const nlohmann::json& node, const std::string& path,
+                       std::set<std::string>& out) {
+    if (node.is_object()) {
+        for (const auto& [key, value] : node.items()) {
+            out.insert(path + "/" + key);
+            collect_key_paths(value, path + "/" + key, out);
+        }
+    } else if (node.is_array() && !node.empty()) {
+        collect_key_paths(node.front(), path + "[]", out);
+    }
+}
+
+std::set<std::string> key_paths(const nlohmann::json& document) {
+    std::set<std::string> paths;
+    collect_key_paths(document, "", paths);
+    return paths;
+}
+
+std::string missing_from(const std::set<std::string>& a, const std::set<std::string>& b) {
+    std::string missing;
+    for (const std::string& key : a)
+        if (!b.count(key)) missing += " " + key;
+    return missing;
+}
+
+nlohmann::json recorded_result(const std::string& name) {
+    std::ifstream file(std::string(LUCENT_TESTS_DIR) + "/../docs/bench/" + name);
+    return nlohmann::json::parse(file);
+}
+
+// The JSON results keep the field names of the results recorded in docs/bench, which
+// scripts read: the same keys, at the same places.
+TEST(CliBenchJson, FogAndIgiKeepTheRecordedFieldNames) {
+    CliRun run = run_cli("bench fog --size 16x12 --frames 1 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::set<std::string> now = key_paths(nlohmann::json::parse(run.output));
+    std::set<std::string> recorded = key_paths(recorded_result("fog-cuda.json"));
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+
+    run = run_cli("bench igi --size 16x12 --frames 1 --vpls 4 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    now = key_paths(nlohmann::json::parse(run.output));
+    recorded = key_paths(recorded_result("igi-cuda-sponza.json"));
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+}
+
+TEST(CliBenchJson, RaysKeepsTheRecordedFieldNames) {
+    const std::string scene = std::string(LUCENT_SCENES_DIR) + "/bunny.obj";
+    if (!fs::exists(scene)) GTEST_SKIP() << scene << " is not here";
+    CliRun run = run_cli("bench rays --scene '" + scene + "' --size 32x24 --repeat 1 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json result = nlohmann::json::parse(run.output);
+    std::set<std::string> now = key_paths(result);
+    std::set<std::string> recorded = key_paths(recorded_result("rays-cpu-bunny.json"));
+    recorded.insert("/cpu_isa");  // added after that record was made
+    EXPECT_EQ(missing_from(now, recorded), "") << run.output;
+    if (result.contains("embree"))  // a build with the peer gives every recorded field
+        EXPECT_EQ(missing_from(recorded, now), "") << run.output;
+}
 
 // `lucent bench present` opens OpenGL through EGL without a window (Mesa's software device
 // here), shows frames the way `lucent view` does and reads the framebuffer back.

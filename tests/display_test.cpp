@@ -176,3 +176,28 @@ TEST(DisplayFrame, SessionsGiveDisplayFramesEqualToTheirImages) {
 }
 
 }  // namespace
+
+namespace {
+
+// GlTexture has one definition whatever the build: where CUDA-OpenGL interop cannot be made
+// (no CUDA backend, no driver) it throws an error saying so; where it can, a host frame is
+// refused with the fix (upload its rgba()).
+TEST(GlTexture, SaysWhyItCannotCopyAFrame) {
+    const std::vector<float4> pixels(4, make_float4(0.5f, 0.5f, 0.5f, 1));
+    const auto frame = lucent::DisplayFrame::from_linear(2, 2, pixels.data());
+    try {
+        lucent::GlTexture texture(1);
+        try {
+            texture.copy_from(*frame);
+            ADD_FAILURE() << "a host frame was copied through CUDA-OpenGL interop";
+        } catch (const lucent::Error& e) {
+            EXPECT_NE(std::string(e.what()).find("upload its rgba()"), std::string::npos)
+                << e.what();
+        }
+    } catch (const lucent::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("CUDA-OpenGL interop"), std::string::npos)
+            << e.what();
+    }
+}
+
+}  // namespace

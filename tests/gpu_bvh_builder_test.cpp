@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "accel/triangle_accel.h"
-#include "cuda/driver_api.h"
-#include "cuda/gpu_bvh_builder.h"
-#include "cuda/gpu_triangle_bvh.h"
+#include "cuda/backend/driver_api.h"
+#include "cuda/accel/gpu_bvh_builder.h"
+#include "cuda/accel/gpu_triangle_bvh.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"

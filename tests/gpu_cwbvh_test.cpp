@@ -12,8 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "cuda/gpu_cwbvh.h"
-#include "cuda/nvrtc_compiler.h"
+#include "bench/gpu/bench_sources.h"
+#include "bench/gpu/gpu_cwbvh.h"
+#include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"
@@ -299,7 +300,7 @@ TEST(jit, gpu_cwbvh_traversal) {
     std::string why;
     if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
     setenv("LUCENT_CACHE_DIR", "off", 1);
-    const char* source = R"(#include "lucent_gpu/cwbvh.cuh"
+    const char* source = R"(#include "lucent_bench/cwbvh.cuh"
 extern "C" __global__ void lucent_cwbvh_probe(lucent::gpu::GpuCwbvhView bvh, const float4* rays,
                                               float* t, int count) {
     const int i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -313,7 +314,7 @@ extern "C" __global__ void lucent_cwbvh_probe(lucent::gpu::GpuCwbvhView bvh, con
     t[i] = found ? hit.t : (blocked ? -2.0f : -1.0f);
 }
 )";
-    const cuda::CompileResult result = cuda::compile_cubin(cuda::embedded_request(
+    const cuda::CompileResult result = cuda::compile_cubin(cuda::bench_kernel_request(
         "lucent_cwbvh_probe.cu", source, {"--std=c++17", "--ptxas-options=-v"}, 90));
     EXPECT_FALSE(result.cubin.empty()) << result.log;
     EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;

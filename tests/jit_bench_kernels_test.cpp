@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "accel/triangle_accel.h"
+#include "bench/gpu/bench_sources.h"
 #include "cuda/device/lucent_gpu/ray_order.cuh"
-#include "cuda/gpu_triangle_bvh.h"
-#include "cuda/nvrtc_compiler.h"
+#include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/device/triangle_intersect.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"
@@ -27,8 +28,8 @@ using namespace test_meshes;
 std::string compile_log_or_skip(const std::vector<std::string>& extra, cuda::CompileResult& out) {
     std::vector<std::string> options = {"--std=c++17", "--fmad=false"};
     options.insert(options.end(), extra.begin(), extra.end());
-    out = cuda::compile_cubin(cuda::embedded_request(
-        "lucent_bench_kernels.cu", "#include \"lucent_gpu/bench_kernels.cuh\"\n", options, 90));
+    out = cuda::compile_cubin(cuda::bench_kernel_request(
+        "lucent_bench_kernels.cu", "#include \"lucent_bench/trace_kernels.cuh\"\n", options, 90));
     return out.log;
 }
 

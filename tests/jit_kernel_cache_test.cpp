@@ -7,7 +7,7 @@
 #include <fstream>
 
 #if LUCENT_HAVE_CUDA
-#include "cuda/nvrtc_compiler.h"
+#include "cuda/jit/nvrtc_compiler.h"
 #endif
 
 namespace {

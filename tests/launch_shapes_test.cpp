@@ -1,4 +1,4 @@
-// The CUDA backend's launch shapes (src/cuda/launch_shapes.h): which carveouts it tries and
+// The CUDA backend's launch shapes (src/cuda/backend/launch_shapes.h): which carveouts it tries and
 // how it settles on one. Pure host logic; the driver's occupancy answer is modelled here on
 // sm_90's shared-memory configurations.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "cuda/launch_shapes.h"
+#include "cuda/backend/launch_shapes.h"
 
 namespace {
 

@@ -3,11 +3,9 @@
 // launches that read what earlier ones wrote; per-device TEA keys; device lists.
 // Runs on the CPU (two CPU devices); where a GPU answers, also GPU + GPU (one GPU listed
 // twice), CPU + GPU, and every GPU of the machine.
+#include "backends/backend_factory.h"
 #include "tests/programs/multi_device_programs.h"
 #include "tests/test_support.h"
-#if LUCENT_HAVE_CUDA
-#include "cuda/cuda_backend.h"
-#endif
 
 namespace lucent_tests {
 namespace {
@@ -19,11 +17,7 @@ DeviceSpec gpu(int ordinal) {
 }
 
 int gpus() {
-#if LUCENT_HAVE_CUDA
-    return cuda::gpu_count();
-#else
-    return 0;
-#endif
+    return lucent::core::gpu_count();
 }
 
 std::string list_name(const std::vector<DeviceSpec>& devices) {

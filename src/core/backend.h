@@ -97,12 +97,18 @@ class Backend {
                                size_t bytes);
 };
 
-/// The CPU backend: a worker per core (or `threads`), tiles of the launch grid.
+/// The CPU backend: a worker per core (or `threads`), tiles of the launch grid. Made by the
+/// backend factory (src/backends), as every backend is.
 std::unique_ptr<Backend> make_cpu_backend(unsigned threads);
 
-/// One launch spread over several backends (docs/multi-device.md).
+/// Runs job(worker) for every worker of a pool at once and returns when all are done.
+using RunOnWorkers = std::function<void(const std::function<void(unsigned worker)>& job)>;
+
+/// One launch spread over several backends (docs/multi-device.md), each driven from a
+/// worker of `run_on_devices` (one per device; the factory gives it the CPU's thread pool).
 std::unique_ptr<Backend> make_multi_device_backend(std::vector<std::unique_ptr<Backend>> devices,
                                                    std::vector<std::string> device_names,
-                                                   unsigned piece_rows);
+                                                   unsigned piece_rows,
+                                                   RunOnWorkers run_on_devices);
 
 }  // namespace lucent::core

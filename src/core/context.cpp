@@ -5,15 +5,12 @@
 #include <chrono>
 #include <sstream>
 
+#include "backends/backend_factory.h"
 #include "core/backend.h"
-#include "lucent/device/tea.h"
 #include "core/context_state.h"
 #include "core/module_registry.h"
 #include "core/scene_compiler.h"
-#if LUCENT_HAVE_CUDA
-#include "cuda/cuda_backend.h"
-#include "cuda/megakernel_compiler.h"
-#endif
+#include "lucent/device/tea.h"
 
 namespace lucent {
 
@@ -51,64 +48,22 @@ double ms_since(Clock::time_point t0) {
 }
 }  // namespace
 
-namespace {
-std::unique_ptr<core::Backend> make_device_backend(const DeviceSpec& device, unsigned threads) {
-    if (device.kind == DeviceSpec::Kind::kCpu) return core::make_cpu_backend(threads);
-#if LUCENT_HAVE_CUDA
-    std::string why;
-    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why)) return backend;
-    throw Error("Context: device " + device_spec_name(device) + " cannot run here: " + why +
-                "; list the GPUs `nvidia-smi -L` shows, or cpu");
-#else
-    throw Error("Context: device " + device_spec_name(device) +
-                " needs the CUDA backend, which is not part of this build (it needs the CUDA "
-                "toolkit at configure time); use the device cpu");
-#endif
-}
-}  // namespace
-
 Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     m_impl->state.context = this;
     m_impl->on_progress = std::move(options.on_progress);
     if (options.devices.size() > kMaxDevices)
         throw Error("Context: " + std::to_string(options.devices.size()) +
                     " devices listed; at most " + std::to_string(kMaxDevices));
-    if (!options.devices.empty()) {
-        std::vector<std::unique_ptr<core::Backend>> devices;
-        std::vector<std::string> names;
-        for (const DeviceSpec& device : options.devices) {
-            devices.push_back(make_device_backend(device, options.threads));
-            names.push_back(device_spec_name(device));
-        }
-        m_impl->device_count = unsigned(devices.size());
-        m_impl->backend = core::make_multi_device_backend(std::move(devices), std::move(names),
-                                                          options.piece_rows);
-    } else if (options.backend != BackendKind::kCpu) {
-#if LUCENT_HAVE_CUDA
-        std::string why;
-        m_impl->backend = cuda::make_cuda_backend(0, &why);
-        if (!m_impl->backend && options.backend == BackendKind::kCuda)
-            throw Error("Context: the CUDA backend cannot run here: " + why +
-                        "; use --backend cpu or --backend auto");
-        if (!m_impl->backend) m_impl->notice = why + ": running on the CPU";
-#else
-        if (options.backend == BackendKind::kCuda)
-            throw Error(
-                "Context: the CUDA backend is not part of this build (it needs the CUDA toolkit "
-                "at configure time); use --backend cpu or --backend auto");
-        m_impl->notice = "this build has no CUDA backend: running on the CPU";
-#endif
-    }
-    if (!m_impl->backend) m_impl->backend = core::make_cpu_backend(options.threads);
+    m_impl->backend = core::make_backend(options, m_impl->notice);
+    if (!options.devices.empty()) m_impl->device_count = unsigned(options.devices.size());
     core::Backend* backend = m_impl->backend.get();
     m_impl->shared->fetch_from_device = [backend](const Buffer& b) { backend->fetch(b); };
     m_impl->derive_device_keys();
     if (options.jit_check_sm) {
-#if LUCENT_HAVE_CUDA
+        if (!core::can_jit_check())
+            throw Error(
+                "Context: the JIT check needs a build with the CUDA toolkit; drop the option");
         m_impl->jit_check_sm = options.jit_check_sm;
-#else
-        throw Error("Context: the JIT check needs a build with the CUDA toolkit; drop the option");
-#endif
     }
 }
 
@@ -460,15 +415,7 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
         report.accel_ms = compiler.accel_ms();
         report.compile_ms = ms_since(t0) - report.accel_ms;
         report.recompiled = true;
-#if LUCENT_HAVE_CUDA
-        if (m_impl->jit_check_sm) {
-            cuda::Megakernel kernel = cuda::generate_megakernel(
-                *m_impl->compiled, cuda::build_program_table(*m_impl->compiled));
-            cuda::compile_megakernel(kernel, m_impl->jit_check_sm);
-            report.jit_ms = kernel.binary.ms;
-            report.jit_cached = kernel.binary.from_cache;
-        }
-#endif
+        if (m_impl->jit_check_sm) core::jit_check(*m_impl->compiled, m_impl->jit_check_sm, report);
     }
     const core::CompiledScene& scene = *m_impl->compiled;
     check_ray_generation(scene, entry);

@@ -2,11 +2,9 @@
 #include <algorithm>
 #include <cctype>
 
+#include "backends/backend_factory.h"
 #include "lucent/context.h"
 #include "lucent/error.h"
-#if LUCENT_HAVE_CUDA
-#include "cuda/cuda_backend.h"
-#endif
 
 namespace lucent {
 
@@ -26,10 +24,7 @@ std::vector<DeviceSpec> parse_device_list(const std::string& text) {
     const std::string all = lower(text);
     std::vector<DeviceSpec> devices;
     if (all == "all") {
-        int gpus = 0;
-#if LUCENT_HAVE_CUDA
-        gpus = cuda::gpu_count();
-#endif
+        const int gpus = core::gpu_count();
         for (int g = 0; g < gpus; ++g) devices.push_back({DeviceSpec::Kind::kCuda, g});
         if (devices.empty()) devices.push_back({DeviceSpec::Kind::kCpu, 0});
         devices.resize(std::min<size_t>(devices.size(), kMaxDevices));

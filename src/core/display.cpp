@@ -1,4 +1,4 @@
-// 8-bit sRGB encoding and host display frames (include/lucent/display.h).
+// 8-bit sRGB encoding, host display frames and GlTexture (include/lucent/display.h).
 #include "lucent/display.h"
 
 #include <array>
@@ -7,7 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "lucent/error.h"
+#include "backends/backend_factory.h"
+#include "core/gl_texture_interop.h"
 
 namespace lucent {
 
@@ -102,15 +103,19 @@ std::shared_ptr<DisplayFrame> DisplayFrame::from_linear(unsigned width, unsigned
     return frame;
 }
 
-#ifndef LUCENT_HAVE_CUDA
-// Without the CUDA backend no frame is ever on a device.
-struct GlTexture::Impl {};
-GlTexture::GlTexture(unsigned gl_texture) : m_gl_texture(gl_texture) {
-    throw Error("CUDA-OpenGL interop: this build of Lucent has no CUDA backend");
+GlTexture::GlTexture(unsigned gl_texture)
+    : m_gl_texture(gl_texture), m(core::make_gl_texture_interop(gl_texture)) {}
+
+GlTexture::~GlTexture() {
+    m->release();
 }
-GlTexture::~GlTexture() = default;
-void GlTexture::copy_from(const DisplayFrame&) {}
-void GlTexture::release() {}
-#endif
+
+void GlTexture::copy_from(const DisplayFrame& frame) {
+    m->copy_from(frame);
+}
+
+void GlTexture::release() {
+    m->release();
+}
 
 }  // namespace lucent

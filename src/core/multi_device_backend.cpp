@@ -14,7 +14,6 @@
 
 #include "core/backend.h"
 #include "core/piece_queue.h"
-#include "cpu/thread_pool.h"
 #include "lucent/error.h"
 
 namespace lucent::core {
@@ -89,11 +88,12 @@ struct SplitChoice {
 class MultiDeviceBackend final : public Backend {
   public:
     MultiDeviceBackend(std::vector<std::unique_ptr<Backend>> devices,
-                       std::vector<std::string> names, unsigned piece_rows)
+                       std::vector<std::string> names, unsigned piece_rows,
+                       RunOnWorkers run_on_workers)
         : m_devices(std::move(devices)),
           m_names(std::move(names)),
           m_piece_rows(piece_rows),
-          m_pool(unsigned(m_devices.size())) {
+          m_run_on_workers(std::move(run_on_workers)) {
         for (auto& a : m_devices)
             for (auto& b : m_devices)
                 if (a != b) a->connect(*b);
@@ -346,7 +346,7 @@ class MultiDeviceBackend final : public Backend {
     void run_on_devices(const Job& job) {
         std::mutex mutex;
         std::exception_ptr error;
-        m_pool.run([&](unsigned d) {
+        m_run_on_workers([&](unsigned d) {
             try {
                 job(d);
             } catch (...) {
@@ -436,7 +436,7 @@ class MultiDeviceBackend final : public Backend {
     std::vector<std::unique_ptr<Backend>> m_devices;
     std::vector<std::string> m_names;
     unsigned m_piece_rows;
-    cpu::ThreadPool m_pool;
+    RunOnWorkers m_run_on_workers;  // a worker per device
     const CompiledScene* m_scene = nullptr;
     uint64_t m_generation = 0;
     std::map<std::pair<unsigned, uint64_t>, std::vector<double>> m_speeds;  // by entry, count
@@ -458,9 +458,10 @@ class MultiDeviceBackend final : public Backend {
 
 std::unique_ptr<Backend> make_multi_device_backend(std::vector<std::unique_ptr<Backend>> devices,
                                                    std::vector<std::string> device_names,
-                                                   unsigned piece_rows) {
+                                                   unsigned piece_rows,
+                                                   RunOnWorkers run_on_devices) {
     return std::make_unique<MultiDeviceBackend>(std::move(devices), std::move(device_names),
-                                                piece_rows);
+                                                piece_rows, std::move(run_on_devices));
 }
 
 }  // namespace lucent::core

@@ -1,7 +1,7 @@
 // The GPU triangle BVH builder: H-PLOC (Benthin, Meister, Barczak, Mehalwal, Tsakok and
 // Kensler 2024, "H-PLOC: Hierarchical Parallel Locally-Ordered Clustering for Bounding
 // Volume Hierarchy Construction", HPG 2024), writing the layout of triangle_bvh.cuh
-// directly. Compiled by NVRTC (src/cuda/gpu_bvh_builder.cpp launches it).
+// directly. Compiled by NVRTC (src/cuda/accel/gpu_bvh_builder.cpp launches it).
 //
 // The passes, one kernel each (after lucent_build_reset, which clears the counters):
 //  1. lucent_build_bounds:  the box of the triangle centroids (ordered-integer atomics).

@@ -2,7 +2,7 @@
 // topology stays, the triangles are copied again and every box is recomputed bottom-up.
 // Each node waits for its two children with an atomic counter and the second to arrive
 // goes on to the parent (Karras 2012, "Maximizing parallelism in the construction of
-// BVHs, octrees, and k-d trees", Sec. 4). Launched by src/cuda/gpu_bvh_builder.cpp; works
+// BVHs, octrees, and k-d trees", Sec. 4). Launched by src/cuda/accel/gpu_bvh_builder.cpp; works
 // on any layout with parent links, built on the host or by bvh_build.cuh.
 #pragma once
 

@@ -1,7 +1,7 @@
 // 8-bit sRGB display frames on the GPU (Context::display_frame on the CUDA backend): each
 // linear float4 pixel of a launch's output becomes RGBA8 by the host's own threshold table
 // (lucent::srgb8_thresholds), so the codes equal the CPU's bit for bit. Launched by
-// src/cuda/display_frame.cpp.
+// src/cuda/interop/display_frame.cpp.
 #pragma once
 
 #include "lucent/device/platform.h"

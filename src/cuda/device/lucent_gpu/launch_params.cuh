@@ -1,5 +1,5 @@
 // The compiled scene as the megakernel sees it: flat arrays in device memory, indexed by
-// integers. Shared by the host (which fills it, src/cuda/gpu_scene.cpp) and the device.
+// integers. Shared by the host (which fills it, src/cuda/backend/gpu_scene.cpp) and the device.
 #pragma once
 
 #include "lucent/device/types.h"

@@ -2,7 +2,7 @@
 // BVH builder (bvh_build.cuh): per-tile digit histograms, one exclusive scan, a stable
 // scatter (Merrill and Grimshaw 2011, "High performance and scalable radix sorting", in its
 // simplest reduce-then-scan form). The host launches the three kernels once per pass
-// (src/cuda/gpu_bvh_builder.cpp).
+// (src/cuda/accel/gpu_bvh_builder.cpp).
 #pragma once
 
 #include "lucent/device/platform.h"

@@ -1,0 +1,41 @@
+// The one reporter of the benchmarks: each benchmark measures into a result struct and
+// says how that result reads as text and as JSON; report() prints one or the other. The
+// JSON is built with nlohmann-json, so any text in it (a scene path with a quote, a
+// device name) is escaped, and the document always parses.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "bench/common/rate.h"
+
+namespace lucent::bench {
+
+/// Keys stay in the order they were written, as the text reports list them.
+using Json = nlohmann::ordered_json;
+
+/// `value` rounded to `decimals` places: the JSON figures keep the precision the
+/// benchmark measures to, not the noise below it.
+double rounded(double value, int decimals);
+
+/// {"mrays": median, "min": .., "max": ..}, each to 4 places.
+Json rate_json(const Rate& rate);
+
+/// The document as printed: two-space indents, one key per line, then a newline; bytes
+/// of a string that are not UTF-8 are written as U+FFFD.
+std::string json_text(const Json& document);
+
+/// Writes json_text(document) to stdout.
+void print_json(const Json& document);
+
+/// Prints `result` as JSON (to_json(result), found by argument-dependent lookup) when `json`,
+/// else as text (print_text(result)).
+template <class Result>
+void report(const Result& result, bool json) {
+    if (json)
+        print_json(to_json(result));
+    else
+        print_text(result);
+}
+
+}  // namespace lucent::bench

@@ -1,0 +1,30 @@
+// `lucent bench rays`: the ray sets of shared/BENCH.md traced on the CPU (and beside it
+// Embree) or on the GPU (rays_bench_cuda.h).
+#pragma once
+
+#include <string>
+
+#include "lucent/device/vector_math.h"
+
+namespace lucent::bench {
+
+struct RaysOptions {
+    std::string scene;  // an OBJ file
+    bool has_camera =
+        false;  // eye/look/up/fov/light given; else read from cameras.txt beside the scene
+    float3 eye{0, 0, 0}, look{0, 0, -1}, up{0, 1, 0};
+    float fov = 60;
+    float3 light{0, 0, 0};
+    unsigned width = 1024, height = 768;
+    int repeat = 5;               // timed repeats (median reported), after one warm-up
+    unsigned threads = 0;         // 0 = all cores
+    bool peer = true;             // run Embree on the same rays when built with it
+    bool json = false;            // machine-readable output
+    std::string backend = "cpu";  // "cpu", or "cuda" (rays_bench_cuda.h)
+};
+/// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,
+/// and the peer's lines and ratios. Returns the process exit code; throws lucent::Error
+/// for bad input (missing file, bad OBJ) with file:line.
+int run_bench_rays(const RaysOptions& options);
+
+}  // namespace lucent::bench

@@ -1,0 +1,521 @@
+// The CUDA backend (docs/architecture.md, "The CUDA backend"): at launch, if the compiled scene changed shape,
+// generate the megakernel, compile it with NVRTC (or load it from the disk cache), load it
+// with the driver API and run it with persistent threads.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "core/backend.h"
+#include "cuda/backend/cuda_backend.h"
+#include "cuda/interop/display_frame.h"
+#include "cuda/backend/driver_api.h"
+#include "cuda/backend/gpu_scene.h"
+#include "cuda/backend/launch_shapes.h"
+#include "cuda/jit/megakernel_compiler.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+
+constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
+/// Pieces of a multi-device launch queued on a GPU at once, each on its own stream: 4, the
+/// best of 4 and 8 on two H200s (docs/multi-device.md); LUCENT_GPU_PIECES_IN_FLIGHT sets
+/// 1 to kMaxPiecesInFlight, for experiments.
+constexpr unsigned kPiecesInFlight = 4, kMaxPiecesInFlight = 8;
+
+constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
+
+class CudaBackend final : public core::Backend {
+  public:
+    CudaBackend(const DriverApi& d, int ordinal) : m_driver(d), m_ordinal(ordinal) {
+        check(d.cuDeviceGet(&m_device, ordinal), "cuDeviceGet");
+        char name[256] = {};
+        d.cuDeviceGetName(name, sizeof name, m_device);
+        m_device_name = name;
+        int major = 0, minor = 0;
+        d.cuDeviceGetAttribute(&major, CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR, m_device);
+        d.cuDeviceGetAttribute(&minor, CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR, m_device);
+        d.cuDeviceGetAttribute(&m_sm_count, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, m_device);
+        m_sm = major * 10 + minor;
+        check(d.cuDevicePrimaryCtxRetain(&m_context, m_device), "cuDevicePrimaryCtxRetain");
+        check(d.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Its own stream: two devices on one GPU (a GPU listed twice) run side by side. A
+        // blocking stream: the synchronous uploads on the default stream come before kernels.
+        // Several: a piece queued behind another starts on the SMs the other's tail frees.
+        if (const char* n = std::getenv("LUCENT_GPU_PIECES_IN_FLIGHT"))
+            m_in_flight = std::clamp(unsigned(std::atoi(n)), 1u, kMaxPiecesInFlight);
+        for (CUstream& s : m_streams) check(d.cuStreamCreate(&s, CU_STREAM_DEFAULT), "cuStreamCreate");
+        for (CUevent& e : m_piece_done) check(d.cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate");
+        check(d.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
+        check(d.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
+    }
+    ~CudaBackend() override {
+        m_driver.cuCtxSetCurrent(m_context);
+        m_scene.reset();
+        m_display.reset();
+        for (CUevent e : m_piece_done) m_driver.cuEventDestroy(e);
+        for (CUstream s : m_streams)
+            if (s) m_driver.cuStreamDestroy(s);
+        if (m_start) m_driver.cuEventDestroy(m_start);
+        if (m_stop) m_driver.cuEventDestroy(m_stop);
+        if (m_module) m_driver.cuModuleUnload(m_module);
+        m_driver.cuDevicePrimaryCtxRelease(m_device);
+    }
+
+    std::string name() const override {
+        return "cuda:" + std::to_string(m_ordinal) + " (" + m_device_name + ", sm_" +
+               std::to_string(m_sm) + ")";
+    }
+
+    void begin_launch(const core::CompiledScene& scene, const core::LaunchSpec& spec,
+                      LaunchReport& report) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
+            if (!m_scene) m_scene = std::make_unique<GpuScene>(m_sm);
+            m_scene->update(scene);
+            report.accel_ms += m_scene->accel_ms();  // the GPU layouts (GPU or host builds)
+            m_last_scene = &scene;
+            m_last_generation = scene.generation;
+            prepare_kernel(scene, report);
+        } else {
+            m_scene->sync_buffers();
+        }
+        if (spec.device_keys.empty() || spec.device_keys.size() > gpu::kGpuMaxDeviceSlots)
+            throw Error("CUDA backend: a launch needs 1 to 16 device keys");
+
+        gpu::LaunchParams p = m_scene->params();
+        p.ray_generation = m_scene->ray_generation(spec.entry);
+        p.exception = m_scene->exception(spec.entry);
+        p.launch_size = spec.size;
+        p.launch_count = spec.count();
+        p.device_slots = unsigned(spec.device_keys.size());
+        for (size_t i = 0; i < spec.device_keys.size(); ++i) p.device_keys[i] = spec.device_keys[i];
+        m_counters.alloc(m_in_flight * sizeof(unsigned long long));  // one per stream
+        m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
+        m_exceptions.fill(0);
+        p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
+        // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
+        m_tuning_key = {spec.entry, p.launch_count};
+        if (m_fixed_shape) {
+            m_shape = kOccupancyFirst;
+        } else {
+            auto tuning = m_tuning.try_emplace(m_tuning_key, m_shapes.size()).first;
+            m_shape = tuning->second.next_shape();
+        }
+        apply_shape(m_shapes[size_t(m_shape)]);
+        int largest_grid = 0;
+        for (const LaunchShape& shape : m_shapes) largest_grid = std::max(largest_grid, shape.grid);
+        const unsigned threads = unsigned(largest_grid) * kBlock;
+        if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
+            m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
+        p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
+        check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
+        m_size = spec.size;
+        m_pieces = 0;
+        m_indices = 0;
+        check(m_driver.cuEventRecord(m_start, m_streams[0]), "cuEventRecord");
+        for (unsigned i = 1; i < m_in_flight; ++i)
+            check(m_driver.cuStreamWaitEvent(m_streams[i], m_start, 0), "cuStreamWaitEvent");
+    }
+
+    void run_piece(core::LaunchPiece piece) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Pieces take turns on the streams, each with its counter: the counter reset, the
+        // kernel over the piece, its event. Then wait for the oldest piece in flight, so the
+        // pieces queued behind a running one fill the SMs its tail leaves idle (a few warps
+        // on costly tiles, such as IGI's mirror pixels, can outlast a piece's other work).
+        const unsigned slot = m_pieces % m_in_flight;
+        m_indices += piece.last - piece.first;
+        CUstream stream = m_streams[slot];
+        const CUdeviceptr counter = m_counters.ptr() + slot * sizeof(unsigned long long);
+        check(m_driver.cuMemsetD32Async(counter, 0, 2, stream), "reset the work counter");
+        unsigned long long first = piece.first, last = piece.last;
+        void* counter_arg = reinterpret_cast<void*>(counter);
+        void* no_owners = nullptr;
+        unsigned device = 0;
+        void* args[] = {&first, &last, &counter_arg, &no_owners, &device};
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+                                      stream, args, nullptr),
+              "launch the megakernel");
+        check(m_driver.cuEventRecord(m_piece_done[slot], stream), "cuEventRecord");
+        if (m_pieces + 1 >= m_in_flight)
+            check(m_driver.cuEventSynchronize(
+                      m_piece_done[(m_pieces + 1 - m_in_flight) % m_in_flight]),
+                  "run the megakernel");
+        ++m_pieces;
+    }
+
+    /// The whole launch as one kernel taking tiles from a counter other GPUs share.
+    void run_shared(uint64_t count, CUdeviceptr counter, CUdeviceptr owners, unsigned device) {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        m_indices = count;
+        ++m_pieces;
+        unsigned long long first = 0, last = count;
+        void* counter_arg = reinterpret_cast<void*>(counter);
+        void* owners_arg = reinterpret_cast<void*>(owners);
+        void* args[] = {&first, &last, &counter_arg, &owners_arg, &device};
+        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+                                      m_streams[0], args, nullptr),
+              "launch the megakernel");
+    }
+
+    /// Copies into this GPU's copy of `buffer` the tiles other GPUs ran (queued; sync()).
+    void gather_tiles(const Buffer& buffer, CUdeviceptr owners, unsigned device, uint64_t tiles,
+                      const gpu::DeviceCopies& copies, uint3 size) {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        unsigned long long tile_count = tiles;
+        unsigned element_bytes = unsigned(buffer.element().size);
+        void* owners_arg = reinterpret_cast<void*>(owners);
+        gpu::DeviceCopies by_value = copies;
+        void* args[] = {&owners_arg, &device, &tile_count, &by_value, &element_bytes, &size};
+        const unsigned blocks = unsigned(std::min<uint64_t>((tiles * 32 + 255) / 256, 4096));
+        check(m_driver.cuLaunchKernel(m_gather, std::max(1u, blocks), 1, 1, 256, 1, 1, 0,
+                                      m_streams[0], args, nullptr),
+              "gather the tiles of other GPUs");
+    }
+    void sync() {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        check(m_driver.cuStreamSynchronize(m_streams[0]), "gather the tiles of other GPUs");
+    }
+    CUdeviceptr copy_of(const Buffer& buffer) const { return mirror_of(buffer); }
+    CUdevice device() const { return m_device; }
+    CUcontext context() const { return m_context; }
+    const DriverApi& driver_api() const { return m_driver; }
+
+    std::unique_ptr<core::SharedTileQueue> share_tile_queue(
+        const std::vector<core::Backend*>& devices) override;
+
+    void end_launch(LaunchReport& report) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Stop after every stream's pieces.
+        for (unsigned i = 1; i < m_in_flight; ++i) {
+            check(m_driver.cuEventRecord(m_piece_done[i], m_streams[i]), "cuEventRecord");
+            check(m_driver.cuStreamWaitEvent(m_streams[0], m_piece_done[i], 0), "cuStreamWaitEvent");
+        }
+        check(m_driver.cuEventRecord(m_stop, m_streams[0]), "cuEventRecord");
+        check(m_driver.cuStreamSynchronize(m_streams[0]), "run the megakernel");
+        float kernel_ms = 0;
+        m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
+        report.kernel_ms = kernel_ms;
+        if (!m_fixed_shape && m_indices > 0)
+            m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
+
+        std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
+        m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
+        const uint3 size = m_size;
+        for (const auto& s : slots) {
+            if (s.code == 0) continue;
+            uint64_t linear = ~s.first_linear_inverted;
+            uint3 first{unsigned(linear % size.x), unsigned(linear / size.x % size.y),
+                        unsigned(linear / (uint64_t(size.x) * size.y))};
+            report.exceptions[s.code] = {s.count, first};
+        }
+    }
+
+    void publish_outputs() override {
+        m_scene->mark_outputs_device_newer();  // copied back when the host reads them
+    }
+
+    void upload_range(const Buffer& buffer, size_t offset, size_t bytes) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        const auto* host = static_cast<const unsigned char*>(buffer.raw());
+        check(m_driver.cuMemcpyHtoD(mirror_of(buffer) + offset, host + offset, bytes),
+              "upload a piece of a buffer");
+    }
+
+    void download_range(const Buffer& buffer, size_t offset, size_t bytes) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        auto* host = static_cast<unsigned char*>(const_cast<void*>(buffer.raw()));
+        check(m_driver.cuMemcpyDtoH(host + offset, mirror_of(buffer) + offset, bytes),
+              "download a piece of a buffer");
+    }
+
+    void copy_range_to(core::Backend& target, const Buffer& buffer, size_t offset,
+                       size_t bytes) override {
+        auto* gpu = dynamic_cast<CudaBackend*>(&target);
+        if (!gpu) return core::Backend::copy_range_to(target, buffer, offset, bytes);
+        // GPU to GPU: directly over NVLink or PCIe where peer access is on (connect()), else
+        // the driver stages it through host memory.
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        check(m_driver.cuMemcpyPeer(gpu->mirror_of(buffer) + offset, gpu->m_context,
+                                    mirror_of(buffer) + offset, m_context, bytes),
+              "copy a piece of a buffer between GPUs");
+    }
+
+    void connect(core::Backend& peer) override {
+        auto* gpu = dynamic_cast<CudaBackend*>(&peer);
+        if (!gpu || gpu->m_device == m_device) return;
+        int can = 0;
+        m_driver.cuDeviceCanAccessPeer(&can, m_device, gpu->m_device);
+        if (!can) return;
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        CUresult r = m_driver.cuCtxEnablePeerAccess(gpu->m_context, 0);
+        if (r != CUDA_ERROR_PEER_ACCESS_ALREADY_ENABLED) check(r, "enable peer access");
+        if (std::getenv("LUCENT_MULTI_TRACE"))
+            std::fprintf(stderr, "multi-device: %s reaches %s directly (peer access)\n",
+                         name().c_str(), gpu->name().c_str());
+    }
+
+    std::shared_ptr<DisplayFrame> display_frame(const Buffer& output) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        const CUdeviceptr linear = m_scene ? m_scene->current_mirror(output) : 0;
+        if (!linear) return core::Backend::display_frame(output);  // the host copy is newer
+        if (!m_display) m_display = std::make_unique<DisplayEncoder>(m_device, m_sm);
+        return m_display->encode(linear, output.size().x, output.size().y);
+    }
+
+    void fetch(const Buffer& buffer) override {
+        check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        if (m_scene) m_scene->fetch(buffer);
+    }
+
+    /// Generates the kernel for this scene; compiles it only when the source changed.
+    void prepare_kernel(const core::CompiledScene& scene, LaunchReport& report) {
+        Megakernel kernel = generate_megakernel(scene, m_scene->programs());
+        if (kernel.source == m_source && m_module) return;  // same shape: keep the kernel
+        compile_megakernel(kernel, m_sm);
+        report.jit_ms = kernel.binary.ms;
+        report.jit_cached = kernel.binary.from_cache;
+        const KernelShape& shape = kernel.shape;
+        const CompileResult& compiled = kernel.binary;
+
+        if (m_module) m_driver.cuModuleUnload(m_module);
+        m_module = nullptr;
+        check(m_driver.cuModuleLoadData(&m_module, compiled.cubin.data()), "load the megakernel");
+        check(m_driver.cuModuleGetFunction(&m_kernel, m_module, "lucent_megakernel"),
+              "find lucent_megakernel");
+        check(m_driver.cuModuleGetFunction(&m_gather, m_module, "lucent_gather_tiles"),
+              "find lucent_gather_tiles");
+        size_t bytes = 0;
+        check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
+                                         "_ZN6lucent3gpu6paramsE"),
+              "find the launch parameters");
+        // The launch shapes (launch_shapes.h): for each count of blocks per SM up to what the
+        // registers allow, just the shared memory those blocks need (the runtime's per-thread
+        // state, 5 KB a block) and the rest as L1 for the trace frames in local memory.
+        const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
+        m_fixed_shape = fixed != nullptr;
+        int static_shared = 0, reserved = 0, shared_per_sm = 0;
+        m_driver.cuFuncGetAttribute(&static_shared, CU_FUNC_ATTRIBUTE_SHARED_SIZE_BYTES, m_kernel);
+        m_driver.cuDeviceGetAttribute(
+            &reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK, m_device);
+        m_driver.cuDeviceGetAttribute(
+            &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
+        const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
+        m_shapes.clear();
+        if (fixed) {
+            m_shapes.push_back({std::atoi(fixed), 0});
+        } else {
+            const SharedMemoryNeeds needs{static_shared, reserved, shared_per_sm};
+            for (int carveout : launch_shape_carveouts(
+                     by_registers, needs, [&](int c) { return resident_blocks(c); }))
+                m_shapes.push_back({carveout, 0});
+        }
+        for (LaunchShape& shape : m_shapes)
+            shape.grid = resident_blocks(shape.carveout) * m_sm_count;
+        m_applied = {-1, 0};
+        m_tuning.clear();
+        // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
+        size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
+        check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
+        m_source = std::move(kernel.source);
+    }
+
+  private:
+    CUdeviceptr mirror_of(const Buffer& buffer) const {
+        CUdeviceptr ptr = m_scene ? m_scene->mirror(buffer) : 0;
+        if (!ptr)
+            throw Error("CUDA backend: " + buffer.describe() + " has no copy on " + name());
+        return ptr;
+    }
+
+    /// Blocks of the megakernel resident per SM with this carveout.
+    int resident_blocks(int carveout) {
+        check(m_driver.cuFuncSetAttribute(
+                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, carveout),
+              "set the shared memory carveout");
+        m_applied = {-1, 0};
+        int blocks = 0;
+        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, m_kernel, kBlock, 0),
+              "occupancy");
+        return std::max(1, blocks);
+    }
+
+    void apply_shape(const LaunchShape& shape) {
+        if (shape.carveout == m_applied.carveout) return;
+        check(m_driver.cuFuncSetAttribute(
+                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, shape.carveout),
+              "set the shared memory carveout");
+        m_applied = shape;
+    }
+
+    const DriverApi& m_driver;
+    int m_ordinal = 0;
+    CUdevice m_device = 0;
+    CUstream m_streams[kMaxPiecesInFlight] = {};
+    CUevent m_piece_done[kMaxPiecesInFlight] = {};
+    unsigned m_in_flight = kPiecesInFlight;
+    unsigned m_pieces = 0;   // of the current launch
+    uint64_t m_indices = 0;  // launch indices in them
+    uint3 m_size{1, 1, 1};
+    int m_shape = kOccupancyFirst;
+    std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
+    CUcontext m_context = nullptr;
+    CUmodule m_module = nullptr;
+    CUfunction m_kernel = nullptr, m_gather = nullptr;
+    CUdeviceptr m_params_global = 0;
+    std::string m_device_name, m_source;
+    int m_sm = 0, m_sm_count = 0;
+    std::unique_ptr<GpuScene> m_scene;
+    std::unique_ptr<DisplayEncoder> m_display;  // made by the first display_frame
+    std::vector<LaunchShape> m_shapes{LaunchShape{}};  // shape 0: occupancy first
+    LaunchShape m_applied{-1, 0};
+    bool m_fixed_shape = false;
+    std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
+    const core::CompiledScene* m_last_scene = nullptr;
+    uint64_t m_last_generation = 0;
+    DeviceBuffer m_counters, m_exceptions, m_scratch;
+    CUevent m_start = nullptr, m_stop = nullptr;
+};
+
+/// The tile counter and the tile owners live on the first GPU; the others reach them by
+/// peer access (the same address works on every GPU of the group).
+class GpuSharedTileQueue final : public core::SharedTileQueue {
+  public:
+    explicit GpuSharedTileQueue(std::vector<CudaBackend*> gpus) : m_gpus(std::move(gpus)) {}
+    ~GpuSharedTileQueue() override {
+        m_gpus[0]->driver_api().cuCtxSetCurrent(m_gpus[0]->context());  // frees on the first GPU
+        m_counter.reset();
+        m_owners.reset();
+        for (unsigned d = 1; d < m_local_owners.size(); ++d) {
+            m_gpus[d]->driver_api().cuCtxSetCurrent(m_gpus[d]->context());
+            m_local_owners[d].reset();
+        }
+    }
+
+    void run(const core::LaunchSpec& spec) override {
+        CudaBackend& first = *m_gpus[0];
+        check(first.driver_api().cuCtxSetCurrent(first.context()), "cuCtxSetCurrent");
+        const uint64_t tiles = tile_count(spec);
+        if (m_owners.size() < tiles) m_owners.alloc(tiles);
+        m_counter.alloc(sizeof(unsigned long long));
+        m_counter.fill(0);  // synchronous: done before any GPU starts
+        for (unsigned d = 0; d < m_gpus.size(); ++d)
+            m_gpus[d]->run_shared(spec.count(), m_counter.ptr(), m_owners.ptr(), d);
+    }
+
+    void gather(const core::LaunchSpec& spec,
+                const std::vector<std::shared_ptr<const Buffer>>& written,
+                std::vector<uint64_t>& indices) override {
+        const uint64_t tiles = tile_count(spec);
+        // Each GPU reads the owners from its own memory: one peer copy, not a peer read per
+        // element.
+        m_local_owners.resize(m_gpus.size());
+        for (unsigned d = 1; d < m_gpus.size() && !written.empty(); ++d) {
+            CudaBackend& gpu = *m_gpus[d];
+            check(gpu.driver_api().cuCtxSetCurrent(gpu.context()), "cuCtxSetCurrent");
+            if (m_local_owners[d].size() < tiles) m_local_owners[d].alloc(tiles);
+            check(gpu.driver_api().cuMemcpyPeer(m_local_owners[d].ptr(), gpu.context(),
+                                                m_owners.ptr(), m_gpus[0]->context(), tiles),
+                  "copy the tile owners between GPUs");
+        }
+        for (const auto& buffer : written) {
+            gpu::DeviceCopies copies{};
+            for (unsigned d = 0; d < m_gpus.size(); ++d) copies.base[d] = m_gpus[d]->copy_of(*buffer);
+            for (unsigned d = 0; d < m_gpus.size(); ++d)
+                m_gpus[d]->gather_tiles(*buffer, d ? m_local_owners[d].ptr() : m_owners.ptr(), d,
+                                        tiles, copies, spec.size);
+        }
+        for (CudaBackend* gpu : m_gpus) gpu->sync();
+        // Who ran what, for the report.
+        CudaBackend& first = *m_gpus[0];
+        check(first.driver_api().cuCtxSetCurrent(first.context()), "cuCtxSetCurrent");
+        std::vector<unsigned char> owners(tiles);
+        m_owners.download(owners.data(), tiles);
+        indices.assign(m_gpus.size(), 0);
+        const uint3 s = spec.size;
+        const uint64_t rows = uint64_t(s.y) * s.z, tiles_x = (s.x + 7) / 8;
+        for (uint64_t t = 0; t < tiles; ++t) {
+            uint64_t n;
+            if (spec.by_rows())
+                n = std::min<uint64_t>(8, s.x - (t % tiles_x) * 8) *
+                    std::min<uint64_t>(4, rows - (t / tiles_x) * 4);
+            else
+                n = std::min<uint64_t>(32, spec.count() - t * 32);
+            if (owners[t] < indices.size()) indices[owners[t]] += n;
+        }
+    }
+
+  private:
+    /// The megakernel's tiles: 8x4 over the rows of a launch of several rows, else 32.
+    static uint64_t tile_count(const core::LaunchSpec& spec) {
+        if (!spec.by_rows()) return (spec.count() + 31) / 32;
+        const uint64_t rows = uint64_t(spec.size.y) * spec.size.z;
+        return ((spec.size.x + 7) / 8) * ((rows + 3) / 4);
+    }
+
+    std::vector<CudaBackend*> m_gpus;
+    DeviceBuffer m_counter, m_owners;        // on the first GPU
+    std::vector<DeviceBuffer> m_local_owners;  // the owners copied to each other GPU
+};
+
+std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
+    const std::vector<core::Backend*>& devices) {
+    std::vector<CudaBackend*> gpus;
+    for (core::Backend* b : devices) {
+        auto* gpu = dynamic_cast<CudaBackend*>(b);
+        if (!gpu) return nullptr;  // a CPU cannot take tiles from a counter in GPU memory
+        gpus.push_back(gpu);
+    }
+    // Every pair of GPUs needs peer atomics (NVLink). A GPU listed twice gains nothing from
+    // sharing: its first kernel would fill it and take every tile; its two devices take
+    // pieces from the host queue instead, and both run.
+    for (CudaBackend* a : gpus)
+        for (CudaBackend* b : gpus) {
+            if (a == b) continue;
+            if (a->device() == b->device()) return nullptr;
+            int access = 0, atomics = 0;
+            m_driver.cuDeviceCanAccessPeer(&access, a->device(), b->device());
+            m_driver.cuDeviceGetP2PAttribute(
+                &atomics, CU_DEVICE_P2P_ATTRIBUTE_NATIVE_ATOMIC_SUPPORTED, a->device(), b->device());
+            if (!access || !atomics) return nullptr;
+        }
+    if (gpus.empty() || gpus[0] != this) return nullptr;
+    return std::make_unique<GpuSharedTileQueue>(std::move(gpus));
+}
+
+}  // namespace
+
+std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why) {
+    const DriverApi* d = driver(why);
+    if (!d) return nullptr;
+    std::string nvrtc_why;
+    if (nvrtc_version(&nvrtc_why).empty()) {
+        if (why) *why = nvrtc_why;
+        return nullptr;
+    }
+    int count = 0;
+    d->cuDeviceGetCount(&count);
+    if (ordinal < 0 || ordinal >= count) {
+        if (why)
+            *why = "there is no GPU " + std::to_string(ordinal) + " (the driver reports " +
+                   std::to_string(count) + ")";
+        return nullptr;
+    }
+    return std::make_unique<CudaBackend>(*d, ordinal);
+}
+
+int gpu_count() {
+    const DriverApi* d = driver();
+    int count = 0;
+    if (d) d->cuDeviceGetCount(&count);
+    return count;
+}
+
+}  // namespace lucent::cuda

@@ -1,0 +1,96 @@
+// The compiled scene in device memory: flat arrays, records with device pointers, and a
+// mirror of every Buffer the programs use. Uploads only what changed since the last launch.
+#pragma once
+
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "core/compiled_scene.h"
+#include "cuda/backend/device_buffer.h"
+#include "cuda/accel/gpu_bvh_builder.h"
+#include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/jit/megakernel_generator.h"
+#include "lucent_gpu/launch_params.cuh"
+
+namespace lucent::cuda {
+
+class GpuScene {
+  public:
+    /// For the device of the current context, of compute capability `sm` (x10).
+    explicit GpuScene(int sm) : m_sm(sm) {}
+
+    /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
+    /// buffers whose host contents changed.
+    void update(const core::CompiledScene& scene);
+    /// Time the last update() spent building or refitting GPU triangle layouts, in ms.
+    double accel_ms() const { return m_accel_ms; }
+    /// Uploads buffers changed by the host since the last launch (same compile).
+    void sync_buffers();
+    /// After a launch: buffers programs may write (output, input-output) are newer on the
+    /// device; their host copies are fetched when the host reads them (fetch()).
+    void mark_outputs_device_newer();
+    /// Copies one buffer's device contents to its host copy (no-op if not mirrored).
+    void fetch(const Buffer& buffer);
+    /// The device copy of a buffer this compile uses, or 0.
+    CUdeviceptr mirror(const Buffer& buffer) const;
+    /// The device copy when it holds the buffer's newest contents (a launch wrote it, or
+    /// the host has not changed it since the upload), else 0.
+    CUdeviceptr current_mirror(const Buffer& buffer) const;
+
+    /// The scene part of the launch parameters (per-launch fields left for the caller).
+    const gpu::LaunchParams& params() const { return m_params; }
+    const ProgramTable& programs() const { return m_programs; }
+    gpu::ProgramRef ray_generation(unsigned entry) const { return m_entries[entry].first; }
+    gpu::ProgramRef exception(unsigned entry) const { return m_entries[entry].second; }
+
+  private:
+    struct BufferMirror {
+        DeviceBuffer memory;
+        uint64_t version = 0;
+        std::shared_ptr<const Buffer> buffer;  // alive while mirrored
+        bool device_newer = false;
+    };
+    struct GeometryMirror {
+        uint64_t structure = 0, content = 0;
+        GpuTriangleBvhDevice bvh;  // the triangles in the GPU layout (Aila and Laine 2009)
+        bool empty = true;
+    };
+
+    struct FlatScene;
+    // update(), one step each, in this order.
+    void add_programs(const core::CompiledScene& scene, FlatScene& flat);
+    void flatten_instances(const core::CompiledScene& scene, FlatScene& flat);
+    void flatten_nodes(const core::CompiledScene& scene, FlatScene& flat);
+    gpu::GpuGeometryAccel flatten_geometry_accel(const core::CompiledScene& scene,
+                                                 const core::CompiledNode& node,
+                                                 FlatScene& flat);
+    void upload(const core::CompiledScene& scene, const FlatScene& flat);
+    void set_params(const core::CompiledScene& scene);
+    void drop_unused(const FlatScene& flat);
+
+    CUdeviceptr device_pointer(const std::shared_ptr<const Buffer>& buffer);
+    gpu::ProgramRef add_program(const core::CompiledProgram& program);
+    unsigned reserve_record(const core::CompiledProgram& program);
+    void write_record(unsigned offset, const core::CompiledProgram& program);
+    void fetch_mirror(BufferMirror& mirror);
+    void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
+    void update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror);
+
+    int m_sm;
+    double m_accel_ms = 0;
+    std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a Builder::kGpuHploc needs it
+    ProgramTable m_programs;
+    std::vector<unsigned char> m_records;
+    std::unordered_map<const void*, gpu::ProgramRef> m_callable_slots;  // by host record
+    std::vector<std::pair<gpu::ProgramRef, gpu::ProgramRef>> m_entries;
+    std::unordered_map<const Buffer*, BufferMirror> m_buffers, m_previous_buffers;
+    std::unordered_map<const core::GeometryAccel*, GeometryMirror> m_geometry;
+    gpu::LaunchParams m_params{};
+    // Device copies of the flat arrays.
+    DeviceBuffer m_nodes, m_children, m_bvh_nodes, m_prim_order, m_prim_refs, m_bvhs, m_accels,
+        m_accel_instances, m_accel_prim_first, m_instances, m_materials, m_record_blob, m_miss,
+        m_payload_signatures;
+};
+
+}  // namespace lucent::cuda

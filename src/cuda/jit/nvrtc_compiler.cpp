@@ -1,0 +1,241 @@
+#include "cuda/jit/nvrtc_compiler.h"
+
+#include <dlfcn.h>
+#include <nvrtc.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cuda/jit/embedded_sources.h"
+#include "lucent/error.h"
+
+namespace lucent::cuda {
+
+namespace {
+
+struct NvrtcApi {
+    decltype(&::nvrtcVersion) version = nullptr;
+    decltype(&::nvrtcCreateProgram) create = nullptr;
+    decltype(&::nvrtcDestroyProgram) destroy = nullptr;
+    decltype(&::nvrtcCompileProgram) compile = nullptr;
+    decltype(&::nvrtcGetProgramLogSize) log_size = nullptr;
+    decltype(&::nvrtcGetProgramLog) log = nullptr;
+    decltype(&::nvrtcGetCUBINSize) cubin_size = nullptr;
+    decltype(&::nvrtcGetCUBIN) cubin = nullptr;
+    decltype(&::nvrtcGetErrorString) error_string = nullptr;
+    bool ok = false;
+    std::string why;
+};
+
+const NvrtcApi& nvrtc() {
+    static const NvrtcApi api = [] {
+        NvrtcApi a;
+        std::vector<std::string> candidates;
+        if (const char* p = std::getenv("LUCENT_NVRTC")) candidates.push_back(p);
+        candidates.insert(candidates.end(),
+                          {"libnvrtc.so.13", "libnvrtc.so", "/usr/local/cuda/lib64/libnvrtc.so.13",
+                           "/usr/local/cuda/lib64/libnvrtc.so"});
+        void* lib = nullptr;
+        for (auto& c : candidates)
+            if ((lib = dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL))) break;
+        if (!lib) {
+            a.why = "NVRTC (libnvrtc.so) not found; install the CUDA toolkit or set LUCENT_NVRTC";
+            return a;
+        }
+        auto get = [&](auto& fn, const char* name) {
+            fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(lib, name));
+            if (!fn) a.why = std::string("NVRTC lacks ") + name;
+        };
+        get(a.version, "nvrtcVersion");
+        get(a.create, "nvrtcCreateProgram");
+        get(a.destroy, "nvrtcDestroyProgram");
+        get(a.compile, "nvrtcCompileProgram");
+        get(a.log_size, "nvrtcGetProgramLogSize");
+        get(a.log, "nvrtcGetProgramLog");
+        get(a.cubin_size, "nvrtcGetCUBINSize");
+        get(a.cubin, "nvrtcGetCUBIN");
+        get(a.error_string, "nvrtcGetErrorString");
+        a.ok = a.why.empty();
+        return a;
+    }();
+    return api;
+}
+
+/// 128-bit FNV-1a as two 64-bit lanes with different offsets: a cache key, not security.
+struct Key {
+    uint64_t a = 1469598103934665603ull, b = 0x84222325cbf29ce4ull;
+    void add(const std::string& s) {
+        for (unsigned char c : s) {
+            a = (a ^ c) * 1099511628211ull;
+            b = (b ^ c) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
+        }
+        add_separator();
+    }
+    void add_separator() { a = (a ^ 0xff) * 1099511628211ull; }
+    std::string hex() const {
+        char s[33];
+        std::snprintf(s, sizeof s, "%016llx%016llx", (unsigned long long)a, (unsigned long long)b);
+        return s;
+    }
+};
+
+constexpr char kMagic[8] = {'L', 'U', 'C', 'B', 'I', 'N', '0', '1'};
+
+uint64_t checksum(const std::string& data) {
+    uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : data) h = (h ^ c) * 1099511628211ull;
+    return h;
+}
+
+/// A cache entry: magic, the full key, payload size, payload checksum, payload. Anything
+/// that does not match exactly is treated as absent (and overwritten).
+bool read_entry(const std::filesystem::path& file, const std::string& key, std::string& cubin) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return false;
+    char magic[8];
+    char stored_key[32];
+    uint64_t size = 0, sum = 0;
+    if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) return false;
+    if (!in.read(stored_key, 32) || std::string(stored_key, 32) != key) return false;
+    if (!in.read(reinterpret_cast<char*>(&size), 8) || !in.read(reinterpret_cast<char*>(&sum), 8))
+        return false;
+    if (size > (1ull << 30)) return false;
+    cubin.resize(size);
+    if (!in.read(cubin.data(), std::streamsize(size))) return false;
+    return checksum(cubin) == sum;
+}
+
+void write_entry(const std::filesystem::path& file, const std::string& key,
+                 const std::string& cubin) {
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    auto tmp = file;
+    tmp += ".tmp" + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) return;  // an unwritable cache only costs speed
+        uint64_t size = cubin.size(), sum = checksum(cubin);
+        out.write(kMagic, 8);
+        out.write(key.data(), 32);
+        out.write(reinterpret_cast<const char*>(&size), 8);
+        out.write(reinterpret_cast<const char*>(&sum), 8);
+        out.write(cubin.data(), std::streamsize(cubin.size()));
+        if (!out) {
+            out.close();
+            std::filesystem::remove(tmp, ec);
+            return;
+        }
+    }
+    std::filesystem::rename(tmp, file, ec);  // atomic: readers never see half an entry
+    if (ec) std::filesystem::remove(tmp, ec);
+}
+
+}  // namespace
+
+std::string nvrtc_version(std::string* why) {
+    const NvrtcApi& api = nvrtc();
+    if (!api.ok) {
+        if (why) *why = api.why;
+        return "";
+    }
+    int major = 0, minor = 0;
+    api.version(&major, &minor);
+    return std::to_string(major) + "." + std::to_string(minor);
+}
+
+std::string kernel_cache_dir() {
+    if (const char* d = std::getenv("LUCENT_CACHE_DIR")) return std::string(d) == "off" ? "" : d;
+    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lucent";
+    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/lucent";
+    return "";
+}
+
+CompileRequest embedded_request(std::string name, std::string source,
+                                std::vector<std::string> options, int sm) {
+    CompileRequest request;
+    request.name = std::move(name);
+    request.source = std::move(source);
+    for (const EmbeddedSource& s : embedded_sources())
+        request.headers.emplace_back(std::string(s.name), std::string(s.text));
+    request.options = std::move(options);
+    request.sm = sm;
+    return request;
+}
+
+void add_options_from_env(CompileRequest& request, const char* variable) {
+    const char* text = std::getenv(variable);
+    if (!text) return;
+    std::istringstream words(text);
+    for (std::string w; words >> w;) request.options.push_back(w);
+}
+
+CompileResult compile_cubin(const CompileRequest& request) {
+    using Clock = std::chrono::steady_clock;
+    auto t0 = Clock::now();
+    std::string why;
+    std::string version = nvrtc_version(&why);
+    if (version.empty()) throw Error("cannot compile GPU code: " + why);
+
+    std::vector<std::string> options = request.options;
+    options.push_back("--gpu-architecture=sm_" + std::to_string(request.sm));
+    Key key;
+    key.add(version);
+    key.add(request.source);
+    for (auto& [name, text] : request.headers) {
+        key.add(name);
+        key.add(text);
+    }
+    for (auto& o : options) key.add(o);
+    const std::string hex = key.hex();
+
+    CompileResult result;
+    const std::string dir = kernel_cache_dir();
+    const std::filesystem::path file =
+        dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / (hex + ".cubin");
+    if (!dir.empty() && read_entry(file, hex, result.cubin)) {
+        result.from_cache = true;
+        result.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        return result;
+    }
+
+    const NvrtcApi& api = nvrtc();
+    std::vector<const char*> header_text, header_names, option_ptrs;
+    for (auto& [name, text] : request.headers) {
+        header_names.push_back(name.c_str());
+        header_text.push_back(text.c_str());
+    }
+    for (auto& o : options) option_ptrs.push_back(o.c_str());
+    nvrtcProgram program;
+    if (nvrtcResult r =
+            api.create(&program, request.source.c_str(), request.name.c_str(),
+                       int(header_text.size()), header_text.data(), header_names.data());
+        r != NVRTC_SUCCESS)
+        throw Error(std::string("NVRTC: cannot create program: ") + api.error_string(r));
+    nvrtcResult compiled = api.compile(program, int(option_ptrs.size()), option_ptrs.data());
+    size_t log_size = 0;
+    api.log_size(program, &log_size);
+    result.log.resize(log_size);
+    if (log_size) api.log(program, result.log.data());
+    while (!result.log.empty() && (result.log.back() == '\0' || result.log.back() == '\n'))
+        result.log.pop_back();
+    if (compiled != NVRTC_SUCCESS) {
+        api.destroy(&program);
+        throw Error("NVRTC could not compile " + request.name + " (" + api.error_string(compiled) +
+                    "):\n" + result.log);
+    }
+    size_t size = 0;
+    api.cubin_size(program, &size);
+    result.cubin.resize(size);
+    api.cubin(program, result.cubin.data());
+    api.destroy(&program);
+    if (!dir.empty()) write_entry(file, hex, result.cubin);
+    result.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    return result;
+}
+
+}  // namespace lucent::cuda
