@@ -104,8 +104,8 @@ struct ThreadState {
     uint3 launch_size{1, 1, 1};
     const uint4* device_keys = nullptr;  // per device slot (device_tea_key())
     unsigned device_slots = 1;
-    unsigned depth = 0;              // active traces
-    TraceFrame* frame = nullptr;     // the innermost, on the stack of its trace
+    unsigned depth = 0;           // active traces
+    TraceFrame* frame = nullptr;  // the innermost, on the stack of its trace
     ProgramContext context = ProgramContext::kRayGeneration;  // outside any trace
     bool print_here = false;
 };

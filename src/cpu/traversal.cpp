@@ -5,8 +5,8 @@
 #include <algorithm>
 
 #include "cpu/cpu_state.h"
-#include "lucent/error.h"
 #include "lucent/device/triangle_intersect.h"
+#include "lucent/error.h"
 
 namespace lucent::cpu {
 
@@ -167,8 +167,9 @@ void CpuPolicy::traverse(TraceFrame& frame, Handle root, const Ray& ray) const {
 bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
     const CompiledScene& scene = *ts.scene;
     if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
-        throw Error("occluded() is called, but no module of this scene declares it; declare "
-                    "it in the module that calls it: LUCENT_MODULE(name, lucent::kUsesOccluded)");
+        throw Error(
+            "occluded() is called, but no module of this scene declares it; declare "
+            "it in the module that calls it: LUCENT_MODULE(name, lucent::kUsesOccluded)");
     const CpuPolicy policy{&ts};
     runtime::occlusion_allowed(policy, root, ray);  // raises (throws) on bad input
     // A GeometryGroup of triangles (the common shadow root): the BVH's any-hit traversal.

@@ -28,7 +28,7 @@
 // The GPU's tuning: these run inside trace_ray's frame (inlined, as they were written
 // there); g++ decides for itself on the CPU.
 #if LUCENT_GPU_CODE
-#define LUCENT_RUNTIME_INLINE __forceinline__
+#define LUCENT_RUNTIME_INLINE LUCENT_HD __forceinline__
 #else
 #define LUCENT_RUNTIME_INLINE inline
 #endif
@@ -194,8 +194,9 @@ LUCENT_RUNTIME_INLINE void run_intersection(const P& p, FrameOf<P>& f, unsigned 
 /// The attributes of a triangle hit: the attribute program's, or the built-in
 /// TriangleAttributes (barycentrics and object-space geometric normal).
 template <class P>
-inline void triangle_attributes(const P& p, FrameOf<P>& f, const typename P::Instance& inst,
-                                unsigned prim, float2 bary, typename FrameOf<P>::Attributes& out) {
+LUCENT_HD inline void triangle_attributes(const P& p, FrameOf<P>& f,
+                                          const typename P::Instance& inst, unsigned prim,
+                                          float2 bary, typename FrameOf<P>::Attributes& out) {
     const typename P::Program attribute = p.attribute(inst);
     if (p.bound(attribute)) {
         const ProgramContext saved = f.context;
@@ -220,7 +221,8 @@ inline void triangle_attributes(const P& p, FrameOf<P>& f, const typename P::Ins
 
 /// Records a hit as the closest so far (the caller fills its attributes).
 template <class P>
-inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, float t, unsigned material) {
+LUCENT_HD inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, float t,
+                             unsigned material) {
     f.has_hit = true;
     f.closest = t;
     f.hit_t = t;
@@ -239,8 +241,8 @@ inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, float t, uns
 
 /// Commits a triangle hit whose attributes wait for the shade phase (no any-hit ran).
 template <class P>
-inline void commit_triangle(FrameOf<P>& f, unsigned instance, unsigned prim, float t,
-                            unsigned material, float2 bary) {
+LUCENT_HD inline void commit_triangle(FrameOf<P>& f, unsigned instance, unsigned prim, float t,
+                                      unsigned material, float2 bary) {
     commit<P>(f, instance, prim, t, material);
     f.hit_bary = bary;
     f.hit_pending = true;
@@ -250,7 +252,7 @@ inline void commit_triangle(FrameOf<P>& f, unsigned instance, unsigned prim, flo
 /// ended with ignore_intersection(). terminate_ray() accepts the candidate and ends the
 /// traversal.
 template <class P>
-inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program any) {
+LUCENT_HD inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program any) {
     const ProgramContext saved = f.context;
     f.context = ProgramContext::kAnyHit;
     f.any_hit = AnyHitOutcome::kAccept;
@@ -263,8 +265,8 @@ inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program any) {
 
 /// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
 template <class P>
-inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned instance_index, unsigned prim,
-                               float t, float2 bary) {
+LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                         unsigned prim, float t, float2 bary) {
     if constexpr (P::kOcclusion) {
         if (f.occlusion) {  // occluded(): any intersection answers the query
             f.has_hit = f.terminated = true;
@@ -328,12 +330,14 @@ LUCENT_RUNTIME_INLINE bool report_intersection(const P& p, unsigned material) {
     return true;
 }
 
-/// What ignore_intersection() and terminate_ray() leave for run_any_hit: recorded only
-/// while an any-hit program runs under a trace (the macros then return from it).
+/// What ignore_intersection() and terminate_ray() leave for run_any_hit (the macros then
+/// return from the program). They compile only in an any-hit body, and only run_any_hit
+/// reads the outcome, after resetting it for each program it runs: no context check is
+/// needed (an any-hit function called by hand from another program changes nothing).
 template <class P>
 LUCENT_RUNTIME_INLINE void end_any_hit(const P& p, AnyHitOutcome outcome) {
     FrameOf<P>* f = p.thread().frame;
-    if (f && f->context == ProgramContext::kAnyHit) f->any_hit = outcome;
+    if (f) f->any_hit = outcome;
 }
 
 // ---- trace() and occluded() ------------------------------------------------------------------
