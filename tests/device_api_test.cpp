@@ -24,7 +24,7 @@ enum ProbeRay : unsigned {
 
 class ProbeScene {
   public:
-    ProbeScene() : ctx(test_context_options()) {
+    explicit ProbeScene(const ContextOptions& options = test_context_options()) : ctx(options) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<ProbePayload>(0, "probe");
         ctx.set_exception_enabled(kAllExceptions, true);
@@ -231,9 +231,9 @@ std::ostream& operator<<(std::ostream& os, const EndCase& c) {
 
 class AnyHitEndTest : public testing::TestWithParam<EndCase> {};
 
-TEST_P(AnyHitEndTest, CodeAfterTheEndDoesNotRun) {
-    const EndCase& c = GetParam();
-    Context ctx(test_context_options());
+/// Traces one ray through three squares whose material has `c`'s any-hit program.
+EndPayload run_end_case(const EndCase& c, const ContextOptions& options) {
+    Context ctx(options);
     ctx.set_entry_point_count(1);
     ctx.set_ray_type<EndPayload>(0, "end");
     ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(da_end_miss)));
@@ -252,7 +252,12 @@ TEST_P(AnyHitEndTest, CodeAfterTheEndDoesNotRun) {
     auto results = ctx.create_buffer<EndPayload>(BufferType::kOutput, 1);
     ctx["results"] = results;
     ctx.launch(0, 1);
-    const EndPayload r = read_buffer<EndPayload>(*results)[0];
+    return read_buffer<EndPayload>(*results)[0];
+}
+
+TEST_P(AnyHitEndTest, CodeAfterTheEndDoesNotRun) {
+    const EndCase& c = GetParam();
+    const EndPayload r = run_end_case(c, test_context_options());
     EXPECT_EQ(r.after, 0u) << "a statement after ignore_intersection()/terminate_ray() ran";
     EXPECT_EQ(r.hit, c.hit);
     if (c.hit == 1 && c.hit_t > 0)
@@ -357,6 +362,34 @@ INSTANTIATE_TEST_SUITE_P(
                     BadTraceCase{"MaterialIndexOutOfRange", 4, kExceptionMaterialIndexOutOfRange,
                                  3}),
     [](const testing::TestParamInfo<BadTraceCase>& info) { return std::string(info.param.name); });
+
+// ---- the same scenes as megakernels ---------------------------------------------------------
+
+/// On the CPU, the probe scene (selector, transforms, custom and triangle geometry, attribute,
+/// any-hit and exception programs) and the any-hit scenes also compile as CUDA megakernels
+/// for sm_90 (no GPU needed); a failed compile throws from the launch.
+TEST(DeviceApiJit, TheSuitesScenesCompileAsMegakernelsForSm90) {
+#if !LUCENT_HAVE_CUDA
+    GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
+#else
+    if (test_backend() != BackendKind::kCpu) GTEST_SKIP() << "the GPU compiles them to launch";
+    ContextOptions options = test_context_options();
+    options.jit_check_sm = 90;
+    ProbeScene scene(options);
+    const std::vector<Probe> probes = scene.run();
+    EXPECT_EQ(probes[kSphereRay * kProbeSlots + kProbeAnyHit].ran, 1u);
+    const EndCase terminate_far{
+        "IgnoreOrTerminateInBranches",
+        []() -> const ProgramDesc& { return LUCENT_PROGRAM(da_terminate_far); },
+        6.5f,
+        1,
+        -1,
+        false,
+        1,
+        0};
+    EXPECT_EQ(run_end_case(terminate_far, options).after, 0u);
+#endif
+}
 
 }  // namespace
 }  // namespace lucent_tests
