@@ -88,11 +88,14 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray);
 LUCENT_HD bool occluded(Handle root, const Ray& ray);
 #endif
 
-/// In an intersection program: is t inside the ray's current interval?
+/// In an intersection program: is t inside the ray's current interval (tmin, closest hit so
+/// far)? False, and no effect, in every other program kind.
 LUCENT_HD bool potential_intersection(float t);
 /// In an intersection program, after potential_intersection(t) returned true and the
 /// attributes were written: commit the hit with this material index (runs any-hit).
-/// Returns false when any-hit ignored it.
+/// Returns false when any-hit ignored it, when no candidate is open, and outside an
+/// intersection program. An index beyond the instance's materials raises
+/// kExceptionMaterialIndexOutOfRange (detail: the index).
 LUCENT_HD bool report_intersection(unsigned material_index);
 
 // ---- ending an any-hit program -------------------------------------------------------------
@@ -112,7 +115,7 @@ enum class AnyHitOutcome : unsigned {
     kIgnore,     // ignore_intersection()
     kTerminate,  // terminate_ray()
 };
-/// Records the outcome for the trace whose any-hit program is running (nothing elsewhere).
+/// Records the outcome in the innermost trace (nothing outside a trace).
 LUCENT_HD void end_any_hit(AnyHitOutcome outcome);
 struct OutsideAnyHit {};
 template <class Scope>
