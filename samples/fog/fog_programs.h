@@ -294,7 +294,7 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
 
 LUCENT_ANY_HIT(fog_opaque_shadow, lucent::NoRecord, fog::ShadowPayload, fog::HitAttributes) {
     prd.attenuation = make_float3(0.0f);
-    lucent::terminate_ray();
+    terminate_ray();
 }
 
 // The crystal lets a tinted part of the light through (each face it crosses).
@@ -302,10 +302,9 @@ LUCENT_ANY_HIT(fog_glass_shadow, fog::GlassRecord, fog::ShadowPayload, fog::HitA
     prd.attenuation = prd.attenuation * rec.shadow_tint;
     if (max_component(prd.attenuation) < 1e-3f) {
         prd.attenuation = make_float3(0.0f);
-        lucent::terminate_ray();
-        return;
+        terminate_ray();
     }
-    lucent::ignore_intersection();
+    ignore_intersection();
 }
 
 // ---- the fog box ---------------------------------------------------------------------------
@@ -329,7 +328,7 @@ LUCENT_INTERSECTION(fog_box_intersect, fog::FogBoxRecord, fog::HitAttributes) {
 
 // Shadows pass through fog (Sebald: "simply ignores the intersection").
 LUCENT_ANY_HIT(fog_volume_shadow, lucent::NoRecord, fog::ShadowPayload, fog::HitAttributes) {
-    lucent::ignore_intersection();
+    ignore_intersection();
 }
 
 LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAttributes) {

@@ -583,9 +583,9 @@ LUCENT_ANY_HIT(whitted_glass_shadow, whitted::GlassShadowRecord, whitted::Shadow
                                                      make_float3(1.0f));
     if (max_component(prd.attenuation) <= 1e-3f) {
         prd.attenuation = make_float3(0.0f);
-        lucent::terminate_ray();
+        terminate_ray();
     } else {
-        lucent::ignore_intersection();
+        ignore_intersection();
     }
 }
 
@@ -593,7 +593,7 @@ LUCENT_ANY_HIT(whitted_glass_shadow, whitted::GlassShadowRecord, whitted::Shadow
 LUCENT_ANY_HIT(whitted_opaque_shadow, lucent::NoRecord, whitted::ShadowPayload,
                whitted::HitAttributes) {
     prd.attenuation = make_float3(0.0f);
-    lucent::terminate_ray();
+    terminate_ray();
 }
 
 }  // namespace whitted

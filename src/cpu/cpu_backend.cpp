@@ -71,7 +71,6 @@ class CpuBackend final : public core::Backend {
             ts.launch_size = size;
             ts.device_keys = m_spec.device_keys.data();
             ts.device_slots = unsigned(m_spec.device_keys.size());
-            ts.frames.resize(scene.max_depth);
             set_thread_state(&ts);
             try {
                 for (uint64_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
@@ -126,6 +125,7 @@ class CpuBackend final : public core::Backend {
                           const core::CompiledEntry& e, uint3 index, WorkerExceptions& out) {
         ts.launch_index = index;
         ts.depth = 0;
+        ts.frame = nullptr;
         ts.context = ProgramContext::kRayGeneration;
         ts.print_here = scene.print_enabled &&
                         (scene.print_index.x < 0 || unsigned(scene.print_index.x) == index.x) &&
@@ -139,6 +139,7 @@ class CpuBackend final : public core::Backend {
             out.add(ex.code, index, linear);
             if (e.exception && scene.exception_enabled(ex.code)) {
                 ts.depth = 0;
+                ts.frame = nullptr;  // the unwound traces' frames are gone
                 ts.context = ProgramContext::kException;
                 try {
                     e.exception.entry<ExceptionFn>()(e.exception.rec(),

@@ -1,73 +1,102 @@
-// Per-thread state of the CPU backend: the launch index, and a frame per active trace
-// (the ray, its payload, the closest hit so far and the traversal position), which the
-// device API functions read and write.
+// Per-thread state of the CPU backend and the policy that instantiates the trace state
+// machine (src/runtime/trace_rules.h) for it: the scene is a core::CompiledScene, programs
+// are called through their thunks, an exception is a C++ exception that unwinds the launch
+// index, and the traversal is the Traverser of traversal.cpp.
 #pragma once
 
-#include <vector>
+#include <cstring>
 
 #include "core/compiled_scene.h"
 #include "core/program_exception.h"
+#include "runtime/trace_rules.h"
 
 namespace lucent::cpu {
 
-constexpr size_t kAttributeBytes = 256;
-
 using core::ProgramException;
+using runtime::ProgramContext;
 
-enum class ProgramContext {
-    kRayGeneration,
-    kException,
-    kMiss,
-    kClosestHit,
-    kAnyHit,
-    kIntersection,
-    kVisit,
-    kAttribute,
-    kBoundingBox,
+struct ThreadState;
+
+struct CpuPolicy {
+    using Thread = ThreadState;
+    using Instance = core::CompiledInstance;
+    using Program = const core::CompiledProgram*;
+    using PayloadTag = const void*;  // the payload type's detail::TypeTag
+    static constexpr bool kTransforms = true;
+    static constexpr bool kOcclusion = true;
+    static constexpr unsigned kAttributeBytes = 256;
+
+    ThreadState* ts;
+
+    ThreadState& thread() const { return *ts; }
+    [[noreturn]] void raise(int code, unsigned detail) const {
+        throw ProgramException{code, detail};
+    }
+    bool exception_pending() const { return false; }  // a raised exception has unwound
+
+    inline const core::CompiledScene& scene() const;
+    unsigned ray_type_count() const { return unsigned(scene().ray_types.size()); }
+    bool payload_matches(unsigned ray_type, const void* tag) const {
+        return tag == scene().ray_types[ray_type].payload->tag;
+    }
+    unsigned node_count() const { return unsigned(scene().nodes.size()); }
+    unsigned max_depth() const { return scene().max_depth; }
+    const Ray& no_ray() const {
+        static const Ray none{};
+        return none;
+    }
+
+    const Instance& instance(unsigned index) const { return scene().instances[index]; }
+    unsigned material_count(const Instance& inst) const { return unsigned(inst.materials.size()); }
+    unsigned triangle_material(const Instance& inst, unsigned prim) const {
+        return inst.material_indices ? inst.material_indices[prim] : 0u;
+    }
+    void triangle(const Instance& inst, unsigned prim, float3& p0, float3& p1, float3& p2) const {
+        const uint3 t = triangle_of(inst, prim);
+        p0 = inst.vertices[t.x];
+        p1 = inst.vertices[t.y];
+        p2 = inst.vertices[t.z];
+    }
+    Program any_hit(const Instance& inst, unsigned material, unsigned ray_type) const {
+        return &inst.materials[material].any_hit[ray_type];
+    }
+    Program closest_hit(const Instance& inst, unsigned material, unsigned ray_type) const {
+        return &inst.materials[material].closest_hit[ray_type];
+    }
+    Program miss(unsigned ray_type) const { return &scene().miss[ray_type]; }
+    Program attribute(const Instance& inst) const { return &inst.attribute; }
+    bool bound(Program program) const { return bool(*program); }
+
+    void call_any_hit(Program any, void* payload, const void* attr) const {
+        any->entry<HitFn>()(any->rec(), payload, attr);
+    }
+    void call_closest_hit(Program closest, void* payload, const void* attr) const {
+        closest->entry<HitFn>()(closest->rec(), payload, attr);
+    }
+    void call_miss(Program miss, void* payload) const {
+        miss->entry<MissFn>()(miss->rec(), payload);
+    }
+    void call_attribute(Program attribute, unsigned prim, float2 bary, void* out) const {
+        attribute->entry<AttributeFn>()(attribute->rec(), prim, bary, out);
+    }
+    void call_intersection(const Instance& inst, unsigned prim, void* attr) const {
+        inst.intersection.entry<IntersectionFn>()(inst.intersection.rec(), prim, attr);
+    }
+    unsigned call_visit(Program visit) const { return visit->entry<VisitFn>()(visit->rec()); }
+    template <class Attributes>
+    void copy_attributes(Attributes& dst, const Attributes& src, const Instance& inst) const {
+        std::memcpy(dst.bytes, src.bytes, inst.attributes->size);
+    }
+    /// The Traverser over the compiled graph (traversal.cpp).
+    void traverse(runtime::TraceFrame<CpuPolicy>& frame, Handle root, const Ray& ray) const;
+
+    static uint3 triangle_of(const Instance& inst, unsigned prim) {
+        return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
+    }
 };
 
-struct alignas(16) AttributeStorage {
-    unsigned char bytes[kAttributeBytes];
-};
-
-/// The committed (closest so far) hit of a trace.
-struct HitState {
-    float t = 0;
-    unsigned instance = 0;  // CompiledScene::instances index
-    unsigned prim = 0;
-    unsigned material = 0;
-    float2 barycentrics{0, 0};
-    bool attributes_pending = false;  // triangles: attributes computed at closest-hit time
-    bool transformed = false;
-    Matrix4x3 to_world{}, to_object{};
-    AttributeStorage attributes;
-};
-
-struct TraceFrame {
-    Ray world_ray;   // as passed to trace()
-    Ray object_ray;  // in the space of the node being traversed
-    void* payload = nullptr;
-    unsigned ray_type = 0;
-    float closest = 0;  // upper end of the ray interval: shrinks with each committed hit
-    bool has_hit = false;
-    bool terminated = false;
-    bool occlusion = false;  // occluded(): the first intersection ends it, no programs run
-    HitState hit;
-    // Traversal position, for intersection and any-hit programs.
-    const core::CompiledInstance* instance = nullptr;
-    unsigned instance_index = 0;
-    unsigned prim = 0;
-    bool transformed = false;
-    Matrix4x3 to_world{}, to_object{};
-    // Candidate hit of the intersection program being run.
-    float candidate_t = 0;
-    bool candidate_open = false;
-    AttributeStorage scratch;
-    // Any-hit outcome.
-    bool ignore_requested = false;
-    bool terminate_requested = false;
-    ProgramContext context = ProgramContext::kRayGeneration;
-};
+using TraceFrame = runtime::TraceFrame<CpuPolicy>;
+using AttributeStorage = TraceFrame::Attributes;
 
 struct ThreadState {
     const core::CompiledScene* scene = nullptr;
@@ -75,20 +104,28 @@ struct ThreadState {
     uint3 launch_size{1, 1, 1};
     const uint4* device_keys = nullptr;  // per device slot (device_tea_key())
     unsigned device_slots = 1;
-    unsigned depth = 0;              // active traces
-    std::vector<TraceFrame> frames;  // frames[depth - 1] is the innermost trace
+    unsigned depth = 0;           // active traces
+    TraceFrame* frame = nullptr;  // the innermost, on the stack of its trace
     ProgramContext context = ProgramContext::kRayGeneration;  // outside any trace
     bool print_here = false;
-    TraceFrame* current() { return depth ? &frames[depth - 1] : nullptr; }
 };
+
+inline const core::CompiledScene& CpuPolicy::scene() const {
+    return *ts->scene;
+}
 
 /// The calling thread's state (set by the launch loop).
 ThreadState& thread_state();
 void set_thread_state(ThreadState* state);
 
-/// Runs one trace (the device API's trace()).
-void trace(ThreadState& ts, Handle root, const Ray& ray, void* payload, const void* payload_tag);
 /// occluded() of the device API.
 bool occluded(ThreadState& ts, Handle root, const Ray& ray);
 
 }  // namespace lucent::cpu
+
+namespace lucent::runtime {
+/// The policy of the calling thread (device_api.h).
+inline cpu::CpuPolicy backend() {
+    return cpu::CpuPolicy{&cpu::thread_state()};
+}
+}  // namespace lucent::runtime

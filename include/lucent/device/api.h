@@ -1,5 +1,7 @@
-// The device API: what a program may call. Each backend implements the
-// non-template functions (the CPU backend in src/cpu/device_runtime.cpp).
+// The device API: what a program may call. The rules of the functions that read or change
+// a trace are written once, in src/runtime/ (device_api.h there defines them for both
+// backends); each backend implements the others (the CPU's in src/cpu/device_runtime.cpp,
+// the GPU's in src/cuda/device/lucent_gpu/runtime.cuh).
 #pragma once
 
 #include "lucent/device/device_slot.h"
@@ -86,16 +88,75 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray);
 LUCENT_HD bool occluded(Handle root, const Ray& ray);
 #endif
 
-/// In an intersection program: is t inside the ray's current interval?
+/// In an intersection program: is t inside the ray's current interval (tmin, closest hit so
+/// far)? False, and no effect, in every other program kind.
 LUCENT_HD bool potential_intersection(float t);
 /// In an intersection program, after potential_intersection(t) returned true and the
 /// attributes were written: commit the hit with this material index (runs any-hit).
-/// Returns false when any-hit ignored it.
+/// Returns false when any-hit ignored it, when no candidate is open, and outside an
+/// intersection program. An index beyond the instance's materials raises
+/// kExceptionMaterialIndexOutOfRange (detail: the index).
 LUCENT_HD bool report_intersection(unsigned material_index);
-/// In an any-hit program: discard this intersection and go on traversing.
-LUCENT_HD void ignore_intersection();
-/// In an any-hit program: accept this intersection and stop traversal of this ray.
-LUCENT_HD void terminate_ray();
+
+// ---- ending an any-hit program -------------------------------------------------------------
+// ignore_intersection() and terminate_ray() end the any-hit program that calls them, as in
+// OptiX: code after them does not run. Device code has neither exceptions nor longjmp, so
+// they are macros that record the outcome and `return` from the program. They compile only
+// in the body of a LUCENT_ANY_HIT program, whose hidden parameter `lucent_any_hit_scope`
+// they name; elsewhere (another program kind, a helper function) the global declaration
+// below is found instead, and a static_assert says what to do. Write them unqualified.
+// Inside a lambda in the body they would end the lambda only: do not call them there.
+/// The type of an any-hit program's hidden last parameter.
+struct AnyHitScope {};
+namespace detail {
+/// How an any-hit program ended (what the runtime reads after it returns).
+enum class AnyHitOutcome : unsigned {
+    kAccept,     // it returned
+    kIgnore,     // ignore_intersection()
+    kTerminate,  // terminate_ray()
+};
+/// Records the outcome in the innermost trace (nothing outside a trace).
+LUCENT_HD void end_any_hit(AnyHitOutcome outcome);
+struct OutsideAnyHit {};
+template <class Scope>
+struct IsAnyHitScope {
+    static constexpr bool value = false;
+};
+template <>
+struct IsAnyHitScope<AnyHitScope> {
+    static constexpr bool value = true;
+};
+template <class Scope>
+LUCENT_HD inline void end_any_hit_in(AnyHitOutcome outcome) {
+    static_assert(IsAnyHitScope<Scope>::value,
+                  "ignore_intersection() and terminate_ray() end an any-hit program: call them "
+                  "in the body of a LUCENT_ANY_HIT program. A helper function cannot end its "
+                  "caller: return a flag from it and call them in the program.");
+    end_any_hit(outcome);
+}
+}  // namespace detail
+}  // namespace lucent
+
+/// Found outside the body of an any-hit program (only its type is ever used).
+extern const ::lucent::detail::OutsideAnyHit lucent_any_hit_scope;
+
+/// In an any-hit program: discard this intersection and go on traversing; ends the program.
+#define ignore_intersection()                                                                  \
+    do {                                                                                       \
+        ::lucent::detail::end_any_hit_in<decltype(lucent_any_hit_scope)>(                     \
+            ::lucent::detail::AnyHitOutcome::kIgnore);                                         \
+        return;                                                                                \
+    } while (0)
+/// In an any-hit program: accept this intersection and stop the traversal of this ray
+/// (closest hit still runs); ends the program.
+#define terminate_ray()                                                                        \
+    do {                                                                                       \
+        ::lucent::detail::end_any_hit_in<decltype(lucent_any_hit_scope)>(                     \
+            ::lucent::detail::AnyHitOutcome::kTerminate);                                      \
+        return;                                                                                \
+    } while (0)
+
+namespace lucent {
 
 namespace detail {
 /// The transform in effect for the running program (the committed hit's in closest hit,

@@ -158,8 +158,22 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 
 #define LUCENT_CLOSEST_HIT(name, Record, Payload, Attributes) \
     LUCENT_HIT_PROGRAM_(name, kClosestHit, Record, Payload, Attributes)
-#define LUCENT_ANY_HIT(name, Record, Payload, Attributes) \
-    LUCENT_HIT_PROGRAM_(name, kAnyHit, Record, Payload, Attributes)
+/// Any-hit programs have a hidden last parameter, `lucent_any_hit_scope`: what lets
+/// ignore_intersection() and terminate_ray() compile in their body only (lucent/device/api.h).
+#define LUCENT_ANY_HIT(name, Record, Payload, Attributes)                                       \
+    inline void name(const Record& rec, Payload& prd, const Attributes& attr,                   \
+                     ::lucent::AnyHitScope = {});                                               \
+    LUCENT_DECLARE_PROGRAM_(                                                                    \
+        name, ::lucent::detail::make_desc<Record>(                                              \
+                  #name, ::lucent::ProgramKind::kAnyHit, __FILE__,                              \
+                  &::lucent::type_info_of<Payload>(), &::lucent::type_info_of<Attributes>(),    \
+                  ::lucent::detail::erase_fn(+[](const void* r, void* p, const void* a) {       \
+                      name(*static_cast<const Record*>(r), *static_cast<Payload*>(p),           \
+                           *static_cast<const Attributes*>(a));                                 \
+                  })))                                                                          \
+    inline void name([[maybe_unused]] const Record& rec, [[maybe_unused]] Payload& prd,         \
+                     [[maybe_unused]] const Attributes& attr,                                   \
+                     [[maybe_unused]] ::lucent::AnyHitScope lucent_any_hit_scope)
 
 #define LUCENT_INTERSECTION(name, Record, Attributes)                                        \
     inline void name(const Record& rec, unsigned prim, Attributes& attr);                    \
@@ -243,8 +257,9 @@ constexpr auto callable_thunk(R (*)(const Record&, Args...)) -> R (*)(const void
 #define LUCENT_MISS(name, Record, Payload) __device__ void name(const Record& rec, Payload& prd)
 #define LUCENT_CLOSEST_HIT(name, Record, Payload, Attributes) \
     __device__ void name(const Record& rec, Payload& prd, const Attributes& attr)
-#define LUCENT_ANY_HIT(name, Record, Payload, Attributes) \
-    __device__ void name(const Record& rec, Payload& prd, const Attributes& attr)
+#define LUCENT_ANY_HIT(name, Record, Payload, Attributes)                          \
+    __device__ void name(const Record& rec, Payload& prd, const Attributes& attr, \
+                         [[maybe_unused]] ::lucent::AnyHitScope lucent_any_hit_scope = {})
 #define LUCENT_INTERSECTION(name, Record, Attributes) \
     __device__ void name(const Record& rec, unsigned prim, Attributes& attr)
 #define LUCENT_BOUNDING_BOX(name, Record) \

@@ -25,6 +25,13 @@ __device__ __forceinline__ void invoke(void (*f)(const R&, P&, const A&), const 
                                        void* prd, const void* attr) {
     f(*static_cast<const R*>(rec), *static_cast<P*>(prd), *static_cast<const A*>(attr));
 }
+// Any-hit programs: their hidden last parameter is what ignore_intersection() names.
+template <class R, class P, class A>
+__device__ __forceinline__ void invoke(void (*f)(const R&, P&, const A&, AnyHitScope),
+                                       const void* rec, void* prd, const void* attr) {
+    f(*static_cast<const R*>(rec), *static_cast<P*>(prd), *static_cast<const A*>(attr),
+      AnyHitScope{});
+}
 template <class R, class A>
 __device__ __forceinline__ void invoke(void (*f)(const R&, unsigned, A&), const void* rec,
                                        unsigned prim, void* attr) {

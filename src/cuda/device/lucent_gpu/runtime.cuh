@@ -1,5 +1,6 @@
 // The GPU side of the engine, compiled into every megakernel by NVRTC: per-thread state,
-// the device API (lucent/device/api.h) and trace() over the compiled graph. The generated
+// the policy that instantiates the trace state machine (src/runtime/) for the megakernel,
+// and the device API (lucent/device/api.h); trace.cuh has the traversal. The generated
 // part of the megakernel defines the dispatch functions declared here and sets the
 // LUCENT_GPU_* switches, so code for features the scene does not use is never compiled
 // (OptiX paper §4.3: no transforms → no transform code, exceptions off → no checks).
@@ -7,6 +8,7 @@
 
 #include "lucent/device.h"
 #include "lucent_gpu/launch_params.cuh"
+#include "runtime/trace_frame.h"
 
 #ifndef LUCENT_GPU_GROUPS
 #define LUCENT_GPU_GROUPS 1
@@ -59,48 +61,117 @@ __device__ void dispatch_intersection(int id, const void* rec, unsigned prim, vo
 __device__ unsigned dispatch_visit(int id, const void* rec);
 __device__ void dispatch_attribute(int id, const void* rec, unsigned prim, float2 bary, void* attr);
 
-enum Context : unsigned {
-    kCtxRayGeneration,
-    kCtxException,
-    kCtxMiss,
-    kCtxClosestHit,
-    kCtxAnyHit,
-    kCtxIntersection,
-    kCtxVisit,
-    kCtxAttribute,
-};
+struct ThreadState;
 
-struct alignas(16) Attributes {
-    unsigned char bytes[LUCENT_GPU_ATTRIBUTE_BYTES];
+/// How the trace state machine (src/runtime/trace_rules.h) runs in the megakernel: thread
+/// state in shared memory, the scene in `params`, programs through the generated dispatch,
+/// exceptions recorded (device code cannot unwind). The switches above say which frame
+/// fields and paths exist.
+struct GpuPolicy {
+    using Thread = ThreadState;
+    using Instance = GpuInstance;
+    using Program = ProgramRef;
+    using PayloadTag = unsigned;  // sizeof(payload) << 8 | alignof(payload)
+    static constexpr bool kTransforms = LUCENT_GPU_TRANSFORMS;
+    static constexpr bool kOcclusion = LUCENT_GPU_OCCLUSION;
+    static constexpr unsigned kAttributeBytes = LUCENT_GPU_ATTRIBUTE_BYTES;
+
+    __device__ __forceinline__ ThreadState& thread() const;
+    __device__ __forceinline__ void raise(int code, unsigned detail) const;
+    __device__ __forceinline__ bool exception_pending() const;
+
+    __device__ __forceinline__ unsigned ray_type_count() const { return params.ray_type_count; }
+    __device__ __forceinline__ bool payload_matches(unsigned ray_type, unsigned tag) const {
+        return tag == params.payload_signatures[ray_type];
+    }
+    __device__ __forceinline__ unsigned node_count() const { return params.node_count; }
+    __device__ __forceinline__ unsigned max_depth() const { return LUCENT_GPU_MAX_DEPTH; }
+    __device__ __forceinline__ const Ray& no_ray() const;
+
+    __device__ __forceinline__ const GpuInstance& instance(unsigned index) const {
+        return params.instances[index];
+    }
+    __device__ __forceinline__ unsigned material_count(const GpuInstance& inst) const {
+        return inst.material_count;
+    }
+    __device__ __forceinline__ unsigned triangle_material(const GpuInstance& inst,
+                                                          unsigned prim) const {
+        return inst.material_indices ? inst.material_indices[prim] : 0u;
+    }
+    __device__ __forceinline__ void triangle(const GpuInstance& inst, unsigned prim, float3& p0,
+                                             float3& p1, float3& p2) const {
+        const uint3 t = triangle_of(inst, prim);
+        p0 = inst.vertices[t.x];
+        p1 = inst.vertices[t.y];
+        p2 = inst.vertices[t.z];
+    }
+    __device__ __forceinline__ ProgramRef any_hit(const GpuInstance& inst, unsigned material,
+                                                  unsigned ray_type) const {
+        return material_slot(inst, material, ray_type).any;
+    }
+    __device__ __forceinline__ ProgramRef closest_hit(const GpuInstance& inst, unsigned material,
+                                                      unsigned ray_type) const {
+        return material_slot(inst, material, ray_type).closest;
+    }
+    __device__ __forceinline__ ProgramRef miss(unsigned ray_type) const {
+        return params.miss[ray_type];
+    }
+    __device__ __forceinline__ ProgramRef attribute(const GpuInstance& inst) const {
+        return inst.attribute;
+    }
+    __device__ __forceinline__ bool bound(ProgramRef program) const { return program.id >= 0; }
+
+    __device__ __forceinline__ void call_any_hit(ProgramRef any, void* payload,
+                                                 const void* attr) const {
+        dispatch_any_hit(any.id, record(any), payload, attr);
+    }
+    __device__ __forceinline__ void call_closest_hit(ProgramRef closest, void* payload,
+                                                     const void* attr) const {
+        dispatch_closest_hit(closest.id, record(closest), payload, attr);
+    }
+    __device__ __forceinline__ void call_miss(ProgramRef miss, void* payload) const {
+        dispatch_miss(miss.id, record(miss), payload);
+    }
+    __device__ __forceinline__ void call_attribute(ProgramRef attribute, unsigned prim,
+                                                   float2 bary, void* out) const {
+        dispatch_attribute(attribute.id, record(attribute), prim, bary, out);
+    }
+    __device__ __forceinline__ void call_intersection(const GpuInstance& inst, unsigned prim,
+                                                      void* attr) const {
+        dispatch_intersection(inst.intersection.id, record(inst.intersection), prim, attr);
+    }
+    __device__ __forceinline__ unsigned call_visit(ProgramRef visit) const {
+        return dispatch_visit(visit.id, record(visit));
+    }
+    template <class Attributes>
+    __device__ __forceinline__ void copy_attributes(Attributes& dst, const Attributes& src,
+                                                    const GpuInstance&) const {
+        const uint4* s = reinterpret_cast<const uint4*>(src.bytes);
+        uint4* d = reinterpret_cast<uint4*>(dst.bytes);
+        for (int i = 0; i < LUCENT_GPU_ATTRIBUTE_BYTES / 16; ++i) d[i] = s[i];
+    }
+    /// The GPU's traversal (trace.cuh).
+    __device__ __forceinline__ void traverse(runtime::TraceFrame<GpuPolicy>& f, Handle root,
+                                             const Ray& ray) const;
+
+    __device__ __forceinline__ static const unsigned char* record(ProgramRef p) {
+        return params.records + p.record;
+    }
+    __device__ __forceinline__ static uint3 triangle_of(const GpuInstance& inst, unsigned prim) {
+        return inst.indices ? inst.indices[prim]
+                            : make_uint3(3 * prim, 3 * prim + 1, 3 * prim + 2);
+    }
+    __device__ __forceinline__ static const GpuMaterialSlot& material_slot(
+        const GpuInstance& inst, unsigned material, unsigned ray_type) {
+        return params
+            .materials[(inst.material_offset + material) * params.ray_type_count + ray_type];
+    }
 };
 
 /// One active trace (lives on the stack of trace_ray; recursion nests them).
-struct Frame {
-    Ray world_ray;
-#if LUCENT_GPU_TRANSFORMS
-    Ray object_ray;  // in the space of the node being traversed
-#endif
-    void* payload;
-    unsigned ray_type;
-    float closest;
-    unsigned context;
-    bool has_hit, terminated, candidate_open, ignore_requested, terminate_requested;
-    bool occlusion;  // occluded(): the first intersection ends it, no programs run
-    // committed hit
-    float hit_t;
-    unsigned hit_instance, hit_prim, hit_material;
-    float2 hit_bary;
-    bool hit_pending;
-    // traversal position
-    unsigned instance, prim;
-    float candidate_t;
-#if LUCENT_GPU_TRANSFORMS
-    bool transformed, hit_transformed;
-    Matrix4x3 to_world, to_object, hit_to_world, hit_to_object;
-#endif
-    Attributes hit_attr;
-    Attributes scratch;
-};
+using Frame = runtime::TraceFrame<GpuPolicy>;
+using Attributes = Frame::Attributes;
+using runtime::ProgramContext;
 
 struct ThreadState {
     uint3 launch_index;
@@ -109,16 +180,22 @@ struct ThreadState {
     unsigned exception_detail;
     Frame* frame;
     unsigned print_here;
-    unsigned context;  // outside any trace
+    ProgramContext context;  // outside any trace
 };
 
 __shared__ ThreadState g_threads[LUCENT_GPU_BLOCK];
 __device__ __forceinline__ ThreadState& self() {
     return g_threads[threadIdx.x];
 }
+__device__ __forceinline__ ThreadState& GpuPolicy::thread() const {
+    return self();
+}
+__device__ __forceinline__ bool GpuPolicy::exception_pending() const {
+    return self().exception_code != 0;
+}
 
 __device__ __forceinline__ const unsigned char* record(ProgramRef p) {
-    return params.records + p.record;
+    return GpuPolicy::record(p);
 }
 
 }  // namespace lucent::gpu
@@ -162,81 +239,20 @@ LUCENT_HD uint4 device_tea_key() {
 
 namespace gpu {
 __device__ const Ray g_no_ray = {};  // current_ray() outside any trace
+__device__ __forceinline__ const Ray& GpuPolicy::no_ray() const {
+    return g_no_ray;
 }
-LUCENT_HD const Ray& current_ray() {
-    gpu::Frame* f = gpu::self().frame;
-    if (!f) return gpu::g_no_ray;
-    switch (f->context) {
-        case gpu::kCtxIntersection:
-        case gpu::kCtxAnyHit:
-        case gpu::kCtxVisit:
-        case gpu::kCtxAttribute:
-#if LUCENT_GPU_TRANSFORMS
-            return f->object_ray;
-#else
-            return f->world_ray;  // no transforms: object space is world space
-#endif
-        default:
-            return f->world_ray;
-    }
+__device__ __forceinline__ void GpuPolicy::raise(int code, unsigned detail) const {
+    ::lucent::detail::raise_exception(code, detail);
 }
+}  // namespace gpu
 
-LUCENT_HD float t_hit() {
-    gpu::Frame* f = gpu::self().frame;
-    if (!f) return 0.0f;
-    switch (f->context) {
-        case gpu::kCtxAnyHit:
-            return f->candidate_t;
-        case gpu::kCtxClosestHit:
-            return f->hit_t;
-        case gpu::kCtxMiss:
-            return f->world_ray.tmax;
-        default:
-            return f->closest;
-    }
+namespace runtime {
+__device__ __forceinline__ gpu::GpuPolicy backend() {
+    return {};
 }
-
-LUCENT_HD unsigned primitive_index() {
-    gpu::Frame* f = gpu::self().frame;
-    if (!f) return 0;
-    return f->context == gpu::kCtxClosestHit ? f->hit_prim : f->prim;
-}
-
-LUCENT_HD bool potential_intersection(float t) {
-    gpu::Frame* f = gpu::self().frame;
-    f->candidate_open = t > f->world_ray.tmin && t < f->closest;
-    if (f->candidate_open) f->candidate_t = t;
-    return f->candidate_open;
-}
-
-LUCENT_HD void ignore_intersection() {
-    gpu::self().frame->ignore_requested = true;
-}
-LUCENT_HD void terminate_ray() {
-    gpu::self().frame->terminate_requested = true;
-}
-
-namespace detail {
-LUCENT_HD bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object) {
-#if LUCENT_GPU_TRANSFORMS
-    gpu::Frame* f = gpu::self().frame;
-    if (!f) return false;
-    if (f->context == gpu::kCtxClosestHit) {
-        if (!f->hit_transformed) return false;
-        to_world = &f->hit_to_world;
-        to_object = &f->hit_to_object;
-        return true;
-    }
-    if (f->context == gpu::kCtxMiss || !f->transformed) return false;
-    to_world = &f->to_world;
-    to_object = &f->to_object;
-    return true;
-#else
-    (void)to_world;
-    (void)to_object;
-    return false;
-#endif
-}
-}  // namespace detail
-
+}  // namespace runtime
 }  // namespace lucent
+
+// The device API functions that read or change a trace: the rules shared with the CPU.
+#include "runtime/device_api.h"

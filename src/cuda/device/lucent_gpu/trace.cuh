@@ -1,112 +1,20 @@
 // trace() on the GPU and the megakernel entry point (included after the generated
-// dispatch). The same algorithm as the CPU backend (src/cpu/traversal.cpp): Traverse the
-// graph, running intersection and any-hit programs, then Shade with closest hit or miss.
+// dispatch): the traversal of the GPU's BVHs, which drives the trace state machine of
+// src/runtime/trace_rules.h (the CPU's traversal, src/cpu/traversal.cpp, drives the same):
+// Traverse the graph, running intersection and any-hit programs, then Shade with closest
+// hit or miss.
 #pragma once
 
 #include "lucent/device/triangle_intersect.h"
 #include "lucent_gpu/runtime.cuh"
+#include "runtime/trace_rules.h"
 
 namespace lucent::gpu {
 
-__device__ inline Matrix4x3 compose(const Matrix4x3& a, const Matrix4x3& b) {
-    Matrix4x3 r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 4; ++j) {
-            float v =
-                a.m[i * 4 + 0] * b.m[j] + a.m[i * 4 + 1] * b.m[4 + j] + a.m[i * 4 + 2] * b.m[8 + j];
-            r.m[i * 4 + j] = j == 3 ? v + a.m[i * 4 + 3] : v;
-        }
-    return r;
-}
-
-__device__ inline uint3 triangle_of(const GpuInstance& inst, unsigned prim) {
-    return inst.indices ? inst.indices[prim] : make_uint3(3 * prim, 3 * prim + 1, 3 * prim + 2);
-}
-
-__device__ inline const GpuMaterialSlot& material_slot(const GpuInstance& inst, unsigned material,
-                                                       unsigned ray_type) {
-    return params.materials[(inst.material_offset + material) * params.ray_type_count + ray_type];
-}
-
-__device__ inline void triangle_attributes(Frame& f, const GpuInstance& inst, unsigned prim,
-                                           float2 bary, Attributes& out) {
-    if (inst.attribute.id >= 0) {
-        unsigned saved = f.context;
-        f.context = kCtxAttribute;
-        dispatch_attribute(inst.attribute.id, record(inst.attribute), prim, bary, out.bytes);
-        f.context = saved;
-        return;
-    }
-    uint3 t = triangle_of(inst, prim);
-    float3 p0 = inst.vertices[t.x], p1 = inst.vertices[t.y], p2 = inst.vertices[t.z];
-    TriangleAttributes* a = reinterpret_cast<TriangleAttributes*>(out.bytes);
-    a->barycentrics = bary;
-    a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
-}
-
-__device__ inline void commit(Frame& f, unsigned instance, unsigned prim, float t,
-                              unsigned material) {
-    f.has_hit = true;
-    f.closest = t;
-    f.hit_t = t;
-    f.hit_instance = instance;
-    f.hit_prim = prim;
-    f.hit_material = material;
-    f.hit_pending = false;
-#if LUCENT_GPU_TRANSFORMS
-    f.hit_transformed = f.transformed;
-    if (f.transformed) {
-        f.hit_to_world = f.to_world;
-        f.hit_to_object = f.to_object;
-    }
-#endif
-}
-
-__device__ inline void copy_attributes(Attributes& dst, const Attributes& src) {
-    const uint4* s = reinterpret_cast<const uint4*>(src.bytes);
-    uint4* d = reinterpret_cast<uint4*>(dst.bytes);
-    for (int i = 0; i < LUCENT_GPU_ATTRIBUTE_BYTES / 16; ++i) d[i] = s[i];
-}
-
-/// Runs the any-hit program on the candidate; false when it called ignore_intersection.
-__device__ inline bool run_any_hit(Frame& f, ProgramRef any) {
-    unsigned saved = f.context;
-    f.context = kCtxAnyHit;
-    f.ignore_requested = false;
-    f.terminate_requested = false;
-    dispatch_any_hit(any.id, record(any), f.payload, f.scratch.bytes);
-    f.context = saved;
-    if (f.ignore_requested) return false;
-    if (f.terminate_requested) f.terminated = true;
-    return true;
-}
-
-/// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
-__device__ inline bool triangle_candidate(Frame& f, unsigned instance_index, unsigned prim, float t,
-                                          float2 bary) {
-#if LUCENT_GPU_OCCLUSION
-    if (f.occlusion) {  // occluded(): any intersection answers the query
-        f.has_hit = f.terminated = true;
-        return true;
-    }
-#endif
-    const GpuInstance& inst = params.instances[instance_index];
-    unsigned material = inst.material_indices ? inst.material_indices[prim] : 0u;
-    ProgramRef any = material_slot(inst, material, f.ray_type).any;
-    if (any.id >= 0) {
-        f.instance = instance_index;
-        f.prim = prim;
-        triangle_attributes(f, inst, prim, bary, f.scratch);
-        f.candidate_t = t;
-        if (!run_any_hit(f, any)) return false;
-        commit(f, instance_index, prim, t, material);
-        copy_attributes(f.hit_attr, f.scratch);
-        return true;
-    }
-    commit(f, instance_index, prim, t, material);
-    f.hit_bary = bary;
-    f.hit_pending = true;
-    return true;
+/// The trace state machine's steps as the traversal below uses them.
+__device__ __forceinline__ bool triangle_candidate(Frame& f, unsigned instance_index, unsigned prim,
+                                                   float t, float2 bary) {
+    return runtime::triangle_candidate(GpuPolicy{}, f, instance_index, prim, t, bary);
 }
 
 /// Slab test of a binary BVH node against the ray interval [tmin, tmax]; the far distance
@@ -143,10 +51,7 @@ __device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origi
 
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                                float3 direction) {
-#if LUCENT_GPU_TRANSFORMS  // else the object-space ray is the world ray
-    f.object_ray.origin = origin;
-    f.object_ray.direction = direction;
-#endif
+    runtime::enter_space<GpuPolicy>(f, origin, direction);
     const float tmin = f.world_ray.tmin;
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
@@ -186,19 +91,13 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     auto visit_resolved = [&](unsigned instance_index, unsigned local) {
         const GpuInstance& inst = params.instances[instance_index];
         if (inst.triangles) {
-            uint3 t = triangle_of(inst, local);
+            uint3 t = GpuPolicy::triangle_of(inst, local);
             float th, u, v;
             if (intersect_triangle_watertight(wray, inst.vertices[t.x], inst.vertices[t.y],
                                               inst.vertices[t.z], tmin, f.closest, th, u, v))
                 triangle_candidate(f, instance_index, local, th, make_float2(u, v));
         } else {
-            f.instance = instance_index;
-            f.prim = local;
-            unsigned saved = f.context;
-            f.context = kCtxIntersection;
-            dispatch_intersection(inst.intersection.id, record(inst.intersection), local,
-                                  f.scratch.bytes);
-            f.context = saved;
+            runtime::run_intersection(GpuPolicy{}, f, instance_index, inst, local);
         }
         return f.terminated || self().exception_code != 0;
     };
@@ -277,29 +176,17 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
             return;
 #if LUCENT_GPU_TRANSFORMS
         case kGpuTransform: {
-            const bool was = f.transformed;
-            const Matrix4x3 to_world = f.to_world, to_object = f.to_object;
-            f.to_world = was ? compose(to_world, n.to_world) : n.to_world;
-            f.to_object = was ? compose(n.to_object, to_object) : n.to_object;
-            f.transformed = true;
+            const runtime::SavedTransform saved =
+                runtime::enter_transform(f, n.to_world, n.to_object);
             traverse_node(f, params.children[n.first], transform_point(n.to_object, origin),
                           transform_vector(n.to_object, direction));
-            f.transformed = was;
-            f.to_world = to_world;
-            f.to_object = to_object;
+            runtime::leave_transform(f, saved);
             return;
         }
 #endif
 #if LUCENT_GPU_SELECTORS
         case kGpuSelector: {
-#if LUCENT_GPU_TRANSFORMS
-            f.object_ray.origin = origin;
-            f.object_ray.direction = direction;
-#endif
-            unsigned saved = f.context;
-            f.context = kCtxVisit;
-            unsigned child = dispatch_visit(n.visit.id, record(n.visit));
-            f.context = saved;
+            const unsigned child = runtime::run_visit(GpuPolicy{}, f, n.visit, origin, direction);
             if (child < n.count)
                 traverse_node(f, params.children[n.first + child], origin, direction);
             return;
@@ -310,24 +197,6 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
     }
 }
 #endif  // LUCENT_GPU_NESTED
-
-/// A trace frame for `ray`, before traversal.
-__device__ __forceinline__ void begin_frame(Frame& f, const Ray& ray, void* payload,
-                                            bool occlusion) {
-    f.world_ray = ray;
-#if LUCENT_GPU_TRANSFORMS
-    f.object_ray = ray;
-    f.transformed = false;
-#endif
-    f.payload = payload;
-    f.ray_type = ray.ray_type;
-    f.closest = ray.tmax;
-    f.has_hit = false;
-    f.terminated = false;
-    f.occlusion = occlusion;
-    f.candidate_open = false;
-    f.context = kCtxIntersection;
-}
 
 /// Traverses the graph below `root`. A GeometryGroup root (the common case) is traversed
 /// here, inline: one call level less (ncu: returns and register restores of the call ABI
@@ -342,98 +211,24 @@ __device__ __forceinline__ void traverse_root(Frame& f, Handle root, const Ray& 
         geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
 }
 
+__device__ __forceinline__ void GpuPolicy::traverse(Frame& f, Handle root, const Ray& ray) const {
+    traverse_root(f, root, ray);
+}
+
+/// trace(): its frame lives on this function's stack.
 __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
                                        unsigned payload_signature) {
-    ThreadState& s = self();
-    if (s.exception_code) return;  // an exception ends the launch index's work
-    if (ray.ray_type >= params.ray_type_count) {
-        detail::raise_exception(kExceptionInvalidRayType, ray.ray_type);
-        return;
-    }
-    if (payload_signature != params.payload_signatures[ray.ray_type]) {
-        detail::raise_exception(kExceptionPayloadTypeMismatch, ray.ray_type);
-        return;
-    }
-    if (root.index >= params.node_count) {
-        detail::raise_exception(kExceptionInvalidHandle, root.index);
-        return;
-    }
-    if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
-        detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
-        return;
-    }
-    Frame f;
-    begin_frame(f, ray, payload, /*occlusion=*/false);
-    Frame* outer = s.frame;
-    s.frame = &f;
-    ++s.depth;
-    traverse_root(f, root, ray);
-    if (!s.exception_code) {
-        if (f.has_hit) {
-            const GpuInstance& inst = params.instances[f.hit_instance];
-            if (f.hit_pending) {
-                // The attribute program runs as at the hit: its primitive, transform and ray.
-                f.instance = f.hit_instance;
-                f.prim = f.hit_prim;
-#if LUCENT_GPU_TRANSFORMS
-                f.object_ray = ray;
-                f.transformed = f.hit_transformed;
-                if (f.hit_transformed) {
-                    f.to_world = f.hit_to_world;
-                    f.to_object = f.hit_to_object;
-                    f.object_ray.origin = transform_point(f.hit_to_object, ray.origin);
-                    f.object_ray.direction = transform_vector(f.hit_to_object, ray.direction);
-                }
-#endif
-                triangle_attributes(f, inst, f.hit_prim, f.hit_bary, f.hit_attr);
-            }
-#if LUCENT_GPU_TRANSFORMS
-            f.object_ray = ray;
-#endif
-            ProgramRef closest = material_slot(inst, f.hit_material, f.ray_type).closest;
-            if (closest.id >= 0) {
-                f.context = kCtxClosestHit;
-                dispatch_closest_hit(closest.id, record(closest), payload, f.hit_attr.bytes);
-            }
-        } else {
-            ProgramRef miss = params.miss[f.ray_type];
-            if (miss.id >= 0) {
-                f.context = kCtxMiss;
-                dispatch_miss(miss.id, record(miss), payload);
-            }
-        }
-    }
-    --s.depth;
-    s.frame = outer;
+    runtime::trace(GpuPolicy{}, root, ray, payload, payload_signature);
 }
 
 #if LUCENT_GPU_OCCLUSION
 /// occluded() of the device API for the roots its inline fast path leaves (see occluded()
 /// below): any graph, traversed in an occlusion frame; and the checks that raise exceptions.
 __device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
-    ThreadState& s = self();
-    if (s.exception_code) return false;
-    if (ray.ray_type >= params.ray_type_count) {
-        detail::raise_exception(kExceptionInvalidRayType, ray.ray_type);
-        return false;
-    }
-    if (root.index >= params.node_count) {
-        detail::raise_exception(kExceptionInvalidHandle, root.index);
-        return false;
-    }
-    if (s.depth >= LUCENT_GPU_MAX_DEPTH) {
-        detail::raise_exception(kExceptionStackOverflow, s.depth + 1);
-        return false;
-    }
-    Frame f;
-    begin_frame(f, ray, nullptr, /*occlusion=*/true);
-    Frame* outer = s.frame;
-    s.frame = &f;
-    ++s.depth;
-    traverse_root(f, root, ray);
-    --s.depth;
-    s.frame = outer;
-    return f.has_hit && !s.exception_code;
+    const GpuPolicy p{};
+    if (p.exception_pending()) return false;
+    if (!runtime::occlusion_allowed(p, root, ray)) return false;
+    return runtime::occluded_in_frame(p, root, ray);
 }
 #endif  // LUCENT_GPU_OCCLUSION
 
@@ -476,27 +271,6 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray) {
 }
 #endif
 
-LUCENT_HD bool report_intersection(unsigned material) {
-    gpu::Frame& f = *gpu::self().frame;
-    if (f.context != gpu::kCtxIntersection || !f.candidate_open) return false;
-    f.candidate_open = false;
-    const gpu::GpuInstance& inst = gpu::params.instances[f.instance];
-    if (material >= inst.material_count) {
-        detail::raise_exception(kExceptionMaterialIndexOutOfRange, material);
-        return false;
-    }
-#if LUCENT_GPU_OCCLUSION
-    if (f.occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
-        f.has_hit = f.terminated = true;
-        return true;
-    }
-#endif
-    gpu::ProgramRef any = gpu::material_slot(inst, material, f.ray_type).any;
-    if (any.id >= 0 && !gpu::run_any_hit(f, any)) return false;
-    gpu::commit(f, f.instance, f.prim, f.candidate_t, material);
-    gpu::copy_attributes(f.hit_attr, f.scratch);
-    return true;
-}
 }  // namespace lucent
 
 /// The megakernel: persistent threads take launch indices from a global counter, a warp's
@@ -556,7 +330,7 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         s.depth = 0;
         s.exception_code = 0;
         s.frame = nullptr;
-        s.context = kCtxRayGeneration;
+        s.context = ProgramContext::kRayGeneration;
 #if LUCENT_GPU_PRINT
         s.print_here = p.print_enabled && (p.print_index.x < 0 || unsigned(p.print_index.x) == x) &&
                        (p.print_index.y < 0 || unsigned(p.print_index.y) == y) &&
@@ -574,7 +348,7 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
                 s.exception_code = 0;  // the exception program runs normally
                 s.depth = 0;
                 s.frame = nullptr;
-                s.context = kCtxException;
+                s.context = ProgramContext::kException;
                 ExceptionInfo info{code, s.launch_index, s.exception_detail};
                 dispatch_exception(p.exception.id, record(p.exception), info);
                 if (s.exception_code) count_exception(s.exception_code, linear);

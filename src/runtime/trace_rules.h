@@ -1,0 +1,477 @@
+// The trace state machine, written once for both backends (pbrt-v4's way: LUCENT_HD code
+// instantiated by each backend): what each program kind may call and what it sees, how a
+// candidate becomes the committed hit, how any-hit programs accept, ignore or terminate,
+// the checks before a trace and the shade phase after traversal (OptiX paper §3.1, Fig. 2:
+// Traverse, then Shade). The traversal itself (the CPU's over core::CompiledScene, the
+// GPU's over its BVHs) stays with each backend and calls in here.
+//
+// A backend instantiates it with a policy object `p` (its methods const) that provides:
+//   Thread, Instance, Program, PayloadTag      types; a Thread has the members
+//                                              `Frame* frame`, `unsigned depth` and
+//                                              `ProgramContext context` (outside any trace)
+//   kTransforms, kOcclusion, kAttributeBytes   what frames hold and which paths exist
+//   thread()                                   the calling thread's state
+//   raise(code, detail)                        the CPU throws core::ProgramException; the
+//   exception_pending()                        GPU records it and the caller returns
+//   ray_type_count(), payload_matches(ray_type, tag), node_count(), max_depth(), no_ray()
+//   instance(i), material_count(inst), triangle_material(inst, prim), triangle(inst, prim,
+//   p0, p1, p2), any_hit(inst, material, ray_type), closest_hit(...), miss(ray_type),
+//   attribute(inst), bound(program)            the scene, and which programs are bound
+//   call_any_hit, call_closest_hit, call_miss, call_attribute, call_intersection,
+//   call_visit                                 program dispatch
+//   copy_attributes(dst, src, inst), traverse(frame, root, ray)
+#pragma once
+
+#include "lucent/device/api.h"
+#include "runtime/trace_frame.h"
+
+// The GPU's tuning: these run inside trace_ray's frame (inlined, as they were written
+// there); g++ decides for itself on the CPU.
+#if LUCENT_GPU_CODE
+#define LUCENT_RUNTIME_INLINE LUCENT_HD __forceinline__
+#else
+#define LUCENT_RUNTIME_INLINE inline
+#endif
+
+namespace lucent::runtime {
+
+template <class P>
+using FrameOf = TraceFrame<P>;
+
+// ---- what the running program sees ------------------------------------------------------
+
+/// current_ray(): object space in intersection, any-hit, visit and attribute programs (the
+/// space of the node being traversed), world space elsewhere; a zero ray outside a trace.
+template <class P>
+LUCENT_RUNTIME_INLINE const Ray& current_ray(const P& p) {
+    const FrameOf<P>* f = p.thread().frame;
+    if (!f) return p.no_ray();
+    switch (f->context) {
+        case ProgramContext::kIntersection:
+        case ProgramContext::kAnyHit:
+        case ProgramContext::kVisit:
+        case ProgramContext::kAttribute:
+            if constexpr (P::kTransforms)
+                return f->object_ray;
+            else
+                return f->world_ray;  // no transforms: object space is world space
+        default:
+            return f->world_ray;
+    }
+}
+
+/// t_hit(): the candidate's t in any-hit, the committed hit's in closest hit, tmax in miss,
+/// the closest so far elsewhere in a trace; 0 outside one.
+template <class P>
+LUCENT_RUNTIME_INLINE float t_hit(const P& p) {
+    const FrameOf<P>* f = p.thread().frame;
+    if (!f) return 0.0f;
+    switch (f->context) {
+        case ProgramContext::kAnyHit:
+            return f->candidate_t;
+        case ProgramContext::kClosestHit:
+            return f->hit_t;
+        case ProgramContext::kMiss:
+            return f->world_ray.tmax;
+        default:
+            return f->closest;
+    }
+}
+
+/// primitive_index(): the committed hit's in closest hit, the traversal position's elsewhere.
+template <class P>
+LUCENT_RUNTIME_INLINE unsigned primitive_index(const P& p) {
+    const FrameOf<P>* f = p.thread().frame;
+    if (!f) return 0;
+    return f->context == ProgramContext::kClosestHit ? f->hit_prim : f->prim;
+}
+
+/// The transform of the committed hit in closest hit, of the traversal position in the
+/// programs that run during traversal; none in miss, outside a trace, or when not below a
+/// Transform.
+template <class P>
+LUCENT_RUNTIME_INLINE bool current_transform(const P& p, const Matrix4x3*& to_world,
+                                             const Matrix4x3*& to_object) {
+    if constexpr (P::kTransforms) {
+        const FrameOf<P>* f = p.thread().frame;
+        if (!f) return false;
+        if (f->context == ProgramContext::kClosestHit) {
+            if (!f->hit_transformed) return false;
+            to_world = &f->hit_to_world;
+            to_object = &f->hit_to_object;
+            return true;
+        }
+        if (f->context == ProgramContext::kMiss || !f->transformed) return false;
+        to_world = &f->to_world;
+        to_object = &f->to_object;
+        return true;
+    } else {
+        (void)p;
+        (void)to_world;
+        (void)to_object;
+        return false;
+    }
+}
+
+// ---- transforms and spaces during traversal -------------------------------------------------
+
+/// a ∘ b for affine matrices (apply b first).
+LUCENT_HD inline Matrix4x3 compose(const Matrix4x3& a, const Matrix4x3& b) {
+    Matrix4x3 r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) {
+            float v =
+                a.m[i * 4 + 0] * b.m[j] + a.m[i * 4 + 1] * b.m[4 + j] + a.m[i * 4 + 2] * b.m[8 + j];
+            r.m[i * 4 + j] = j == 3 ? v + a.m[i * 4 + 3] : v;
+        }
+    return r;
+}
+
+/// The traversal position's transform before a Transform node was entered.
+struct SavedTransform {
+    bool transformed;
+    Matrix4x3 to_world, to_object;
+};
+
+/// Enters a Transform node. Rays enter the child's space; the direction is not
+/// renormalised, so t is the same in every space and hits compare across transforms.
+template <class Frame>
+LUCENT_RUNTIME_INLINE SavedTransform enter_transform(Frame& f, const Matrix4x3& to_world,
+                                                     const Matrix4x3& to_object) {
+    const SavedTransform saved{f.transformed, f.to_world, f.to_object};
+    f.to_world = saved.transformed ? compose(saved.to_world, to_world) : to_world;
+    f.to_object = saved.transformed ? compose(to_object, saved.to_object) : to_object;
+    f.transformed = true;
+    return saved;
+}
+template <class Frame>
+LUCENT_RUNTIME_INLINE void leave_transform(Frame& f, const SavedTransform& saved) {
+    f.transformed = saved.transformed;
+    f.to_world = saved.to_world;
+    f.to_object = saved.to_object;
+}
+
+/// The ray the programs of a node see: the world ray's interval, in the node's space.
+template <class P>
+LUCENT_RUNTIME_INLINE void enter_space(FrameOf<P>& f, float3 origin, float3 direction) {
+    if constexpr (P::kTransforms) {  // else the object-space ray is the world ray
+        f.object_ray.origin = origin;
+        f.object_ray.direction = direction;
+    } else {
+        (void)f;
+        (void)origin;
+        (void)direction;
+    }
+}
+
+// ---- programs run during traversal -----------------------------------------------------------
+
+/// A Selector's visit program, in the selector's space: the child to traverse.
+template <class P>
+LUCENT_RUNTIME_INLINE unsigned run_visit(const P& p, FrameOf<P>& f, typename P::Program visit,
+                                         float3 origin, float3 direction) {
+    enter_space<P>(f, origin, direction);
+    const ProgramContext saved = f.context;
+    f.context = ProgramContext::kVisit;
+    const unsigned child = p.call_visit(visit);
+    f.context = saved;
+    return child;
+}
+
+/// A custom primitive's intersection program; it reports through potential_intersection
+/// and report_intersection.
+template <class P>
+LUCENT_RUNTIME_INLINE void run_intersection(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                            const typename P::Instance& inst, unsigned prim) {
+    f.instance = instance_index;
+    f.prim = prim;
+    const ProgramContext saved = f.context;
+    f.context = ProgramContext::kIntersection;
+    p.call_intersection(inst, prim, f.scratch.bytes);
+    f.context = saved;
+}
+
+/// The attributes of a triangle hit: the attribute program's, or the built-in
+/// TriangleAttributes (barycentrics and object-space geometric normal).
+template <class P>
+LUCENT_HD inline void triangle_attributes(const P& p, FrameOf<P>& f,
+                                          const typename P::Instance& inst, unsigned prim,
+                                          float2 bary, typename FrameOf<P>::Attributes& out) {
+    const typename P::Program attribute = p.attribute(inst);
+    if (p.bound(attribute)) {
+        const ProgramContext saved = f.context;
+        f.context = ProgramContext::kAttribute;
+        p.call_attribute(attribute, prim, bary, out.bytes);
+        f.context = saved;
+        return;
+    }
+    float3 p0, p1, p2;
+    p.triangle(inst, prim, p0, p1, p2);
+#if LUCENT_GPU_CODE
+    TriangleAttributes* a = reinterpret_cast<TriangleAttributes*>(out.bytes);
+    a->barycentrics = bary;
+    a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
+#else
+    TriangleAttributes a;
+    a.barycentrics = bary;
+    a.geometric_normal = normalize(cross(p1 - p0, p2 - p0));
+    __builtin_memcpy(out.bytes, &a, sizeof a);
+#endif
+}
+
+/// Records a hit as the closest so far (the caller fills its attributes).
+template <class P>
+LUCENT_HD inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, float t,
+                             unsigned material) {
+    f.has_hit = true;
+    f.closest = t;
+    f.hit_t = t;
+    f.hit_instance = instance;
+    f.hit_prim = prim;
+    f.hit_material = material;
+    f.hit_pending = false;
+    if constexpr (P::kTransforms) {
+        f.hit_transformed = f.transformed;
+        if (f.transformed) {
+            f.hit_to_world = f.to_world;
+            f.hit_to_object = f.to_object;
+        }
+    }
+}
+
+/// Commits a triangle hit whose attributes wait for the shade phase (no any-hit ran).
+template <class P>
+LUCENT_HD inline void commit_triangle(FrameOf<P>& f, unsigned instance, unsigned prim, float t,
+                                      unsigned material, float2 bary) {
+    commit<P>(f, instance, prim, t, material);
+    f.hit_bary = bary;
+    f.hit_pending = true;
+}
+
+/// Runs an any-hit program on the candidate (attributes in the scratch); false when it
+/// ended with ignore_intersection(). terminate_ray() accepts the candidate and ends the
+/// traversal.
+template <class P>
+LUCENT_HD inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program any) {
+    const ProgramContext saved = f.context;
+    f.context = ProgramContext::kAnyHit;
+    f.any_hit = AnyHitOutcome::kAccept;
+    p.call_any_hit(any, f.payload, f.scratch.bytes);
+    f.context = saved;
+    if (f.any_hit == AnyHitOutcome::kIgnore) return false;
+    if (f.any_hit == AnyHitOutcome::kTerminate) f.terminated = true;
+    return true;
+}
+
+/// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
+template <class P>
+LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                         unsigned prim, float t, float2 bary) {
+    if constexpr (P::kOcclusion) {
+        if (f.occlusion) {  // occluded(): any intersection answers the query
+            f.has_hit = f.terminated = true;
+            return true;
+        }
+    }
+    const typename P::Instance& inst = p.instance(instance_index);
+    const unsigned material = p.triangle_material(inst, prim);
+    const typename P::Program any = p.any_hit(inst, material, f.ray_type);
+    if (p.bound(any)) {
+        f.instance = instance_index;
+        f.prim = prim;
+        triangle_attributes(p, f, inst, prim, bary, f.scratch);
+        f.candidate_t = t;
+        if (!run_any_hit(p, f, any)) return false;
+        commit<P>(f, instance_index, prim, t, material);
+        p.copy_attributes(f.hit_attr, f.scratch, inst);
+        return true;
+    }
+    commit_triangle<P>(f, instance_index, prim, t, material, bary);
+    return true;
+}
+
+// ---- the device API of intersection and any-hit programs --------------------------------------
+
+/// potential_intersection(t), in an intersection program: is t inside the ray's current
+/// interval (tmin, closest)? Elsewhere false.
+template <class P>
+LUCENT_RUNTIME_INLINE bool potential_intersection(const P& p, float t) {
+    FrameOf<P>* f = p.thread().frame;
+    if (!f || f->context != ProgramContext::kIntersection) return false;
+    f->candidate_open = t > f->world_ray.tmin && t < f->closest;
+    if (f->candidate_open) f->candidate_t = t;
+    return f->candidate_open;
+}
+
+/// report_intersection(material), in an intersection program after potential_intersection
+/// returned true: any-hit, then commit with the attributes the program wrote. False when
+/// any-hit ignored it, when no potential intersection is open, or outside an intersection
+/// program. A material index beyond the instance's raises kExceptionMaterialIndexOutOfRange.
+template <class P>
+LUCENT_RUNTIME_INLINE bool report_intersection(const P& p, unsigned material) {
+    FrameOf<P>* f = p.thread().frame;
+    if (!f || f->context != ProgramContext::kIntersection || !f->candidate_open) return false;
+    f->candidate_open = false;
+    const typename P::Instance& inst = p.instance(f->instance);
+    if (material >= p.material_count(inst)) {
+        p.raise(kExceptionMaterialIndexOutOfRange, material);
+        return false;
+    }
+    if constexpr (P::kOcclusion) {
+        if (f->occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
+            f->has_hit = f->terminated = true;
+            return true;
+        }
+    }
+    const typename P::Program any = p.any_hit(inst, material, f->ray_type);
+    if (p.bound(any) && !run_any_hit(p, *f, any)) return false;
+    commit<P>(*f, f->instance, f->prim, f->candidate_t, material);
+    p.copy_attributes(f->hit_attr, f->scratch, inst);
+    return true;
+}
+
+/// What ignore_intersection() and terminate_ray() leave for run_any_hit (the macros then
+/// return from the program). They compile only in an any-hit body, and only run_any_hit
+/// reads the outcome, after resetting it for each program it runs: no context check is
+/// needed (an any-hit function called by hand from another program changes nothing).
+template <class P>
+LUCENT_RUNTIME_INLINE void end_any_hit(const P& p, AnyHitOutcome outcome) {
+    FrameOf<P>* f = p.thread().frame;
+    if (f) f->any_hit = outcome;
+}
+
+// ---- trace() and occluded() ------------------------------------------------------------------
+
+/// The checks before a trace, each raising its exception: ray type, payload type, root
+/// handle, depth.
+template <class P>
+LUCENT_RUNTIME_INLINE bool trace_allowed(const P& p, Handle root, const Ray& ray,
+                                         typename P::PayloadTag payload_tag) {
+    if (ray.ray_type >= p.ray_type_count()) {
+        p.raise(kExceptionInvalidRayType, ray.ray_type);
+        return false;
+    }
+    if (!p.payload_matches(ray.ray_type, payload_tag)) {
+        p.raise(kExceptionPayloadTypeMismatch, ray.ray_type);
+        return false;
+    }
+    if (root.index >= p.node_count()) {
+        p.raise(kExceptionInvalidHandle, root.index);
+        return false;
+    }
+    if (p.thread().depth >= p.max_depth()) {
+        p.raise(kExceptionStackOverflow, p.thread().depth + 1);
+        return false;
+    }
+    return true;
+}
+
+/// A trace frame for `ray`, before traversal.
+template <class P>
+LUCENT_RUNTIME_INLINE void begin_frame(FrameOf<P>& f, const Ray& ray, void* payload,
+                                       bool occlusion) {
+    f.world_ray = ray;
+    if constexpr (P::kTransforms) {
+        f.object_ray = ray;
+        f.transformed = false;
+    }
+    f.payload = payload;
+    f.ray_type = ray.ray_type;
+    f.closest = ray.tmax;
+    f.has_hit = false;
+    f.terminated = false;
+    f.occlusion = occlusion;
+    f.candidate_open = false;
+    f.context = ProgramContext::kIntersection;
+}
+
+/// After traversal: the attributes of a pending triangle hit, then closest hit or miss.
+template <class P>
+LUCENT_RUNTIME_INLINE void shade(const P& p, FrameOf<P>& f, const Ray& ray) {
+    if (f.has_hit) {
+        const typename P::Instance& inst = p.instance(f.hit_instance);
+        if (f.hit_pending) {
+            // The attribute program runs as at the hit: its primitive, transform and ray.
+            f.instance = f.hit_instance;
+            f.prim = f.hit_prim;
+            if constexpr (P::kTransforms) {
+                f.object_ray = ray;
+                f.transformed = f.hit_transformed;
+                if (f.hit_transformed) {
+                    f.to_world = f.hit_to_world;
+                    f.to_object = f.hit_to_object;
+                    f.object_ray.origin = transform_point(f.hit_to_object, ray.origin);
+                    f.object_ray.direction = transform_vector(f.hit_to_object, ray.direction);
+                }
+            }
+            triangle_attributes(p, f, inst, f.hit_prim, f.hit_bary, f.hit_attr);
+        }
+        if constexpr (P::kTransforms) f.object_ray = ray;
+        const typename P::Program closest = p.closest_hit(inst, f.hit_material, f.ray_type);
+        if (p.bound(closest)) {
+            f.context = ProgramContext::kClosestHit;
+            p.call_closest_hit(closest, f.payload, f.hit_attr.bytes);
+        }
+    } else {
+        const typename P::Program miss = p.miss(f.ray_type);
+        if (p.bound(miss)) {
+            f.context = ProgramContext::kMiss;
+            p.call_miss(miss, f.payload);
+        }
+    }
+}
+
+/// trace(): the checks, a frame on this function's stack, traversal, then shade. On the
+/// GPU a recorded exception ends the launch index's work: later traces return at once.
+template <class P>
+LUCENT_RUNTIME_INLINE void trace(const P& p, Handle root, const Ray& ray, void* payload,
+                                 typename P::PayloadTag payload_tag) {
+    typename P::Thread& s = p.thread();
+    if (p.exception_pending()) return;
+    if (!trace_allowed(p, root, ray, payload_tag)) return;
+    FrameOf<P> f;
+    begin_frame<P>(f, ray, payload, /*occlusion=*/false);
+    FrameOf<P>* outer = s.frame;
+    s.frame = &f;
+    ++s.depth;
+    p.traverse(f, root, ray);
+    if (!p.exception_pending()) shade(p, f, ray);
+    --s.depth;
+    s.frame = outer;
+}
+
+/// The checks of occluded() that come before any fast path: ray type and root handle.
+template <class P>
+LUCENT_RUNTIME_INLINE bool occlusion_allowed(const P& p, Handle root, const Ray& ray) {
+    if (ray.ray_type >= p.ray_type_count()) {
+        p.raise(kExceptionInvalidRayType, ray.ray_type);
+        return false;
+    }
+    if (root.index >= p.node_count()) {
+        p.raise(kExceptionInvalidHandle, root.index);
+        return false;
+    }
+    return true;
+}
+
+/// occluded() through an occlusion frame (intersection programs and selectors run in it,
+/// any-hit, closest hit and miss do not): any graph, after occlusion_allowed.
+template <class P>
+LUCENT_RUNTIME_INLINE bool occluded_in_frame(const P& p, Handle root, const Ray& ray) {
+    typename P::Thread& s = p.thread();
+    if (s.depth >= p.max_depth()) {
+        p.raise(kExceptionStackOverflow, s.depth + 1);
+        return false;
+    }
+    FrameOf<P> f;
+    begin_frame<P>(f, ray, nullptr, /*occlusion=*/true);
+    FrameOf<P>* outer = s.frame;
+    s.frame = &f;
+    ++s.depth;
+    p.traverse(f, root, ray);
+    --s.depth;
+    s.frame = outer;
+    return f.has_hit && !p.exception_pending();
+}
+
+}  // namespace lucent::runtime
