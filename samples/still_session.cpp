@@ -1,9 +1,6 @@
-// The interactive session of a sample that has none of its own (direct, IGI, radiosity):
-// each frame is a full render through SampleInfo::render from the sample's own camera, so
-// the viewer can still show it and change its options (IGI's and radiosity's keys). Moving
-// the camera would need the sample's camera in a buffer, which these samples do not have yet.
-#include <chrono>
-
+// The default interactive session (Sample::open) of a sample whose frame is several passes
+// (IGI, radiosity): each frame is a full render through Sample::render from the sample's own
+// camera, so the viewer can still show it and change its options (IGI's and radiosity's keys).
 #include "samples/sample.h"
 
 namespace lucent::samples {
@@ -11,9 +8,9 @@ namespace {
 
 class StillSession final : public InteractiveSession {
   public:
-    StillSession(const SampleInfo& info, const RenderSettings& settings)
-        : m_info(info), m_settings(settings) {
-        check_options(settings, info);
+    StillSession(const Sample& sample, const RenderSettings& settings)
+        : m_sample(sample), m_settings(settings) {
+        sample.read_options(settings);  // checks them
         m_settings.repeat = 1;
         m_settings.progress = nullptr;
     }
@@ -27,13 +24,13 @@ class StillSession final : public InteractiveSession {
     bool set_option(const std::string& name, const std::string& value) override {
         RenderSettings changed = m_settings;
         changed.sets[name] = value;
-        check_options(changed, m_info);
-        m_settings = changed;  // a bad value shows at the next render, as a SettingsError
+        m_sample.read_options(changed);  // a bad value throws SettingsError
+        m_settings = changed;
         return true;
     }
 
     FrameResult frame() override {
-        RenderResult r = m_info.render(m_settings);
+        RenderResult r = m_sample.render(m_settings);
         m_backend = r.backend;
         m_notice = r.backend_notice;
         FrameResult out;
@@ -50,17 +47,15 @@ class StillSession final : public InteractiveSession {
     }
 
   private:
-    const SampleInfo& m_info;
+    const Sample& m_sample;
     RenderSettings m_settings;
     std::string m_backend = "(not yet rendered)", m_notice;
 };
 
 }  // namespace
 
-std::unique_ptr<InteractiveSession> open_session(const SampleInfo& info,
-                                                 const RenderSettings& settings) {
-    if (info.open) return info.open(settings);
-    return std::make_unique<StillSession>(info, settings);
+std::unique_ptr<InteractiveSession> Sample::open(const RenderSettings& settings) const {
+    return std::make_unique<StillSession>(*this, settings);
 }
 
 }  // namespace lucent::samples
