@@ -218,9 +218,11 @@ TEST(SampleOptions, EveryDefaultHoldsItsOwnRange) {
     // The viewer's sliders start at the default: a range that excludes it is a wrong option.
     for (const Sample* sample : all_samples()) {
         EXPECT_NO_THROW(sample->read_options(RenderSettings{})) << sample->name;
-        for (const SampleOption& option : sample->options)
-            if (option.kind == OptionKind::kInteger || option.kind == OptionKind::kNumber)
+        for (const SampleOption& option : sample->options) {
+            if (option.kind == OptionKind::kInteger || option.kind == OptionKind::kNumber) {
                 EXPECT_LT(option.lo, option.hi) << sample->name << " " << option.name;
+            }
+        }
     }
 }
 

@@ -84,10 +84,11 @@ void set_variables(Context& ctx, Program& camera, const WhittedOptions& options)
     ctx["shadows"] = options.shadows;
 }
 
-/// Builds the whole scene into `ctx`, the camera program reading `camera` at entry 0; returns
-/// the float4 output buffer (context variable output_buffer) of width x height.
-std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options, unsigned width,
-                                    unsigned height, const CameraBuffer& camera_buffer) {
+/// Ray types, exceptions, the output buffer (context variable output_buffer) of width x
+/// height, and the camera (reading `camera_buffer`, entry 0), exception and miss programs.
+std::shared_ptr<Buffer> create_programs(Context& ctx, const WhittedOptions& options,
+                                        unsigned width, unsigned height,
+                                        const CameraBuffer& camera_buffer) {
     const WhittedLayout& layout = whitted_layout();
     ctx.set_ray_type<whitted::RadiancePayload>(whitted::kRadianceRay, "radiance");
     // Shadow rays need only any-hit (attenuate or stop) and no miss program: a ray that
@@ -97,7 +98,6 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options,
     ctx.set_exception_enabled(kExceptionStackOverflow, true);
     ctx.set_exception_enabled(kExceptionBufferIndexOutOfBounds, true);
 
-    // ---- output, camera, exception and miss programs ---------------------------------------
     auto output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
     output->set_name("output_buffer");
     ctx["output_buffer"] = output;
@@ -114,8 +114,15 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options,
     auto miss = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_miss));
     (*miss)["bg_color"] = layout.background;
     ctx.set_miss_program(whitted::kRadianceRay, miss);
+    return output;
+}
 
-    // ---- geometry: three primitive types, each with its own programs (§6.1) ------------
+/// The three primitive types, each with its own programs (§6.1).
+struct Shapes {
+    std::shared_ptr<Geometry> floor, metal_sphere, glass_sphere;
+};
+
+Shapes create_shapes(Context& ctx, const WhittedLayout& layout) {
     auto floor = ctx.create_geometry();
     floor->set_name("floor");
     floor->set_primitive_count(1);
@@ -152,8 +159,15 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options,
     (*glass_sphere)["center"] = layout.glass_center;
     (*glass_sphere)["radius_outer"] = layout.glass_radius;
     (*glass_sphere)["radius_inner"] = layout.glass_radius - layout.glass_thickness;
+    return {floor, metal_sphere, glass_sphere};
+}
 
-    // ---- materials ------------------------------------------------------------------------
+struct Materials {
+    std::shared_ptr<Material> floor, metal, glass;
+};
+
+/// The checker floor, the metal and the glass, with their shadow programs.
+Materials create_materials(Context& ctx, const WhittedLayout& layout) {
     auto opaque_shadow = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_opaque_shadow));
 
     // Checker floor: the colours of Whitted's red and yellow checkers, 1 x 1 unit squares,
@@ -213,32 +227,45 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options,
         make_float3(std::log(0.83f), std::log(0.83f), std::log(0.83f));
     (*glass_material)["cutoff_color"] = make_float3(0.034f, 0.055f, 0.085f);
     (*glass_material)["importance_cutoff"] = 0.01f;
+    return {floor_material, metal_material, glass_material};
+}
 
-    // ---- instances, one GeometryGroup ------------------------------------------------
+/// One instance per shape with its material, in one GeometryGroup.
+std::shared_ptr<GeometryGroup> scene_group(Context& ctx, const WhittedLayout& layout,
+                                           const Shapes& shapes, const Materials& materials) {
     auto floor_instance = ctx.create_geometry_instance();
     floor_instance->set_name("floor");
-    floor_instance->set_geometry(floor);
-    floor_instance->add_material(floor_material);
+    floor_instance->set_geometry(shapes.floor);
+    floor_instance->add_material(materials.floor);
 
     auto metal_instance = ctx.create_geometry_instance();
     metal_instance->set_name("metal sphere");
-    metal_instance->set_geometry(metal_sphere);
-    metal_instance->add_material(metal_material);
+    metal_instance->set_geometry(shapes.metal_sphere);
+    metal_instance->add_material(materials.metal);
     // On the instance: intersection programs see GeometryInstance scope before Geometry's.
     (*metal_instance)["sphere"] = make_float4(layout.metal_center, layout.metal_radius);
 
     auto glass_instance = ctx.create_geometry_instance();
     glass_instance->set_name("glass sphere");
-    glass_instance->set_geometry(glass_sphere);
-    glass_instance->add_material(glass_material);
+    glass_instance->set_geometry(shapes.glass_sphere);
+    glass_instance->add_material(materials.glass);
 
     auto group = ctx.create_geometry_group();
     group->set_name("whitted scene");
     group->add_child(floor_instance);
     group->add_child(metal_instance);
     group->add_child(glass_instance);
+    return group;
+}
 
-    // ---- context-wide variables ---------------------------------------------------------
+/// Builds the whole scene into `ctx`, the camera program reading `camera` at entry 0; returns
+/// the float4 output buffer (context variable output_buffer) of width x height.
+std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options, unsigned width,
+                                    unsigned height, const CameraBuffer& camera_buffer) {
+    const WhittedLayout& layout = whitted_layout();
+    auto output = create_programs(ctx, options, width, height, camera_buffer);
+    const Shapes shapes = create_shapes(ctx, layout);
+    auto group = scene_group(ctx, layout, shapes, create_materials(ctx, layout));
     const std::vector<whitted::BasicLight> lights = make_lights(layout, options.lights);
     auto light_buffer =
         ctx.create_buffer<whitted::BasicLight>(BufferType::kInput, unsigned(lights.size()));
