@@ -18,6 +18,14 @@ inline double ms_since(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+/// A render's result, to be filled: the backend `ctx` runs on and why auto chose it.
+inline RenderResult result_for(const Context& ctx) {
+    RenderResult out;
+    out.backend = ctx.backend_name();
+    out.backend_notice = ctx.backend_notice();
+    return out;
+}
+
 /// Appends the stages a launch that compiled the scene reports: "compile + accel", and
 /// "megakernel JIT" (cold compile or cache load) when the CUDA backend ran it.
 void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& stages);

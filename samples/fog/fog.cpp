@@ -98,9 +98,7 @@ class FogSample final : public Sample {
         const FogOptions options = checked_options(*this, settings);
         const Clock::time_point setup_start = Clock::now();
         FogScene scene(options, settings.width, settings.height, settings.context_options());
-        RenderResult out;
-        out.backend = scene.context().backend_name();
-        out.backend_notice = scene.context().backend_notice();
+        RenderResult out = result_for(scene.context());
         out.stages.push_back({"scene setup", ms_since(setup_start),
                               options.fog ? "tutorial scene with fog" : "tutorial scene, no fog"});
         // The first launch compiles; --repeat gives the median of the rest.

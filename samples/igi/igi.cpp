@@ -22,8 +22,8 @@ namespace {
 
 /// The scene's lights as IGI's point emitters: point lights as they are; each area light as
 /// a side x side grid of cosine lobes at its cells' centres, sharing its power L A pi.
-std::vector<igi::PointLight> point_emitters(const scene::Scene& input, int side) {
-    std::vector<igi::PointLight> lights;
+std::vector<igi::PointEmitter> point_emitters(const scene::Scene& input, int side) {
+    std::vector<igi::PointEmitter> lights;
     for (const auto& l : input.point_lights)
         lights.push_back({l.position, l.intensity, make_float3(0.0f)});
     for (const auto& a : input.area_lights) {
@@ -106,9 +106,9 @@ void set_up_context(Context& ctx, const IgiOptions& o, float extent) {
 }
 
 /// The point emitters and the VPL buffer their particles fill.
-void add_lights(Context& ctx, const std::vector<igi::PointLight>& lights, const IgiConfig& config) {
+void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, const IgiConfig& config) {
     auto light_buffer =
-        ctx.create_buffer<igi::PointLight>(BufferType::kInput, unsigned(lights.size()));
+        ctx.create_buffer<igi::PointEmitter>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
     ctx["vpls"] =
@@ -256,16 +256,14 @@ class IgiSample final : public Sample {
         const Clock::time_point setup_start = Clock::now();
         const scene::Scene input =
             scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
-        const std::vector<igi::PointLight> lights = point_emitters(input, options.area_side);
+        const std::vector<igi::PointEmitter> lights = point_emitters(input, options.area_side);
         if (lights.empty())
             throw SettingsError("igi: scene '" + input.name +
                                 "' has no lights; IGI traces its particles from point and area "
                                 "lights (try --scene cornell, or add a light to a JSON scene)");
 
-        RenderResult out;
         Context ctx(settings.context_options());
-        out.backend = ctx.backend_name();
-        out.backend_notice = ctx.backend_notice();
+        RenderResult out = result_for(ctx);
         set_up_context(ctx, options, scene_extent(input));
         add_lights(ctx, lights, options.config);
         add_graphs(ctx, input);

@@ -39,24 +39,24 @@ enum : unsigned {
 /// A light the particles start from and the direct stage samples. Isotropic when `normal`
 /// is zero; otherwise a cosine lobe around `normal` (a piece of an area light), whose
 /// intensity along the normal is `intensity`.
-struct PointLight {
+struct PointEmitter {
     float3 position;
     float3 intensity;
     float3 normal;
 };
 
-LUCENT_HD inline bool is_oriented(const PointLight& light) {
+LUCENT_HD inline bool is_oriented(const PointEmitter& light) {
     return dot(light.normal, light.normal) > 0.0f;
 }
 
 /// Radiant intensity of `light` towards the unit direction `w` (from the light).
-LUCENT_HD inline float3 intensity_towards(const PointLight& light, float3 w) {
+LUCENT_HD inline float3 intensity_towards(const PointEmitter& light, float3 w) {
     if (!is_oriented(light)) return light.intensity;
     return light.intensity * lc_max(0.0f, dot(light.normal, w));
 }
 
 /// Total flux: 4 pi I for an isotropic light, pi I for a cosine lobe.
-LUCENT_HD inline float3 flux(const PointLight& light) {
+LUCENT_HD inline float3 flux(const PointEmitter& light) {
     return light.intensity * (is_oriented(light) ? 3.14159265f : 4.0f * 3.14159265f);
 }
 
@@ -126,7 +126,7 @@ LUCENT_HD inline float wrap01(float x) {
 
 // ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
-    lucent::BufferView<const PointLight> lights;
+    lucent::BufferView<const PointEmitter> lights;
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
     unsigned bounces;
     float scene_epsilon;
@@ -159,7 +159,7 @@ struct IndirectParams {
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
-    lucent::BufferView<const PointLight> lights;
+    lucent::BufferView<const PointEmitter> lights;
     lucent::BufferView<const Vpl> vpls;
     float min_d;
     unsigned max_depth;
@@ -305,7 +305,7 @@ LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
     // Paths go round the lights; each light walks its own Halton sequence (index i), rotated
     // per light (Cranley-Patterson) so that lights of one area light do not share directions.
     const unsigned count = rec.lights.count(), light_index = path % count;
-    const igi::PointLight light = rec.lights[light_index];
+    const igi::PointEmitter light = rec.lights[light_index];
     const unsigned i = path / count + 1;
     const float r2 = igi::halton(light_index + 1, 5), r3 = igi::halton(light_index + 1, 7);
     const float u1 = igi::wrap01(igi::halton(i, 2) + r2), u2 = igi::wrap01(igi::halton(i, 3) + r3);
@@ -379,7 +379,7 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
     const float3 albedo = rec.Kd * (1.0f / 3.14159265f);
     if (max_component(rec.Kd) > 0.0f) {
         for (unsigned l = 0; l < rec.lights.count(); ++l) {
-            const igi::PointLight light = rec.lights[l];
+            const igi::PointEmitter light = rec.lights[l];
             const float3 to = light.position - x;
             const float d2 = dot(to, to), d = sqrtf(d2), c = dot(n, to) / d;
             if (c <= 0.0f) continue;

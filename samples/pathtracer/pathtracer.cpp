@@ -254,10 +254,8 @@ class PathtracerSample final : public Sample {
     RenderResult render(const RenderSettings& settings) const override {
         const PathOptions options(read_options(settings));
         const Clock::time_point setup_start = Clock::now();
-        RenderResult out;
         Context ctx(settings.context_options());
-        out.backend = ctx.backend_name();
-        out.backend_notice = ctx.backend_notice();
+        RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         const PathScene scene = build(ctx, settings, options, camera);
         camera.set(pinhole_camera(scene.camera, aspect(settings)));

@@ -248,10 +248,8 @@ class RadiositySample final : public Sample {
         const Options options(read_options(settings));
         const Clock::time_point setup_start = Clock::now();
         const scene::Scene input = load_lit_scene(settings);
-        RenderResult out;
         Context ctx(settings.context_options());
-        out.backend = ctx.backend_name();
-        out.backend_notice = ctx.backend_notice();
+        RenderResult out = result_for(ctx);
         set_up_context(ctx, input, options);
         CameraBuffer camera(ctx);
         camera.set(pinhole_camera(input.camera, float(settings.width) / float(settings.height)));

@@ -335,11 +335,9 @@ class WhittedSample final : public Sample {
     RenderResult render(const RenderSettings& settings) const override {
         const WhittedOptions options(read_options(settings));
         check_scene(settings);
-        RenderResult out;
         const Clock::time_point setup_start = Clock::now();
         Context ctx(settings.context_options());
-        out.backend = ctx.backend_name();
-        out.backend_notice = ctx.backend_notice();
+        RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         camera.set(camera_frame(whitted_layout(), float(settings.width) / float(settings.height)));
         auto output = build_scene(ctx, options, settings.width, settings.height, camera);
