@@ -6,7 +6,8 @@
 // whose any-hit programs either stop the ray (opaque) or attenuate it (glass).
 //
 // Single source: compiled by g++ into the host (CPU backend) and by NVRTC for the GPU, so
-// it uses only lucent/device.h and the C math functions.
+// it uses only lucent/device.h, the C math functions and the samples' shared pinhole camera
+// (samples/common/camera.h).
 //
 // Everything lives in namespace `whitted`, the namespace of its module: the host names a
 // program as LUCENT_PROGRAM(whitted::whitted_camera).
