@@ -91,8 +91,6 @@ class InteractiveSession {
     virtual void reset() {}
     /// True when frame() refines the image further while nothing changes.
     virtual bool progressive() const { return false; }
-    /// True when set_camera is ignored: the session renders from the sample's own camera.
-    virtual bool fixed_camera() const { return false; }
     /// Renders one frame (a progressive session: one more sample per pixel).
     virtual FrameResult frame() = 0;
 };
@@ -120,13 +118,19 @@ class Sample {
     }
     /// Renders one image with these settings.
     virtual RenderResult render(const RenderSettings& settings) const = 0;
-    /// Opens an interactive session (size, backend and --set from the settings). The
-    /// default re-renders through render() when an option changes, from the sample's own
-    /// camera (fixed_camera() is true), for samples whose frame is several passes.
-    virtual std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const;
-    /// True when open() gives a session of the sample's own, with a moving camera.
-    virtual bool has_session() const { return false; }
+    /// Opens an interactive session (size, backend and --set from the settings): the same
+    /// scene and ray-generation program as render(), its first frame from the sample's own
+    /// camera.
+    virtual std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const = 0;
 };
+
+/// Checks a session's option change against the sample's options: SettingsError naming the
+/// option, the value and the accepted range when it is bad (InteractiveSession::set_option).
+inline void check_option_change(const Sample& sample, RenderSettings settings,
+                                const std::string& name, const std::string& value) {
+    settings.sets[name] = value;
+    sample.read_options(settings);
+}
 
 /// Adds a sample to all_samples(): a static RegisterSample<MySample> in the sample's own
 /// .cpp. `help_order` places it in --help, lowest first (names break ties), so the order

@@ -153,7 +153,7 @@ TEST(DisplayFrame, ABufferOfAnotherShapeOrContextIsAClearError) {
 }
 
 TEST(DisplayFrame, SessionsGiveDisplayFramesEqualToTheirImages) {
-    for (const char* name : {"whitted", "pathtracer", "fog", "direct", "radiosity"}) {  // 1 still
+    for (const char* name : {"whitted", "pathtracer", "fog", "direct", "radiosity"}) {
         samples::RenderSettings settings;
         settings.width = 40;
         settings.height = 30;

@@ -77,10 +77,6 @@ PanelChanges draw_panel(const samples::Sample& sample, const WorkerStatus& statu
     } else if (status.error.empty()) {
         ImGui::Text("building the scene...");
     }
-    if (status.fixed_camera)
-        ImGui::TextWrapped(
-            "This sample has no interactive session: its own camera, "
-            "re-rendered when an option changes.");
     if (!status.error.empty())
         ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status.error.c_str());
     if (!state.message.empty()) ImGui::Text("%s", state.message.c_str());

@@ -128,7 +128,6 @@ void RenderWorker::open_session() {
     m_session = m_sample.open(m_settings);
     std::lock_guard lock(m_mutex);
     m_status.opened = true;
-    m_status.fixed_camera = m_session->fixed_camera();
     m_status.progressive = m_session->progressive();
     m_status.backend = m_session->backend();
     m_status.backend_notice = m_session->backend_notice();

@@ -41,7 +41,6 @@ struct PartialFrame {
 struct WorkerStatus {
     bool opened = false;  // the session exists (the first frame may still be rendering)
     bool busy = false;    // a frame is being rendered now
-    bool fixed_camera = false;
     bool progressive = false;
     std::string backend, backend_notice;
     std::string error;  // the last failure (a bad option value, an engine error)

@@ -107,7 +107,7 @@ int run_viewer(const ViewerConfig& config) {
         ++ui_frames;
 
         const WorkerStatus status = worker.status();
-        if (!camera && status.opened && !status.fixed_camera) camera.emplace(status.initial_camera);
+        if (!camera && status.opened) camera.emplace(status.initial_camera);
         const ImGuiIO& io = ImGui::GetIO();
         if (camera && input.move_camera(*camera, dt, io.WantCaptureMouse, io.WantCaptureKeyboard))
             worker.set_camera(camera->camera());

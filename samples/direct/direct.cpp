@@ -113,7 +113,6 @@ class DirectSample final : public Sample {
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
         return std::make_unique<DirectSession>(*this, settings, read_options(settings));
     }
-    bool has_session() const override { return true; }
 };
 
 const RegisterSample<DirectSample> kRegistered(/*help_order=*/20);

@@ -28,8 +28,9 @@ FogOptions checked_options(const Sample& sample, const RenderSettings& settings)
 
 class FogSession final : public InteractiveSession {
   public:
-    FogSession(const RenderSettings& settings, const FogOptions& options)
-        : m_display_frames(settings.display_frames),
+    FogSession(const Sample& sample, const RenderSettings& settings, const FogOptions& options)
+        : m_sample(sample),
+          m_settings(settings),
           m_scene(options, settings.width, settings.height, settings.context_options()),
           m_initial(m_scene.orbit_camera(options.orbit_degrees)),
           m_camera(m_initial) {}
@@ -38,18 +39,22 @@ class FogSession final : public InteractiveSession {
     std::string backend_notice() const override { return m_scene.context().backend_notice(); }
     scene::Camera initial_camera() const override { return m_initial; }
     void set_camera(const scene::Camera& camera) override { m_camera = camera; }
-    bool set_option(const std::string&, const std::string&) override { return false; }
+    bool set_option(const std::string& name, const std::string& value) override {
+        check_option_change(m_sample, m_settings, name, value);
+        return false;
+    }
 
     FrameResult frame() override {
         FrameResult out;
         out.report = m_scene.render(m_camera);
         add_launch_stages(out.report, out.stages);
-        take_frame_pixels(m_scene.context(), m_scene.output(), m_display_frames, out);
+        take_frame_pixels(m_scene.context(), m_scene.output(), m_settings.display_frames, out);
         return out;
     }
 
   private:
-    bool m_display_frames;
+    const Sample& m_sample;
+    RenderSettings m_settings;
     mutable FogScene m_scene;  // context() is not const
     scene::Camera m_initial, m_camera;
 };
@@ -121,9 +126,8 @@ class FogSample final : public Sample {
     }
 
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
-        return std::make_unique<FogSession>(settings, checked_options(*this, settings));
+        return std::make_unique<FogSession>(*this, settings, checked_options(*this, settings));
     }
-    bool has_session() const override { return true; }
 };
 
 const RegisterSample<FogSample> kRegistered(/*help_order=*/60);

@@ -1,8 +1,7 @@
 // Host setup of the IGI sample: the scene as triangles with per-triangle materials, its
 // lights as point emitters, a second graph of per-triangle boxes for imperfect visibility,
-// and the passes of seed Fig. 3 as entry points launched in order each frame. Its frame is
-// several passes, so `lucent view` re-renders it (Sample::open's default session) when an
-// option changes.
+// and the passes of seed Fig. 3 as entry points launched in order each frame. `lucent view`
+// runs the same frame, the camera in a buffer.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -203,6 +202,82 @@ void keep_layers(const IgiConfig& config, const IgiImages& images, RenderResult&
     }
 }
 
+float aspect(const RenderSettings& settings) {
+    return float(settings.width) / float(settings.height);
+}
+
+/// What a render and a session build: the scene of settings.scene (default: cornell) in
+/// `ctx` with its point emitters, the images of seed Fig. 3 (full resolution G-buffer and
+/// direct image, the indirect irradiance at 1/N resolution, merged, and upsampled) and the
+/// passes, the camera reading `camera`.
+struct IgiScene {
+    scene::Scene input;
+    std::vector<igi::PointEmitter> lights;
+    IgiImages images;
+
+    IgiScene(Context& ctx, const RenderSettings& settings, const IgiOptions& options,
+             const CameraBuffer& camera)
+        : input(scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene)),
+          lights(point_emitters(input, options.area_side)) {
+        if (lights.empty())
+            throw SettingsError("igi: scene '" + input.name +
+                                "' has no lights; IGI traces its particles from point and area "
+                                "lights (try --scene cornell, or add a light to a JSON scene)");
+        set_up_context(ctx, options, scene_extent(input));
+        add_lights(ctx, lights, options.config);
+        add_graphs(ctx, input);
+        images = create_igi_images(ctx, options.config);
+        add_passes(ctx, options.config, images, camera);
+    }
+};
+
+/// `lucent view`: the scene built once, its frame (the passes of Fig. 3) launched again when
+/// the camera moves. The options are variables baked at build time or size its buffers, so
+/// an option rebuilds the scene.
+class IgiSession final : public InteractiveSession {
+  public:
+    IgiSession(const Sample& sample, const RenderSettings& settings, const IgiOptions& options)
+        : m_sample(sample),
+          m_settings(settings),
+          m_options(options),
+          m_ctx(settings.context_options()),
+          m_camera(m_ctx),
+          m_scene(m_ctx, settings, options, m_camera) {
+        m_settings.repeat = 1;
+        m_settings.progress = nullptr;
+        set_camera(initial_camera());
+    }
+
+    std::string backend() const override { return m_ctx.backend_name(); }
+    std::string backend_notice() const override { return m_ctx.backend_notice(); }
+    scene::Camera initial_camera() const override { return m_scene.input.camera; }
+    void set_camera(const scene::Camera& camera) override {
+        m_camera.set(pinhole_camera(camera, aspect(m_settings)));
+    }
+    bool set_option(const std::string& name, const std::string& value) override {
+        check_option_change(m_sample, m_settings, name, value);
+        return false;
+    }
+
+    FrameResult frame() override {
+        RenderResult r;
+        render_igi_frames(m_ctx, m_options.config, m_settings, r);
+        FrameResult out;
+        out.stages = std::move(r.stages);
+        out.report = r.report;
+        take_frame_pixels(m_ctx, *m_scene.images.output, m_settings.display_frames, out);
+        return out;
+    }
+
+  private:
+    const Sample& m_sample;
+    RenderSettings m_settings;
+    IgiOptions m_options;
+    Context m_ctx;
+    CameraBuffer m_camera;
+    IgiScene m_scene;
+};
+
 class IgiSample final : public Sample {
   public:
     IgiSample()
@@ -254,34 +329,23 @@ class IgiSample final : public Sample {
     RenderResult render(const RenderSettings& settings) const override {
         const IgiOptions options(read_options(settings), settings);
         const Clock::time_point setup_start = Clock::now();
-        const scene::Scene input =
-            scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
-        const std::vector<igi::PointEmitter> lights = point_emitters(input, options.area_side);
-        if (lights.empty())
-            throw SettingsError("igi: scene '" + input.name +
-                                "' has no lights; IGI traces its particles from point and area "
-                                "lights (try --scene cornell, or add a light to a JSON scene)");
-
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
-        set_up_context(ctx, options, scene_extent(input));
-        add_lights(ctx, lights, options.config);
-        add_graphs(ctx, input);
-        // The images of seed Fig. 3: full resolution G-buffer and direct image, the indirect
-        // irradiance at 1/N resolution, merged, and upsampled.
-        const IgiImages images = create_igi_images(ctx, options.config);
         CameraBuffer camera(ctx);
-        camera.set(pinhole_camera(input.camera, float(settings.width) / float(settings.height)));
-        add_passes(ctx, options.config, images, camera);
+        const IgiScene scene(ctx, settings, options, camera);
+        camera.set(pinhole_camera(scene.input.camera, aspect(settings)));
         out.stages.push_back({"scene setup", ms_since(setup_start),
-                              input.name + ", " + std::to_string(input.triangle_count()) +
-                                  " triangles, " + std::to_string(lights.size()) +
-                                  " point emitters"});
-
+                              scene.input.name + ", " +
+                                  std::to_string(scene.input.triangle_count()) + " triangles, " +
+                                  std::to_string(scene.lights.size()) + " point emitters"});
         render_igi_frames(ctx, options.config, settings, out);
-        out.image = image_from_output(*images.output);
-        if (settings.keep_layers) keep_layers(options.config, images, out);
+        out.image = image_from_output(*scene.images.output);
+        if (settings.keep_layers) keep_layers(options.config, scene.images, out);
         return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        return std::make_unique<IgiSession>(*this, settings, IgiOptions(read_options(settings), settings));
     }
 };
 

@@ -268,7 +268,6 @@ class PathtracerSample final : public Sample {
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
         return std::make_unique<PathSession>(*this, settings, PathOptions(read_options(settings)));
     }
-    bool has_session() const override { return true; }
 };
 
 const RegisterSample<PathtracerSample> kRegistered(/*help_order=*/50);

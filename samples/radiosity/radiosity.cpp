@@ -1,7 +1,6 @@
 // The instant radiosity sample (the seed blog): the scene's triangles with (textured) diffuse
 // materials, its area lights, a photon launch, VPL merging on the host, then the G-buffer and
-// the deferred shading pass. Its frame is three passes and a host step, so `lucent view`
-// re-renders it (Sample::open's default session) when an option changes.
+// the deferred shading pass. `lucent view` runs the same frame, the camera in a buffer.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -210,6 +209,70 @@ void render_passes(Context& ctx, const scene::Scene& input, const Options& optio
     if (settings.keep_layers) keep_vpl_layers(raw, options, passes, out);
 }
 
+float aspect(const RenderSettings& settings) {
+    return float(settings.width) / float(settings.height);
+}
+
+/// What a render and a session build: the scene in `ctx` and its passes, the camera
+/// reading `camera`.
+struct RadiosityScene {
+    scene::Scene input;
+    Passes passes;
+
+    RadiosityScene(Context& ctx, const RenderSettings& settings, const Options& options,
+                   const CameraBuffer& camera)
+        : input(load_lit_scene(settings)) {
+        set_up_context(ctx, input, options);
+        passes = create_passes(ctx, input, options, settings.width, settings.height, camera);
+    }
+};
+
+/// `lucent view`: the scene built once, its frame (photons, merging, G-buffer, shading) run
+/// again when the camera moves. Every option is a variable baked at build time or sizes a
+/// buffer, so an option rebuilds the scene.
+class RadiositySession final : public InteractiveSession {
+  public:
+    RadiositySession(const Sample& sample, const RenderSettings& settings, const Options& options)
+        : m_sample(sample),
+          m_settings(settings),
+          m_options(options),
+          m_ctx(settings.context_options()),
+          m_camera(m_ctx),
+          m_scene(m_ctx, settings, options, m_camera) {
+        m_settings.keep_layers = false;
+        set_camera(initial_camera());
+    }
+
+    std::string backend() const override { return m_ctx.backend_name(); }
+    std::string backend_notice() const override { return m_ctx.backend_notice(); }
+    scene::Camera initial_camera() const override { return m_scene.input.camera; }
+    void set_camera(const scene::Camera& camera) override {
+        m_camera.set(pinhole_camera(camera, aspect(m_settings)));
+    }
+    bool set_option(const std::string& name, const std::string& value) override {
+        check_option_change(m_sample, m_settings, name, value);
+        return false;
+    }
+
+    FrameResult frame() override {
+        RenderResult r;
+        render_passes(m_ctx, m_scene.input, m_options, m_settings, m_scene.passes, r);
+        FrameResult out;
+        out.stages = std::move(r.stages);
+        out.report = r.report;
+        take_frame_pixels(m_ctx, *m_scene.passes.output, m_settings.display_frames, out);
+        return out;
+    }
+
+  private:
+    const Sample& m_sample;
+    RenderSettings m_settings;
+    Options m_options;
+    Context m_ctx;
+    CameraBuffer m_camera;
+    RadiosityScene m_scene;
+};
+
 class RadiositySample final : public Sample {
   public:
     RadiositySample()
@@ -247,20 +310,21 @@ class RadiositySample final : public Sample {
     RenderResult render(const RenderSettings& settings) const override {
         const Options options(read_options(settings));
         const Clock::time_point setup_start = Clock::now();
-        const scene::Scene input = load_lit_scene(settings);
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
-        set_up_context(ctx, input, options);
         CameraBuffer camera(ctx);
-        camera.set(pinhole_camera(input.camera, float(settings.width) / float(settings.height)));
-        Passes passes =
-            create_passes(ctx, input, options, settings.width, settings.height, camera);
-        out.stages.push_back(
-            {"scene setup", ms_since(setup_start),
-             input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
-        render_passes(ctx, input, options, settings, passes, out);
-        out.image = image_from_output(*passes.output);
+        RadiosityScene scene(ctx, settings, options, camera);
+        camera.set(pinhole_camera(scene.input.camera, aspect(settings)));
+        out.stages.push_back({"scene setup", ms_since(setup_start),
+                              scene.input.name + ", " +
+                                  std::to_string(scene.input.triangle_count()) + " triangles"});
+        render_passes(ctx, scene.input, options, settings, scene.passes, out);
+        out.image = image_from_output(*scene.passes.output);
         return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        return std::make_unique<RadiositySession>(*this, settings, Options(read_options(settings)));
     }
 };
 

@@ -352,7 +352,6 @@ class WhittedSample final : public Sample {
         check_scene(settings);
         return std::make_unique<WhittedSession>(*this, settings, options);
     }
-    bool has_session() const override { return true; }
 };
 
 const RegisterSample<WhittedSample> kRegistered(/*help_order=*/10);
