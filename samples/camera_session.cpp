@@ -26,7 +26,7 @@ void CameraSession::start_at(const scene::Camera& camera,
 }
 
 void CameraSession::set_camera(const scene::Camera& camera) {
-    m_camera.set(pinhole_camera(camera, float(m_settings.width) / float(m_settings.height)));
+    m_camera.set(pinhole_camera(camera, m_settings.aspect()));
     reset();
 }
 

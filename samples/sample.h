@@ -37,6 +37,9 @@ struct RenderSettings {
     /// e.g. for a viewer showing partial results; may be empty.
     std::function<void(const LaunchProgress&)> on_launch_progress;
 
+    /// The image's width / height, for the pinhole camera.
+    float aspect() const { return float(width) / float(height); }
+
     /// The Context options these settings ask for.
     ContextOptions context_options() const {
         ContextOptions options{backend, threads, jit_check_sm};

@@ -67,10 +67,6 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
     return out;
 }
 
-float aspect(const RenderSettings& settings) {
-    return float(settings.width) / float(settings.height);
-}
-
 /// `lucent view`: the scene built once; every option is a material or context variable
 /// baked at build time, so an option change rebuilds it (cheap next to a frame).
 class DirectSession final : public CameraSession {
@@ -79,7 +75,7 @@ class DirectSession final : public CameraSession {
         : CameraSession(sample, settings) {
         const DirectScene scene = build(context(), settings, options, camera());
         set_output(scene.output);
-        start_at(scene.camera, pinhole_camera(scene.camera, aspect(settings)));
+        start_at(scene.camera, pinhole_camera(scene.camera, settings.aspect()));
     }
 };
 
@@ -103,7 +99,7 @@ class DirectSample final : public Sample {
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         const DirectScene scene = build(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.camera, aspect(settings)));
+        camera.set(pinhole_camera(scene.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
         timed_launch(ctx, 0, settings, out);
         out.image = image_from_output(*scene.output);

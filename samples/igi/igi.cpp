@@ -202,10 +202,6 @@ void keep_layers(const IgiConfig& config, const IgiImages& images, RenderResult&
     }
 }
 
-float aspect(const RenderSettings& settings) {
-    return float(settings.width) / float(settings.height);
-}
-
 /// What a render and a session build: the scene of settings.scene (default: cornell) in
 /// `ctx` with its point emitters, the images of seed Fig. 3 (full resolution G-buffer and
 /// direct image, the indirect irradiance at 1/N resolution, merged, and upsampled) and the
@@ -252,7 +248,7 @@ class IgiSession final : public InteractiveSession {
     std::string backend_notice() const override { return m_ctx.backend_notice(); }
     scene::Camera initial_camera() const override { return m_scene.input.camera; }
     void set_camera(const scene::Camera& camera) override {
-        m_camera.set(pinhole_camera(camera, aspect(m_settings)));
+        m_camera.set(pinhole_camera(camera, m_settings.aspect()));
     }
     bool set_option(const std::string& name, const std::string& value) override {
         check_option_change(m_sample, m_settings, name, value);
@@ -333,7 +329,7 @@ class IgiSample final : public Sample {
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         const IgiScene scene(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.input.camera, aspect(settings)));
+        camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start),
                               scene.input.name + ", " +
                                   std::to_string(scene.input.triangle_count()) + " triangles, " +

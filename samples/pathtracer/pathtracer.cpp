@@ -149,10 +149,6 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     return out;
 }
 
-float aspect(const RenderSettings& settings) {
-    return float(settings.width) / float(settings.height);
-}
-
 /// Launches settings.spp frames (default 64) into the accumulation buffer and times them.
 void render_frames(Context& ctx, const RenderSettings& settings, RenderResult& out) {
     const unsigned spp = settings.spp ? settings.spp : 64;
@@ -197,7 +193,7 @@ class PathSession final : public CameraSession {
         : CameraSession(sample, settings) {
         m_scene = build(context(), settings, options, camera());
         set_output(m_scene.output);
-        start_at(m_scene.camera, pinhole_camera(m_scene.camera, aspect(settings)));
+        start_at(m_scene.camera, pinhole_camera(m_scene.camera, settings.aspect()));
         reset();
     }
 
@@ -258,7 +254,7 @@ class PathtracerSample final : public Sample {
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         const PathScene scene = build(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.camera, aspect(settings)));
+        camera.set(pinhole_camera(scene.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
         render_frames(ctx, settings, out);
         out.image = image_from_output(*scene.output);

@@ -209,10 +209,6 @@ void render_passes(Context& ctx, const scene::Scene& input, const Options& optio
     if (settings.keep_layers) keep_vpl_layers(raw, options, passes, out);
 }
 
-float aspect(const RenderSettings& settings) {
-    return float(settings.width) / float(settings.height);
-}
-
 /// What a render and a session build: the scene in `ctx` and its passes, the camera
 /// reading `camera`.
 struct RadiosityScene {
@@ -247,7 +243,7 @@ class RadiositySession final : public InteractiveSession {
     std::string backend_notice() const override { return m_ctx.backend_notice(); }
     scene::Camera initial_camera() const override { return m_scene.input.camera; }
     void set_camera(const scene::Camera& camera) override {
-        m_camera.set(pinhole_camera(camera, aspect(m_settings)));
+        m_camera.set(pinhole_camera(camera, m_settings.aspect()));
     }
     bool set_option(const std::string& name, const std::string& value) override {
         check_option_change(m_sample, m_settings, name, value);
@@ -314,7 +310,7 @@ class RadiositySample final : public Sample {
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         RadiosityScene scene(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.input.camera, aspect(settings)));
+        camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start),
                               scene.input.name + ", " +
                                   std::to_string(scene.input.triangle_count()) + " triangles"});

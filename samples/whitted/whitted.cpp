@@ -294,7 +294,7 @@ class WhittedSession final : public CameraSession {
         start.look = layout.lookat;
         start.up = layout.up;
         start.fov_degrees = layout.vfov_degrees;
-        start_at(start, camera_frame(layout, float(settings.width) / float(settings.height)));
+        start_at(start, camera_frame(layout, settings.aspect()));
     }
 
   private:
@@ -339,7 +339,7 @@ class WhittedSample final : public Sample {
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        camera.set(camera_frame(whitted_layout(), float(settings.width) / float(settings.height)));
+        camera.set(camera_frame(whitted_layout(), settings.aspect()));
         auto output = build_scene(ctx, options, settings.width, settings.height, camera);
         out.stages.push_back({"scene setup", ms_since(setup_start)});
         timed_launch(ctx, 0, settings, out);
