@@ -1,6 +1,5 @@
-// What the samples whose frame is one launch share between `lucent render` and `lucent view`:
-// the camera buffer their ray-generation program reads, and the interactive session over a
-// scene built once (the Whitted, direct and path tracer samples).
+// What the samples share between `lucent render` and `lucent view`: the camera buffer their
+// ray-generation program reads, and the interactive session over a scene built once.
 #pragma once
 
 #include <memory>
@@ -23,10 +22,11 @@ class CameraBuffer {
     std::shared_ptr<Buffer> m_buffer;
 };
 
-/// An interactive session whose every frame launches entry point 0 once, into `output`. The
-/// sample builds its scene into context() in its constructor and sets output(); the first
-/// frame is from the sample's own camera (the same pixels as its render), set_camera() puts
-/// the viewer's there.
+/// An interactive session over a scene built once into context() by the derived class's
+/// constructor, which also calls start_at() with the sample's own camera (so the first frame
+/// is the render's image); set_camera() puts the viewer's camera in the buffer. A frame
+/// launches entry point 0 once into the output set by set_output(); a sample of several
+/// passes overrides frame().
 class CameraSession : public InteractiveSession {
   public:
     CameraSession(const Sample& sample, const RenderSettings& settings);

@@ -127,14 +127,6 @@ class Sample {
     virtual std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const = 0;
 };
 
-/// Checks a session's option change against the sample's options: SettingsError naming the
-/// option, the value and the accepted range when it is bad (InteractiveSession::set_option).
-inline void check_option_change(const Sample& sample, RenderSettings settings,
-                                const std::string& name, const std::string& value) {
-    settings.sets[name] = value;
-    sample.read_options(settings);
-}
-
 /// Adds a sample to all_samples(): a static RegisterSample<MySample> in the sample's own
 /// .cpp. `help_order` places it in --help, lowest first (names break ties), so the order
 /// does not depend on the order of static initialisation.

@@ -15,17 +15,18 @@ LUCENT_MODULE(sample_common)
 
 /// A triangle mesh's vertex data, for the attribute programs (variables "positions" and
 /// "triangles" on each GeometryTriangles: samples/scene_setup.h's mesh_group sets them).
+/// Read-only views (BufferView<const T>): the attribute programs only read them.
 struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
+    lucent::BufferView<const float3> positions;
+    lucent::BufferView<const uint3> triangles;
 };
 LUCENT_RECORD(MeshRecord, positions, triangles)
 
 /// The same with the per-vertex texture coordinates ("uvs"; empty when the mesh has none).
 struct TexturedMeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
-    lucent::BufferView<float2> uvs;
+    lucent::BufferView<const float3> positions;
+    lucent::BufferView<const uint3> triangles;
+    lucent::BufferView<const float2> uvs;
 };
 LUCENT_RECORD(TexturedMeshRecord, positions, triangles, uvs)
 

@@ -40,7 +40,9 @@ class FogSession final : public InteractiveSession {
     scene::Camera initial_camera() const override { return m_initial; }
     void set_camera(const scene::Camera& camera) override { m_camera = camera; }
     bool set_option(const std::string& name, const std::string& value) override {
-        check_option_change(m_sample, m_settings, name, value);
+        RenderSettings changed = m_settings;
+        changed.sets[name] = value;
+        m_sample.read_options(changed);  // a bad value throws SettingsError
         return false;
     }
 

@@ -230,47 +230,30 @@ struct IgiScene {
 /// `lucent view`: the scene built once, its frame (the passes of Fig. 3) launched again when
 /// the camera moves. The options are variables baked at build time or size its buffers, so
 /// an option rebuilds the scene.
-class IgiSession final : public InteractiveSession {
+class IgiSession final : public CameraSession {
   public:
     IgiSession(const Sample& sample, const RenderSettings& settings, const IgiOptions& options)
-        : m_sample(sample),
-          m_settings(settings),
-          m_options(options),
-          m_ctx(settings.context_options()),
-          m_camera(m_ctx),
-          m_scene(m_ctx, settings, options, m_camera) {
-        m_settings.repeat = 1;
-        m_settings.progress = nullptr;
-        set_camera(initial_camera());
-    }
-
-    std::string backend() const override { return m_ctx.backend_name(); }
-    std::string backend_notice() const override { return m_ctx.backend_notice(); }
-    scene::Camera initial_camera() const override { return m_scene.input.camera; }
-    void set_camera(const scene::Camera& camera) override {
-        m_camera.set(pinhole_camera(camera, m_settings.aspect()));
-    }
-    bool set_option(const std::string& name, const std::string& value) override {
-        check_option_change(m_sample, m_settings, name, value);
-        return false;
+        : CameraSession(sample, settings),
+          m_config(options.config),
+          m_scene(context(), settings, options, camera()) {
+        start_at(m_scene.input.camera, pinhole_camera(m_scene.input.camera, settings.aspect()));
     }
 
     FrameResult frame() override {
+        RenderSettings once = settings();
+        once.repeat = 1;
+        once.progress = nullptr;
         RenderResult r;
-        render_igi_frames(m_ctx, m_options.config, m_settings, r);
+        render_igi_frames(context(), m_config, once, r);
         FrameResult out;
         out.stages = std::move(r.stages);
         out.report = r.report;
-        take_frame_pixels(m_ctx, *m_scene.images.output, m_settings.display_frames, out);
+        take_frame_pixels(context(), *m_scene.images.output, settings().display_frames, out);
         return out;
     }
 
   private:
-    const Sample& m_sample;
-    RenderSettings m_settings;
-    IgiOptions m_options;
-    Context m_ctx;
-    CameraBuffer m_camera;
+    IgiConfig m_config;
     IgiScene m_scene;
 };
 

@@ -226,46 +226,29 @@ struct RadiosityScene {
 /// `lucent view`: the scene built once, its frame (photons, merging, G-buffer, shading) run
 /// again when the camera moves. Every option is a variable baked at build time or sizes a
 /// buffer, so an option rebuilds the scene.
-class RadiositySession final : public InteractiveSession {
+class RadiositySession final : public CameraSession {
   public:
     RadiositySession(const Sample& sample, const RenderSettings& settings, const Options& options)
-        : m_sample(sample),
-          m_settings(settings),
+        : CameraSession(sample, settings),
           m_options(options),
-          m_ctx(settings.context_options()),
-          m_camera(m_ctx),
-          m_scene(m_ctx, settings, options, m_camera) {
-        m_settings.keep_layers = false;
-        set_camera(initial_camera());
-    }
-
-    std::string backend() const override { return m_ctx.backend_name(); }
-    std::string backend_notice() const override { return m_ctx.backend_notice(); }
-    scene::Camera initial_camera() const override { return m_scene.input.camera; }
-    void set_camera(const scene::Camera& camera) override {
-        m_camera.set(pinhole_camera(camera, m_settings.aspect()));
-    }
-    bool set_option(const std::string& name, const std::string& value) override {
-        check_option_change(m_sample, m_settings, name, value);
-        return false;
+          m_scene(context(), settings, options, camera()) {
+        start_at(m_scene.input.camera, pinhole_camera(m_scene.input.camera, settings.aspect()));
     }
 
     FrameResult frame() override {
+        RenderSettings frame_settings = settings();
+        frame_settings.keep_layers = false;
         RenderResult r;
-        render_passes(m_ctx, m_scene.input, m_options, m_settings, m_scene.passes, r);
+        render_passes(context(), m_scene.input, m_options, frame_settings, m_scene.passes, r);
         FrameResult out;
         out.stages = std::move(r.stages);
         out.report = r.report;
-        take_frame_pixels(m_ctx, *m_scene.passes.output, m_settings.display_frames, out);
+        take_frame_pixels(context(), *m_scene.passes.output, settings().display_frames, out);
         return out;
     }
 
   private:
-    const Sample& m_sample;
-    RenderSettings m_settings;
     Options m_options;
-    Context m_ctx;
-    CameraBuffer m_camera;
     RadiosityScene m_scene;
 };
 
