@@ -40,6 +40,14 @@ bool CameraSession::set_option(const std::string& name, const std::string& value
     return true;
 }
 
+FrameResult CameraSession::frame_of(RenderResult passes, const Buffer& output) {
+    FrameResult out;
+    out.stages = std::move(passes.stages);
+    out.report = passes.report;
+    take_frame_pixels(m_ctx, output, m_settings.display_frames, out);
+    return out;
+}
+
 FrameResult CameraSession::frame() {
     FrameResult out;
     m_ctx.launch(0, m_settings.width, m_settings.height);

@@ -49,6 +49,8 @@ class CameraSession : public InteractiveSession {
     /// Where the sample's render puts the camera: the viewer's start, and the first frame's.
     void start_at(const scene::Camera& camera, const sample_common::PinholeCamera& pinhole);
     void set_output(std::shared_ptr<Buffer> output) { m_output = std::move(output); }
+    /// A frame of several passes: their stages and report, and the pixels of `output`.
+    FrameResult frame_of(RenderResult passes, const Buffer& output);
     CameraBuffer& camera() { return m_camera; }
 
   private:

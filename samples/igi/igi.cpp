@@ -243,13 +243,9 @@ class IgiSession final : public CameraSession {
         RenderSettings once = settings();
         once.repeat = 1;
         once.progress = nullptr;
-        RenderResult r;
-        render_igi_frames(context(), m_config, once, r);
-        FrameResult out;
-        out.stages = std::move(r.stages);
-        out.report = r.report;
-        take_frame_pixels(context(), *m_scene.images.output, settings().display_frames, out);
-        return out;
+        RenderResult passes;
+        render_igi_frames(context(), m_config, once, passes);
+        return frame_of(std::move(passes), *m_scene.images.output);
     }
 
   private:

@@ -238,13 +238,9 @@ class RadiositySession final : public CameraSession {
     FrameResult frame() override {
         RenderSettings frame_settings = settings();
         frame_settings.keep_layers = false;
-        RenderResult r;
-        render_passes(context(), m_scene.input, m_options, frame_settings, m_scene.passes, r);
-        FrameResult out;
-        out.stages = std::move(r.stages);
-        out.report = r.report;
-        take_frame_pixels(context(), *m_scene.passes.output, settings().display_frames, out);
-        return out;
+        RenderResult passes;
+        render_passes(context(), m_scene.input, m_options, frame_settings, m_scene.passes, passes);
+        return frame_of(std::move(passes), *m_scene.passes.output);
     }
 
   private:
