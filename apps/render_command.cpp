@@ -2,22 +2,19 @@
 // never leaves a file behind; write_image itself is atomic.
 #include "render_command.h"
 
-#include <chrono>
 #include <cstdio>
 #include <sstream>
 
 #include "cli_parse.h"
 #include "progress_bar.h"
 #include "samples/sample.h"
+#include "samples/stages.h"
 
 namespace lucent::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using samples::Clock;
+using samples::ms_since;
 
 /// Breaks `text` into lines of at most kHelpWidth columns; the first line starts at column
 /// `first`, the others are indented by `indent`.
@@ -48,16 +45,18 @@ std::string wrap(const std::string& text, size_t first, size_t indent) {
 std::string samples_help() {
     std::ostringstream out;
     out << "Samples (--sample NAME) and their options (--set NAME=VALUE, default shown):\n";
-    for (const samples::SampleInfo& info : samples::all_samples()) {
-        out << "  " << info.name << "  " << wrap(info.description, 4 + info.name.size(), 4) << "\n";
+    for (const samples::Sample* sample : samples::all_samples()) {
+        out << "  " << sample->name << "  " << wrap(sample->description, 4 + sample->name.size(), 4)
+            << "\n";
         size_t width = 0;
-        for (const samples::SampleOption& o : info.options)
+        for (const samples::SampleOption& o : sample->options)
             width = std::max(width, o.name.size() + 1 + o.default_value.size());
-        for (const samples::SampleOption& o : info.options) {
+        for (const samples::SampleOption& o : sample->options) {
             const std::string set = o.name + "=" + o.default_value;
-            out << "    " << set << std::string(width - set.size() + 2, ' ') << o.help << "\n";
+            out << "    " << set << std::string(width - set.size() + 2, ' ') << o.help_with_range()
+                << "\n";
         }
-        if (info.options.empty()) out << "    (no options)\n";
+        if (sample->options.empty()) out << "    (no options)\n";
     }
     return out.str();
 }
@@ -140,10 +139,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
 int run_render(const RenderArgs& args) {
     const samples::RenderSettings settings = settings_from(args);
     check_image_path("--out", args.out);
-    const samples::SampleInfo& info = samples::find_sample(args.sample);
-    samples::check_options(settings, info);
+    const samples::Sample& sample = samples::find_sample(args.sample);
+    sample.read_options(settings);  // every --set checked before the render
     if (args.verbose) {
-        std::printf("sample %s, %ux%u, backend %s, threads %u, scene %s\n", info.name.c_str(),
+        std::printf("sample %s, %ux%u, backend %s, threads %u, scene %s\n", sample.name.c_str(),
                     settings.width, settings.height, args.backend.c_str(), settings.threads,
                     settings.scene.empty() ? "(default)" : settings.scene.c_str());
         for (const auto& [name, value] : settings.sets)
@@ -154,7 +153,7 @@ int run_render(const RenderArgs& args) {
     samples::RenderSettings run = settings;
     run.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
     const Clock::time_point start = Clock::now();
-    samples::RenderResult result = info.render(run);
+    samples::RenderResult result = sample.render(run);
     bar.finish();
     const Clock::time_point written = Clock::now();
     scene::write_image(args.out, result.image);
@@ -162,7 +161,7 @@ int run_render(const RenderArgs& args) {
     const double total_ms = ms_since(start);
 
     if (!result.backend_notice.empty()) std::printf("note: %s\n", result.backend_notice.c_str());
-    std::printf("%s: %ux%u on %s\n", info.name.c_str(), result.image.width, result.image.height,
+    std::printf("%s: %ux%u on %s\n", sample.name.c_str(), result.image.width, result.image.height,
                 result.backend.c_str());
 
     for (const samples::StageTiming& stage : result.stages)

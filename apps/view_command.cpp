@@ -101,11 +101,11 @@ int run_view(const ViewArgs& args) {
             throw UsageError("--screenshot " + quoted(args.screenshot) +
                              ": the window is saved as 8-bit sRGB; the name must end in .png");
     }
-    const samples::SampleInfo& info = samples::find_sample(args.sample);
-    samples::check_options(settings, info);
+    const samples::Sample& sample = samples::find_sample(args.sample);
+    sample.read_options(settings);  // every --set checked before the window opens
 #ifdef LUCENT_HAVE_VIEWER
     viewer::ViewerConfig config;
-    config.info = &info;
+    config.sample = &sample;
     config.settings = settings;
     config.frames = args.frames;
     config.screenshot = args.screenshot;

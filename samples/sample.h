@@ -1,5 +1,5 @@
-// What every sample offers the command line and the tests: a name, its options
-// (given as --set name=value) and a render function.
+// What every sample offers the command line, the viewer and the tests: the Sample class (a
+// name, typed options, render and open), the settings of a render and its results.
 #pragma once
 
 #include <functional>
@@ -9,17 +9,11 @@
 #include <vector>
 
 #include "lucent/context.h"
+#include "samples/options.h"
 #include "scene/image_io.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
-
-/// One `--set` option of a sample.
-struct SampleOption {
-    std::string name;
-    std::string default_value;
-    std::string help;  // one line, with the accepted range
-};
 
 struct RenderSettings {
     unsigned width = 1024, height = 1024;
@@ -42,6 +36,9 @@ struct RenderSettings {
     /// Called as bands of rows of a launch finish on the CPU (ContextOptions::on_progress),
     /// e.g. for a viewer showing partial results; may be empty.
     std::function<void(const LaunchProgress&)> on_launch_progress;
+
+    /// The image's width / height, for the pinhole camera.
+    float aspect() const { return float(width) / float(height); }
 
     /// The Context options these settings ask for.
     ContextOptions context_options() const {
@@ -97,66 +94,51 @@ class InteractiveSession {
     virtual void reset() {}
     /// True when frame() refines the image further while nothing changes.
     virtual bool progressive() const { return false; }
-    /// True when set_camera is ignored: the session renders from the sample's own camera.
-    virtual bool fixed_camera() const { return false; }
     /// Renders one frame (a progressive session: one more sample per pixel).
     virtual FrameResult frame() = 0;
 };
 
-struct SampleInfo {
-    std::string name;
-    std::string description;
-    std::vector<SampleOption> options;
-    RenderResult (*render)(const RenderSettings& settings);
-    /// Opens an interactive session (size, backend and --set from the settings); null for
-    /// samples that have none (`lucent view` then shows their own camera's render).
-    std::unique_ptr<InteractiveSession> (*open)(const RenderSettings& settings) = nullptr;
+/// A sample: a renderer and its scene, with typed options. One class per sample, in the
+/// sample's own folder, registered by a RegisterSample in its .cpp (no central list): it
+/// builds its scene into a Context, renders one image (`lucent render`, the tests) and opens
+/// an interactive session (`lucent view`), both from the same scene build and the same
+/// ray-generation program, whose camera is data in a buffer.
+class Sample {
+  public:
+    Sample(std::string name, std::string description, std::vector<SampleOption> options)
+        : name(std::move(name)), description(std::move(description)), options(std::move(options)) {}
+    virtual ~Sample() = default;
+    Sample(const Sample&) = delete;
+    Sample& operator=(const Sample&) = delete;
+
+    const std::string name;
+    const std::string description;  // one paragraph, for --help
+    const std::vector<SampleOption> options;
+
+    /// The settings' --set values checked against the options; SettingsError on bad input.
+    OptionValues read_options(const RenderSettings& settings) const {
+        return OptionValues(name, options, settings.sets);
+    }
+    /// Renders one image with these settings.
+    virtual RenderResult render(const RenderSettings& settings) const = 0;
+    /// Opens an interactive session (size, backend and --set from the settings): the same
+    /// scene and ray-generation program as render(), its first frame from the sample's own
+    /// camera.
+    virtual std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const = 0;
 };
 
-/// Launches `entry` over width x height, then `settings.repeat - 1` more times when asked,
-/// and fills `result`: report of the first launch, stages "compile + accel", "megakernel
-/// JIT" (when it ran) and "launch" (the first, or the median of the repeats with spread).
-void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
-                  RenderResult& result);
-
-/// The sample's own session (SampleInfo::open) or, for samples without one, a session that
-/// re-renders through SampleInfo::render when an option changes, from the sample's own
-/// camera (fixed_camera() is true).
-std::unique_ptr<InteractiveSession> open_session(const SampleInfo& info,
-                                                 const RenderSettings& settings);
-
-/// The [lo, hi] range an option's help text names, "(1..256)" or "(0..2^30)"; false when it
-/// names none. For the viewer's sliders.
-bool option_range(const SampleOption& option, double& lo, double& hi);
-
-/// A viewer frame's stages from its launch report: "compile + accel" and "megakernel JIT"
-/// when that launch recompiled, then "launch".
-void add_launch_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
-
-/// The frame's pixels from a session's 2D float4 output: `out.display` made where the
-/// launch left them (`display_frame`: RenderSettings::display_frames), else `out.image` on
-/// the host. The display frame's encoding shows as the stage "display frame".
-void take_frame_pixels(Context& ctx, const Buffer& output, bool display_frame, FrameResult& out);
-
-/// Appends the stages a launch that compiled the scene reports: "compile + accel", and
-/// "megakernel JIT" (cold compile or cache load) when the CUDA backend ran it.
-void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
+/// Adds a sample to all_samples(): a static RegisterSample<MySample> in the sample's own
+/// .cpp. `help_order` places it in --help, lowest first (names break ties), so the order
+/// does not depend on the order of static initialisation.
+void register_sample(std::unique_ptr<Sample> sample, int help_order);
+template <class S>
+struct RegisterSample {
+    explicit RegisterSample(int help_order) { register_sample(std::make_unique<S>(), help_order); }
+};
 
 /// Every sample, in the order `--help` lists them.
-const std::vector<SampleInfo>& all_samples();
-/// The sample with this name, or an Error listing the names.
-const SampleInfo& find_sample(const std::string& name);
-
-/// Reads a --set value: the option's default when not given; Error naming the option,
-/// the value and the accepted range when it does not parse or is out of [lo, hi].
-float get_float_option(const RenderSettings& s, const SampleInfo& info, const std::string& name,
-                       float lo, float hi);
-int get_int_option(const RenderSettings& s, const SampleInfo& info, const std::string& name, int lo,
-                   int hi);
-/// Reads a --set value as text (a file name, say): the option's default when not given.
-std::string get_string_option(const RenderSettings& s, const SampleInfo& info,
-                              const std::string& name);
-/// Error naming any --set that the sample does not have, with the list it does have.
-void check_options(const RenderSettings& s, const SampleInfo& info);
+const std::vector<const Sample*>& all_samples();
+/// The sample with this name, or a SettingsError listing the names.
+const Sample& find_sample(const std::string& name);
 
 }  // namespace lucent::samples

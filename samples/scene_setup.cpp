@@ -53,10 +53,30 @@ std::shared_ptr<GeometryGroup> mesh_group(
     return group;
 }
 
-PinholeFrame pinhole_frame(const scene::Camera& c, float aspect) {
+sample_common::PinholeCamera pinhole_camera(const scene::Camera& c, float aspect) {
     const float3 W = normalize(c.look - c.eye), U = normalize(cross(W, c.up)), V = cross(U, W);
     const float half_height = std::tan(c.fov_degrees * 0.5f * 3.14159265f / 180.0f);
-    return {U * (half_height * aspect), V * half_height, W};
+    return {c.eye, U * (half_height * aspect), V * half_height, W};
+}
+
+std::vector<sample_common::AreaLight> area_lights(const scene::Scene& scene) {
+    std::vector<sample_common::AreaLight> areas;
+    for (const auto& l : scene.area_lights) areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
+    return areas;
+}
+
+void bind_lights(Context& ctx, const scene::Scene& scene) {
+    std::vector<sample_common::PointLight> points;
+    for (const auto& l : scene.point_lights) points.push_back({l.position, l.intensity});
+    const std::vector<sample_common::AreaLight> areas = area_lights(scene);
+    auto point_buffer =
+        ctx.create_buffer<sample_common::PointLight>(BufferType::kInput, unsigned(points.size()));
+    point_buffer->upload(points);
+    auto area_buffer =
+        ctx.create_buffer<sample_common::AreaLight>(BufferType::kInput, unsigned(areas.size()));
+    area_buffer->upload(areas);
+    ctx["point_lights"] = point_buffer;
+    ctx["area_lights"] = area_buffer;
 }
 
 scene::Image image_from_output(const Buffer& output, unsigned layer) {

@@ -1,5 +1,5 @@
 // Host-side steps the samples that render a scene/ Scene share: its size, its meshes as
-// buffers, the pinhole camera frame, and the output buffer as an image.
+// buffers, its lights, the pinhole camera, and the output buffer as an image.
 #pragma once
 
 #include <functional>
@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "lucent/context.h"
+#include "samples/common/camera.h"
+#include "samples/common/lights.h"
 #include "scene/image_io.h"
 #include "scene/scene.h"
 
@@ -35,27 +37,15 @@ std::shared_ptr<GeometryGroup> mesh_group(
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each = {});
 
 /// The scene's lights as the input buffers "point_lights" and "area_lights" on the context,
-/// in the program module's own layouts {position, intensity} and {corner, edge1, edge2,
-/// emission} (the direct and path tracer samples).
-template <class PointLight, class AreaLight>
-void bind_lights(Context& ctx, const scene::Scene& scene) {
-    std::vector<PointLight> points;
-    for (const auto& l : scene.point_lights) points.push_back({l.position, l.intensity});
-    std::vector<AreaLight> areas;
-    for (const auto& l : scene.area_lights) areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
-    auto point_buffer = ctx.create_buffer<PointLight>(BufferType::kInput, unsigned(points.size()));
-    point_buffer->upload(points);
-    auto area_buffer = ctx.create_buffer<AreaLight>(BufferType::kInput, unsigned(areas.size()));
-    area_buffer->upload(areas);
-    ctx["point_lights"] = point_buffer;
-    ctx["area_lights"] = area_buffer;
-}
+/// in the layouts of samples/common/lights.h (the direct and path tracer samples).
+void bind_lights(Context& ctx, const scene::Scene& scene);
 
-/// Pinhole camera: W to the image centre, U and V half the image's width and height.
-struct PinholeFrame {
-    float3 U, V, W;
-};
-PinholeFrame pinhole_frame(const scene::Camera& camera, float aspect);
+/// The scene's area lights in the layout of samples/common/lights.h.
+std::vector<sample_common::AreaLight> area_lights(const scene::Scene& scene);
+
+/// The pinhole camera of a scene::Camera for an image of this aspect (width / height): W
+/// the unit view direction, U and V half the image's width and height at distance 1.
+sample_common::PinholeCamera pinhole_camera(const scene::Camera& camera, float aspect);
 
 /// The float4 output buffer of a launch as a linear RGB image: its layer `layer` (z) when it
 /// has several.

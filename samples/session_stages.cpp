@@ -1,7 +1,5 @@
 // The stage timings of one interactive frame, shared by the samples' sessions.
-#include <chrono>
-
-#include "samples/sample.h"
+#include "samples/stages.h"
 #include "samples/scene_setup.h"
 
 namespace lucent::samples {
@@ -16,11 +14,9 @@ void take_frame_pixels(Context& ctx, const Buffer& output, bool display_frame, F
         out.image = image_from_output(output);
         return;
     }
-    const auto start = std::chrono::steady_clock::now();
+    const Clock::time_point start = Clock::now();
     out.display = ctx.display_frame(output);
-    const double ms = std::chrono::duration<double, std::milli>(
-                          std::chrono::steady_clock::now() - start)
-                          .count();
+    const double ms = ms_since(start);
     out.stages.push_back({"display frame", ms, out.display->on_device() ? "on the GPU" : "on the host"});
 }
 

@@ -6,7 +6,7 @@
 
 namespace lucent::samples {
 
-/// Thrown by find_sample, check_options and get_*_option for bad user input.
+/// Thrown by find_sample and OptionValues (Sample::read_options) for bad user input.
 class SettingsError : public Error {
   public:
     using Error::Error;

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "samples/sample.h"
+#include "samples/stages.h"
 
 namespace lucent::samples {
 

@@ -63,7 +63,7 @@ class CliTest : public ::testing::Test {
     fs::path m_dir;
 };
 
-const lucent::samples::SampleInfo& whitted() {
+const lucent::samples::Sample& whitted() {
     return lucent::samples::find_sample("whitted");
 }
 
@@ -88,8 +88,8 @@ TEST_F(CliTest, UnknownFlagIsAUsageError) {
 TEST_F(CliTest, UnknownSampleListsTheSamples) {
     CliRun run = expect_render_usage_error("--sample no_such_sample");
     EXPECT_NE(run.output.find("no_such_sample"), std::string::npos) << run.output;
-    for (const auto& info : lucent::samples::all_samples())
-        EXPECT_NE(run.output.find(info.name), std::string::npos) << run.output;
+    for (const lucent::samples::Sample* info : lucent::samples::all_samples())
+        EXPECT_NE(run.output.find(info->name), std::string::npos) << run.output;
 }
 
 TEST_F(CliTest, SetWithoutEqualsIsAUsageError) {
@@ -187,9 +187,9 @@ TEST_F(CliTest, RenderHelpListsSamplesAndOptions) {
     CliRun run = run_cli("render --help");
     EXPECT_EQ(run.exit_code, 0) << run.output;
     EXPECT_NE(run.output.find("Examples"), std::string::npos) << run.output;
-    for (const auto& info : lucent::samples::all_samples()) {
-        EXPECT_NE(run.output.find(info.name), std::string::npos) << run.output;
-        for (const auto& option : info.options)
+    for (const lucent::samples::Sample* info : lucent::samples::all_samples()) {
+        EXPECT_NE(run.output.find(info->name), std::string::npos) << run.output;
+        for (const auto& option : info->options)
             EXPECT_NE(run.output.find(option.name + "=" + option.default_value), std::string::npos)
                 << run.output;
     }

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "samples/direct/direct.h"
+#include "samples/sample.h"
 #include "scene/image_io.h"
 
 namespace {
@@ -19,7 +19,7 @@ RenderResult render(const std::string& scene, unsigned size = 96) {
     settings.backend = lucent::BackendKind::kCpu;
     settings.scene = scene;
     settings.sets["area_samples"] = "16";
-    return lucent::samples::direct_sample_info().render(settings);
+    return lucent::samples::find_sample("direct").render(settings);
 }
 
 float3 pixel(const RenderResult& r, float fx, float fy) {

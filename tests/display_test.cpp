@@ -153,16 +153,16 @@ TEST(DisplayFrame, ABufferOfAnotherShapeOrContextIsAClearError) {
 }
 
 TEST(DisplayFrame, SessionsGiveDisplayFramesEqualToTheirImages) {
-    for (const char* name : {"whitted", "pathtracer", "fog", "direct"}) {  // 3 sessions, 1 still
+    for (const char* name : {"whitted", "pathtracer", "fog", "direct", "radiosity"}) {
         samples::RenderSettings settings;
         settings.width = 40;
         settings.height = 30;
         settings.backend = test_backend();
         settings.threads = 2;
-        const samples::SampleInfo& info = samples::find_sample(name);
-        const samples::FrameResult image = samples::open_session(info, settings)->frame();
+        const samples::Sample& sample = samples::find_sample(name);
+        const samples::FrameResult image = sample.open(settings)->frame();
         settings.display_frames = true;
-        const samples::FrameResult shown = samples::open_session(info, settings)->frame();
+        const samples::FrameResult shown = sample.open(settings)->frame();
         ASSERT_TRUE(shown.display) << name;
         EXPECT_TRUE(shown.image.pixels.empty()) << name;
         const std::vector<unsigned char> rgb = scene::to_srgb8(image.image);

@@ -10,7 +10,7 @@
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
 
-#include "samples/fog/fog.h"
+#include "samples/sample.h"
 #include "tests/test_support.h"
 
 namespace {
@@ -25,7 +25,7 @@ RenderResult render(const std::map<std::string, std::string>& sets, unsigned w =
     settings.height = h;
     settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.sets = sets;
-    return lucent::samples::fog_sample_info().render(settings);
+    return lucent::samples::find_sample("fog").render(settings);
 }
 
 float max_difference(const RenderResult& a, const RenderResult& b) {
@@ -136,7 +136,7 @@ TEST(Fog, ASceneIsNotAccepted) {
     settings.width = settings.height = 8;
     settings.backend = lucent::BackendKind::kCpu;
     settings.scene = "cornell";
-    EXPECT_THROW(lucent::samples::fog_sample_info().render(settings), std::exception);
+    EXPECT_THROW(lucent::samples::find_sample("fog").render(settings), std::exception);
 }
 
 }  // namespace

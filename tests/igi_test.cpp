@@ -8,7 +8,7 @@
 #include <fstream>
 #include <random>
 
-#include "samples/igi/igi.h"
+#include "samples/sample.h"
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
 #include "scene/scene.h"
@@ -28,7 +28,7 @@ RenderResult render(const std::map<std::string, std::string>& sets, unsigned siz
     settings.sets = sets;
     settings.scene = scene;
     settings.keep_layers = layers;
-    return lucent::samples::igi_sample_info().render(settings);
+    return lucent::samples::find_sample("igi").render(settings);
 }
 
 float brightness(const RenderResult& r, float fx, float fy) {

@@ -13,16 +13,16 @@ TEST(jit, EverySampleMegakernelCompilesForSm90) {
     GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
 #else
     ::setenv("LUCENT_CACHE_DIR", "off", 1);  // a real NVRTC compile, not a cache hit
-    for (const lucent::samples::SampleInfo& sample : lucent::samples::all_samples()) {
+    for (const lucent::samples::Sample* sample : lucent::samples::all_samples()) {
         lucent::samples::RenderSettings settings;
         settings.width = 8;
         settings.height = 8;
         settings.backend = lucent::BackendKind::kCpu;
         settings.jit_check_sm = 90;
         lucent::samples::RenderResult result;
-        ASSERT_NO_THROW(result = sample.render(settings)) << sample.name;
-        EXPECT_GT(result.report.jit_ms, 0.0) << sample.name << ": no megakernel was compiled";
-        EXPECT_FALSE(result.report.jit_cached) << sample.name;
+        ASSERT_NO_THROW(result = sample->render(settings)) << sample->name;
+        EXPECT_GT(result.report.jit_ms, 0.0) << sample->name << ": no megakernel was compiled";
+        EXPECT_FALSE(result.report.jit_cached) << sample->name;
     }
 #endif
 }

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <vector>
 
-#include "samples/pathtracer/pathtracer.h"
+#include "samples/sample.h"
 #include "samples/pathtracer/pathtracer_bsdf.h"
 
 namespace {
@@ -31,7 +31,7 @@ RenderResult render(const std::string& scene, unsigned size, unsigned spp,
     settings.scene = scene;
     settings.spp = spp;
     settings.sets = sets;
-    return lucent::samples::pathtracer_sample_info().render(settings);
+    return lucent::samples::find_sample("pathtracer").render(settings);
 }
 
 float3 mean_of(const RenderResult& r, unsigned x0, unsigned y0, unsigned x1, unsigned y1) {

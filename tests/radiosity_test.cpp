@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "samples/radiosity/radiosity.h"
+#include "samples/sample.h"
 #include "samples/radiosity/vpl_grid.h"
 #include "scene/scene.h"
 #include "tests/test_support.h"
@@ -26,7 +26,7 @@ RenderResult render(const std::map<std::string, std::string>& sets, unsigned siz
     settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.sets = sets;
     settings.keep_layers = layers;
-    return lucent::samples::radiosity_sample_info().render(settings);
+    return lucent::samples::find_sample("radiosity").render(settings);
 }
 
 /// Sum over the pixels, per channel, in double.
@@ -183,7 +183,7 @@ TEST(Radiosity, SceneWithoutAnAreaLightIsAClearError) {
     settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.scene = "cornell-point";
     try {
-        lucent::samples::radiosity_sample_info().render(settings);
+        lucent::samples::find_sample("radiosity").render(settings);
         ADD_FAILURE() << "no error";
     } catch (const std::exception& e) {
         EXPECT_NE(std::string(e.what()).find("no area light"), std::string::npos) << e.what();

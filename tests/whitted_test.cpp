@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lucent/error.h"
+#include "samples/sample.h"
 #include "samples/whitted/whitted.h"
 #include "scene/image_io.h"
 
@@ -33,7 +34,7 @@ RenderResult render(unsigned size, std::map<std::string, std::string> sets) {
     settings.width = settings.height = size;
     settings.backend = lucent_tests_backend();
     settings.sets = std::move(sets);
-    return whitted_sample_info().render(settings);
+    return find_sample("whitted").render(settings);
 }
 
 /// The golden render (adaptive antialiasing on), made once for the tests that read it.
@@ -150,7 +151,7 @@ TEST(Whitted, RejectsUnknownSceneNamingTheAcceptedOne) {
     settings.backend = lucent_tests_backend();
     settings.scene = "cornell";
     try {
-        whitted_sample_info().render(settings);
+        find_sample("whitted").render(settings);
         FAIL() << "--scene cornell was accepted";
     } catch (const Error& e) {
         std::string message = e.what();
@@ -158,7 +159,7 @@ TEST(Whitted, RejectsUnknownSceneNamingTheAcceptedOne) {
         EXPECT_NE(message.find("whitted"), std::string::npos) << message;
     }
     settings.scene = "whitted";
-    EXPECT_NO_THROW(whitted_sample_info().render(settings));
+    EXPECT_NO_THROW(find_sample("whitted").render(settings));
 }
 
 TEST(Whitted, RejectsOptionsOutOfRange) {

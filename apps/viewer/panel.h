@@ -1,5 +1,5 @@
 // The ImGui panel: frames/s, the last frame's stage timings, and a control per sample
-// option (checkbox, slider or text field, from the option's help text).
+// option (checkbox, slider or text field, from the option's kind and range).
 #pragma once
 
 #include <map>
@@ -28,7 +28,7 @@ struct PanelChanges {
 };
 
 /// Draws the panel; returns what the user changed.
-PanelChanges draw_panel(const samples::SampleInfo& info, const WorkerStatus& status,
+PanelChanges draw_panel(const samples::Sample& sample, const WorkerStatus& status,
                         const PanelState& state);
 
 }  // namespace lucent::viewer

@@ -8,9 +8,9 @@
 
 namespace lucent::viewer {
 
-RenderWorker::RenderWorker(const samples::SampleInfo& info, samples::RenderSettings settings,
+RenderWorker::RenderWorker(const samples::Sample& sample, samples::RenderSettings settings,
                            uint64_t frame_limit)
-    : m_info(info), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
+    : m_sample(sample), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
     m_settings.repeat = 1;
     m_settings.display_frames = true;  // GPU frames stay on the GPU until shown
     m_settings.progress = nullptr;
@@ -125,10 +125,9 @@ bool RenderWorker::has_work() const {
 }
 
 void RenderWorker::open_session() {
-    m_session = samples::open_session(m_info, m_settings);
+    m_session = m_sample.open(m_settings);
     std::lock_guard lock(m_mutex);
     m_status.opened = true;
-    m_status.fixed_camera = m_session->fixed_camera();
     m_status.progressive = m_session->progressive();
     m_status.backend = m_session->backend();
     m_status.backend_notice = m_session->backend_notice();
@@ -170,7 +169,7 @@ void RenderWorker::run() {
             for (const auto& [name, value] : new_sets) {
                 samples::RenderSettings changed = m_settings;
                 changed.sets[name] = value;
-                samples::check_options(changed, m_info);
+                m_sample.read_options(changed);  // checks the value
                 if (!m_session->set_option(name, value)) rebuild = true;
                 m_settings = changed;
             }

@@ -41,7 +41,6 @@ struct PartialFrame {
 struct WorkerStatus {
     bool opened = false;  // the session exists (the first frame may still be rendering)
     bool busy = false;    // a frame is being rendered now
-    bool fixed_camera = false;
     bool progressive = false;
     std::string backend, backend_notice;
     std::string error;  // the last failure (a bad option value, an engine error)
@@ -54,7 +53,7 @@ class RenderWorker {
   public:
     /// Opens the sample's session on the worker thread. `frame_limit` > 0: render frames
     /// until that many finished even when nothing changes (headless checks), then stop.
-    RenderWorker(const samples::SampleInfo& info, samples::RenderSettings settings,
+    RenderWorker(const samples::Sample& sample, samples::RenderSettings settings,
                  uint64_t frame_limit);
     ~RenderWorker();
     RenderWorker(const RenderWorker&) = delete;
@@ -81,7 +80,7 @@ class RenderWorker {
     /// On the worker thread, as a launch's rows finish: copies them into m_partial.
     void take_rows(const LaunchProgress& progress);
 
-    const samples::SampleInfo& m_info;
+    const samples::Sample& m_sample;
     samples::RenderSettings m_settings;  // the worker thread's copy of the options in effect
     uint64_t m_frame_limit;
     std::unique_ptr<samples::InteractiveSession> m_session;

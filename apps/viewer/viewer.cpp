@@ -73,14 +73,14 @@ class RateMeter {
 }  // namespace
 
 int run_viewer(const ViewerConfig& config) {
-    const samples::SampleInfo& info = *config.info;
+    const samples::Sample& sample = *config.sample;
     const bool headless_check = config.frames > 0;
-    Window window("lucent view: " + info.name, int(config.settings.width),
+    Window window("lucent view: " + sample.name, int(config.settings.width),
                   int(config.settings.height), /*exact=*/headless_check);
     Input input(window.handle());
     window.start_ui();
     ImageView view;
-    RenderWorker worker(info, config.settings, config.frames);
+    RenderWorker worker(sample, config.settings, config.frames);
 
     std::optional<scene::CameraController> camera;
     ShownFrame shown;
@@ -107,7 +107,7 @@ int run_viewer(const ViewerConfig& config) {
         ++ui_frames;
 
         const WorkerStatus status = worker.status();
-        if (!camera && status.opened && !status.fixed_camera) camera.emplace(status.initial_camera);
+        if (!camera && status.opened) camera.emplace(status.initial_camera);
         const ImGuiIO& io = ImGui::GetIO();
         if (camera && input.move_camera(*camera, dt, io.WantCaptureMouse, io.WantCaptureKeyboard))
             worker.set_camera(camera->camera());
@@ -128,7 +128,7 @@ int run_viewer(const ViewerConfig& config) {
                 if (shown.number == 0) {
                     panel.message = "nothing rendered yet to save";
                 } else {
-                    const std::string name = next_screenshot_name(info.name);
+                    const std::string name = next_screenshot_name(sample.name);
                     try {
                         scene::write_png_rgba8(name, shown.width, shown.height,
                                                shown.display->rgba());
@@ -140,15 +140,15 @@ int run_viewer(const ViewerConfig& config) {
                 std::printf("%s\n", panel.message.c_str());
             }
             if (const char* option = toggled_option(key)) {
-                const bool has = std::any_of(info.options.begin(), info.options.end(),
+                const bool has = std::any_of(sample.options.begin(), sample.options.end(),
                                              [&](const auto& o) { return o.name == option; });
                 if (!has) {
-                    panel.message = "the " + info.name + " sample has no option '" +
+                    panel.message = "the " + sample.name + " sample has no option '" +
                                     std::string(option) + "' (radiosity has)";
                 } else {
                     auto it = status.sets.find(option);
                     std::string value = "0";
-                    for (const auto& o : info.options)
+                    for (const auto& o : sample.options)
                         if (o.name == option) value = o.default_value;
                     if (it != status.sets.end()) value = it->second;
                     const std::string flipped = value == "1" ? "0" : "1";
@@ -191,7 +191,7 @@ int run_viewer(const ViewerConfig& config) {
             panel.ui_fps = ui_rate.rate(now);
             panel.render_fps = render_rate.rate(now);
             panel.frame = &shown;
-            const PanelChanges changes = draw_panel(info, status, panel);
+            const PanelChanges changes = draw_panel(sample, status, panel);
             for (const auto& [name, value] : changes.options) worker.set_option(name, value);
             if (changes.spp_limit) worker.set_spp_limit(*changes.spp_limit);
         }
@@ -217,7 +217,7 @@ int run_viewer(const ViewerConfig& config) {
             "lucent view: %s on %s; window %llu frames in %.2f s (%.1f frames/s; frame "
             "interval median %.1f ms, 95th percentile %.1f ms, slowest %.1f ms); "
             "%llu renders, %llu partial frames shown\n",
-            info.name.c_str(), status.backend.c_str(), (unsigned long long)ui_frames, elapsed,
+            sample.name.c_str(), status.backend.c_str(), (unsigned long long)ui_frames, elapsed,
             double(ui_frames) / std::max(elapsed, 1e-9), at(0.5), at(0.95), ui_frame_ms.back(),
             (unsigned long long)shown.number, (unsigned long long)partial_uploads);
     }

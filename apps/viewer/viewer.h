@@ -9,7 +9,7 @@
 namespace lucent::viewer {
 
 struct ViewerConfig {
-    const samples::SampleInfo* info = nullptr;
+    const samples::Sample* sample = nullptr;
     samples::RenderSettings settings;
     unsigned frames = 0;     // >0: exit after this many rendered frames were shown
     std::string screenshot;  // with frames: save the window's pixels here (.png)

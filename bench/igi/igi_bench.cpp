@@ -8,12 +8,12 @@
 #include <string>
 
 #include "bench/common/report.h"
-#include "samples/igi/igi.h"
+#include "samples/sample.h"
 #include "samples/igi/igi_frames.h"
 
 namespace lucent::bench {
 
-using samples::igi_sample_info;
+using samples::find_sample;
 using samples::kIgiStageNames;
 using samples::RenderResult;
 using samples::RenderSettings;
@@ -58,7 +58,7 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
         {"interleave", c.interleave ? std::to_string(options.interleave) : "1"},
         {"reflection_layer", options.reflection_layer ? "1" : "0"},
     };
-    const RenderResult result = igi_sample_info().render(settings);
+    const RenderResult result = find_sample("igi").render(settings);
     Row row{c.name, vpls, 0, {}, result.backend};
     for (const StageTiming& stage : result.stages) {
         if (stage.name == "frame") row.frame_ms = stage.ms;

@@ -117,7 +117,7 @@ double stage_ms(const samples::FrameResult& frame, const char* name) {
 }  // namespace
 
 int run_present_bench(const PresentBenchOptions& options) {
-    const samples::SampleInfo& info = samples::find_sample(options.sample);
+    const samples::Sample& info = samples::find_sample(options.sample);
     HeadlessGl gl(int(options.width), int(options.height),
                   options.backend != BackendKind::kCpu);
     samples::RenderSettings settings;
@@ -126,7 +126,7 @@ int run_present_bench(const PresentBenchOptions& options) {
     settings.backend = options.backend;
     settings.threads = options.threads;
     settings.display_frames = true;
-    std::unique_ptr<samples::InteractiveSession> session = samples::open_session(info, settings);
+    std::unique_ptr<samples::InteractiveSession> session = info.open(settings);
     const std::string backend = session->backend();
 
     // The interop path first (it falls back to the host path by itself where interop does

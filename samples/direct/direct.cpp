@@ -1,44 +1,42 @@
-// Host setup of the direct-lighting sample: one GeometryTriangles per mesh with its material
-// indices, one Material per scene material, lights in buffers, and a pinhole camera.
-#include "samples/direct/direct.h"
-
+// The direct-lighting sample: any scene (built-in, OBJ or JSON) with Lambertian surfaces,
+// emission, point lights and area lights with shadow rays (programs in direct_programs.h).
+// One GeometryTriangles per mesh with its material indices, one Material per scene material,
+// the lights in buffers, and the pinhole camera in a buffer.
 #include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <map>
+#include <memory>
+#include <vector>
 
+#include "samples/camera_session.h"
 #include "samples/direct/direct_programs.h"
 #include "samples/scene_setup.h"
-#include "samples/settings_error.h"
+#include "samples/stages.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
+/// What build() made: the output buffer and the scene's own camera.
+struct DirectScene {
+    std::shared_ptr<Buffer> output;
+    scene::Camera camera;
+    std::string note;  // "cornell, 32 triangles"
+};
 
-RenderResult render_direct(const RenderSettings& settings) {
-    const SampleInfo& info = direct_sample_info();
-    check_options(settings, info);
-    const int area_samples = get_int_option(settings, info, "area_samples", 1, 1024);
-    const float ambient = get_float_option(settings, info, "ambient", 0.0f, 1.0f);
-    const Clock::time_point setup_start = Clock::now();
+/// Builds the scene of settings.scene (default: cornell) into `ctx`, its camera program at
+/// entry 0 reading `camera`.
+DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValues& options,
+                  const CameraBuffer& camera) {
+    const float ambient = options.number("ambient");
     const scene::Scene input =
         scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
-
-    RenderResult out;
-    Context ctx(settings.context_options());
-    out.backend = ctx.backend_name();
-    out.backend_notice = ctx.backend_notice();
     ctx.set_ray_type<direct::RadiancePayload>(direct::kRadianceRay, "radiance");
     ctx.set_ray_type<direct::ShadowPayload>(direct::kShadowRay, "shadow",
                                             /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(2);  // camera ray, then shadow rays
 
     // Lights; an emitter with no light source of its own still shows its emission.
-    bind_lights<direct::PointLight, direct::AreaLight>(ctx, input);
-    ctx["area_samples"] = unsigned(area_samples);
+    bind_lights(ctx, input);
+    ctx["area_samples"] = unsigned(options.integer("area_samples"));
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 
     DiffuseTextures texture_for(ctx);
@@ -53,48 +51,67 @@ RenderResult render_direct(const RenderSettings& settings) {
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(direct::direct_attributes));
-    auto top = mesh_group(ctx, input, attributes, materials);
-    ctx["top_object"] = top;
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
+    ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
-    const PinholeFrame frame =
-        pinhole_frame(input.camera, float(settings.width) / float(settings.height));
-    auto output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
-    auto camera = ctx.create_program(LUCENT_PROGRAM(direct::direct_camera));
-    (*camera)["eye"] = input.camera.eye;
-    (*camera)["W"] = frame.W;
-    (*camera)["U"] = frame.U;
-    (*camera)["V"] = frame.V;
-    (*camera)["output"] = output;
-    ctx.set_ray_generation_program(0, camera);
+    DirectScene out{ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height),
+                    input.camera,
+                    input.name + ", " + std::to_string(input.triangle_count()) + " triangles"};
+    auto program = ctx.create_program(LUCENT_PROGRAM(direct::direct_camera));
+    (*program)["camera"] = camera.buffer();
+    (*program)["output"] = out.output;
+    ctx.set_ray_generation_program(0, program);
     auto miss = ctx.create_program(LUCENT_PROGRAM(direct::direct_miss));
     (*miss)["background"] = make_float3(0.0f);
     ctx.set_miss_program(direct::kRadianceRay, miss);
-    out.stages.push_back(
-        {"scene setup",
-         std::chrono::duration<double, std::milli>(Clock::now() - setup_start).count(),
-         input.name + ", " + std::to_string(input.triangle_count()) + " triangles"});
-
-    timed_launch(ctx, 0, settings, out);
-    out.image = image_from_output(*output);
     return out;
 }
 
+/// `lucent view`: the scene built once; every option is a material or context variable
+/// baked at build time, so an option change rebuilds it (cheap next to a frame).
+class DirectSession final : public CameraSession {
+  public:
+    DirectSession(const Sample& sample, const RenderSettings& settings, const OptionValues& options)
+        : CameraSession(sample, settings) {
+        const DirectScene scene = build(context(), settings, options, camera());
+        set_output(scene.output);
+        start_at(scene.camera, pinhole_camera(scene.camera, settings.aspect()));
+    }
+};
+
+class DirectSample final : public Sample {
+  public:
+    DirectSample()
+        : Sample("direct",
+                 "Direct lighting of any scene (--scene cornell, cornell-point, FILE.obj or "
+                 "FILE.json): Lambertian surfaces, emission, point and area lights with shadow rays",
+                 {
+                     SampleOption::integer("area_samples", 16, 1, 1024,
+                                           "shadow rays per area light per pixel, a stratified grid"),
+                     SampleOption::number("ambient", 0.0f, 0.0f, 1.0f,
+                                          "added to every diffuse reflectance, to see unlit parts"),
+                 }) {}
+
+    RenderResult render(const RenderSettings& settings) const override {
+        const OptionValues options = read_options(settings);
+        const Clock::time_point setup_start = Clock::now();
+        Context ctx(settings.context_options());
+        RenderResult out = result_for(ctx);
+        CameraBuffer camera(ctx);
+        const DirectScene scene = build(ctx, settings, options, camera);
+        camera.set(pinhole_camera(scene.camera, settings.aspect()));
+        out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
+        timed_launch(ctx, 0, settings, out);
+        out.image = image_from_output(*scene.output);
+        return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        return std::make_unique<DirectSession>(*this, settings, read_options(settings));
+    }
+};
+
+const RegisterSample<DirectSample> kRegistered(/*help_order=*/20);
+
 }  // namespace
-
-const SampleInfo& direct_sample_info() {
-    static const SampleInfo info{
-        "direct",
-        "Direct lighting of any scene (--scene cornell, cornell-point, FILE.obj or FILE.json): "
-        "Lambertian surfaces, emission, point and area lights with shadow rays",
-        {
-            {"area_samples", "16",
-             "shadow rays per area light per pixel, a stratified grid (1..1024)"},
-            {"ambient", "0", "added to every diffuse reflectance, to see unlit parts (0..1)"},
-        },
-        render_direct,
-    };
-    return info;
-}
-
 }  // namespace lucent::samples

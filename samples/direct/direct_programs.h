@@ -4,6 +4,7 @@
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/common_programs.h"
 
 namespace direct {
 
@@ -17,37 +18,21 @@ struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occlu
     float visible;
 };
 
-struct PointLight {
-    float3 position;
-    float3 intensity;
-};
-struct AreaLight {
-    float3 corner, edge1, edge2;
-    float3 emission;
-};
+using sample_common::AreaLight;
+using sample_common::PointLight;
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
-/// What a triangle hit gives the hit programs: its normal and its texture coordinate.
-struct HitAttributes {
-    float3 geometric_normal;  // object space, not normalised
-    float2 uv;
-};
-
-/// The mesh's vertex data, for the attribute program (set on each GeometryTriangles).
-struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
-    lucent::BufferView<float2> uvs;  // per vertex; empty when the mesh has none
-};
-LUCENT_RECORD(MeshRecord, positions, triangles, uvs)
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal_uv): its normal
+/// and its texture coordinate.
+using HitAttributes = sample_common::MeshNormalUv;
 
 struct CameraRecord {
-    float3 eye, U, V, W;  // W: to the image centre; U, V: half the image's extent
+    lucent::BufferView<sample_common::PinholeCamera> camera;  // one element
     lucent::BufferView<float4> output;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, output, top_object)
+LUCENT_RECORD(CameraRecord, camera, output, top_object)
 
 struct SurfaceRecord {
     float3 Kd, Ke;
@@ -79,10 +64,10 @@ LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 p, float3 tar
 
 LUCENT_RAY_GENERATION(direct_camera, direct::CameraRecord) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
-    const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
+    const sample_common::PinholeCamera c = rec.camera[0u];
     direct::RadiancePayload prd{make_float3(0.0f)};
     lucent::trace(rec.top_object,
-                  lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
+                  lucent::make_ray(c.eye, sample_common::pixel_centre_direction(c, i, n),
                                    direct::kRadianceRay, 0.0f),
                   prd);
     rec.output[make_uint2(i.x, i.y)] = make_float4(prd.color, 1.0f);
@@ -90,17 +75,6 @@ LUCENT_RAY_GENERATION(direct_camera, direct::CameraRecord) {
 
 LUCENT_MISS(direct_miss, direct::MissRecord, direct::RadiancePayload) {
     prd.color = rec.background;
-}
-
-LUCENT_ATTRIBUTE(direct_attributes, direct::MeshRecord, direct::HitAttributes) {
-    const uint3 t = rec.triangles[prim];
-    const float3 p0 = rec.positions[t.x], p1 = rec.positions[t.y], p2 = rec.positions[t.z];
-    attr.geometric_normal = cross(p1 - p0, p2 - p0);
-    attr.uv = make_float2(0.0f, 0.0f);
-    if (rec.uvs.count() > 0) {
-        const float w = 1.0f - barycentrics.x - barycentrics.y;
-        attr.uv = w * rec.uvs[t.x] + barycentrics.x * rec.uvs[t.y] + barycentrics.y * rec.uvs[t.z];
-    }
 }
 
 LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayload,

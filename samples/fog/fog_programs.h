@@ -12,6 +12,7 @@
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/common_programs.h"
 #include "lucent/device/noise.h"
 
 namespace fog {
@@ -21,15 +22,7 @@ LUCENT_MODULE(fog)
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
-struct PointLight {
-    float3 position;
-    float3 intensity;
-};
-
-/// The pinhole camera in a buffer, so that a moving camera changes data, not the scene.
-struct CameraFrame {
-    float3 eye, U, V, W;  // W: to the image centre; U, V: half the image's extent
-};
+using sample_common::PointLight;
 
 struct HitAttributes {
     float3 normal;  // object space, not normalised (triangles); unit (fog box)
@@ -62,7 +55,7 @@ LUCENT_HD inline float fresnel(float cos_i, float eta) {
 
 // ---- records ---------------------------------------------------------------------------
 struct CameraRecord {
-    lucent::BufferView<CameraFrame> camera;
+    lucent::BufferView<sample_common::PinholeCamera> camera;
     lucent::BufferView<float4> output;
     lucent::Handle top_object;
 };
@@ -124,12 +117,6 @@ struct FogRecord {
 LUCENT_RECORD(FogRecord, box_min, box_max, density, step, noise_scale, noise, falloff, rounds,
               noise_key, fog_color, solid_object)
 
-struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
-};
-LUCENT_RECORD(MeshRecord, positions, triangles)
-
 struct MissRecord {
     lucent::TextureView environment;  // equirectangular; used when has_environment
     unsigned has_environment;
@@ -180,13 +167,12 @@ LUCENT_HD inline float2 box_span(float3 lo, float3 hi, float3 o, float3 d) {
 // ---- camera, miss ------------------------------------------------------------------------
 LUCENT_RAY_GENERATION(fog_camera, fog::CameraRecord) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
-    const fog::CameraFrame c = rec.camera[0u];
-    const float sx = 2.0f * (i.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (i.y + 0.5f) / n.y;
+    const sample_common::PinholeCamera c = rec.camera[0u];
     fog::RadiancePayload prd{make_float3(0.0f), 0.0f, 0};
-    lucent::trace(
-        rec.top_object,
-        lucent::make_ray(c.eye, normalize(c.W + sx * c.U + sy * c.V), fog::kRadianceRay, 0.0f),
-        prd);
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(c.eye, sample_common::pixel_centre_direction(c, i, n),
+                                   fog::kRadianceRay, 0.0f),
+                  prd);
     rec.output[make_uint2(i.x, i.y)] = make_float4(prd.color, 1.0f);
 }
 
@@ -212,7 +198,9 @@ LUCENT_MISS(fog_environment, fog::MissRecord, fog::RadiancePayload) {
 }
 
 // ---- surfaces ------------------------------------------------------------------------------
-LUCENT_ATTRIBUTE(fog_mesh_attributes, fog::MeshRecord, fog::HitAttributes) {
+// The triangles' attributes: sample_common::mesh_normal's, in fog's HitAttributes (which the
+// fog box's intersection shares, with its exit distance).
+LUCENT_ATTRIBUTE(fog_mesh_attributes, sample_common::MeshRecord, fog::HitAttributes) {
     const uint3 t = rec.triangles[prim];
     attr.normal =
         cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);

@@ -8,7 +8,6 @@
 #include "lucent/device/tea.h"
 #include "samples/fog/fog_programs.h"
 #include "samples/scene_setup.h"
-#include "samples/settings_error.h"
 #include "scene/texture_image.h"
 
 namespace lucent::samples {
@@ -73,42 +72,8 @@ Mesh crystal_mesh(float3 base, float radius) {
     return m;
 }
 
-}  // namespace
-
-FogOptions read_fog_options(const RenderSettings& s, const SampleInfo& info) {
-    FogOptions o;
-    o.fog = get_int_option(s, info, "fog", 0, 1) == 1;
-    o.step = get_float_option(s, info, "step", 1e-3f, 10.0f);
-    o.height = get_float_option(s, info, "height", 0.01f, 100.0f);
-    o.density = get_float_option(s, info, "density", 0.0f, 100.0f);
-    o.noise_scale = get_float_option(s, info, "noise_scale", 0.01f, 1000.0f);
-    o.noise = get_int_option(s, info, "noise", 0, 1) == 1;
-    o.falloff = get_int_option(s, info, "falloff", 0, 1) == 1;
-    o.rounds = unsigned(get_int_option(s, info, "rounds", 1, 64));
-    o.device = unsigned(get_int_option(s, info, "device", 0, 1 << 30));
-    o.seed = unsigned(get_int_option(s, info, "seed", 0, 1 << 30));
-    o.max_depth = unsigned(get_int_option(s, info, "max_depth", 1, 16));
-    o.environment = get_string_option(s, info, "environment");
-    o.orbit_degrees = get_float_option(s, info, "orbit", -3600.0f, 3600.0f);
-    o.eye_height = get_float_option(s, info, "eye_height", -100.0f, 100.0f);
-    o.eye_distance = get_float_option(s, info, "eye_distance", 0.1f, 1000.0f);
-    return o;
-}
-
-struct FogScene::Impl {
-    Context ctx;
-    FogOptions options;
-    unsigned width, height;
-    std::shared_ptr<Buffer> camera, output;
-
-    Impl(const FogOptions& o, unsigned w, unsigned h, const ContextOptions& c)
-        : ctx(c), options(o), width(w), height(h) {}
-};
-
-FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
-                   const ContextOptions& context_options)
-    : m(std::make_unique<Impl>(options, width, height, context_options)) {
-    Context& ctx = m->ctx;
+/// Ray types, recursion depth, lights and the context-wide variables.
+void set_up_context(Context& ctx, const FogOptions& options) {
     ctx.set_ray_type<fog::RadiancePayload>(fog::kRadianceRay, "radiance");
     ctx.set_ray_type<fog::ShadowPayload>(fog::kShadowRay, "shadow", /*expects_closest_hit=*/false);
     // Each level of the reflection and refraction tree may cross the fog, whose look behind
@@ -127,44 +92,51 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
     ctx["max_depth"] = options.max_depth;
     // Sebald Fig. 4: this device's key from its identifier and the seed.
     ctx["noise_key"] = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
+}
 
+struct SolidMaterials {
+    std::shared_ptr<Material> floor, box, glass;
+};
+
+/// The tutorial's tiled floor, rusty box and glass crystal.
+SolidMaterials create_materials(Context& ctx) {
     auto phong = ctx.create_program(LUCENT_PROGRAM(fog::fog_phong));
     auto opaque = ctx.create_program(LUCENT_PROGRAM(fog::fog_opaque_shadow));
-    auto floor_material = ctx.create_material();
-    floor_material->set_name("floor tiles");
-    floor_material->set_closest_hit(fog::kRadianceRay, phong);
-    floor_material->set_any_hit(fog::kShadowRay, opaque);
-    (*floor_material)["Kd_a"] = make_float3(0.75f, 0.72f, 0.66f);
-    (*floor_material)["Kd_b"] = make_float3(0.45f, 0.42f, 0.38f);
-    (*floor_material)["Ks"] = make_float3(0.1f);
-    (*floor_material)["phong_exponent"] = 40.0f;
-    (*floor_material)["Kr"] = make_float3(0.1f);
-    (*floor_material)["pattern"] = 0u;
-    (*floor_material)["pattern_scale"] = 2.0f;
-    auto box_material = ctx.create_material();
-    box_material->set_name("rusty box");
-    box_material->set_closest_hit(fog::kRadianceRay, phong);
-    box_material->set_any_hit(fog::kShadowRay, opaque);
-    (*box_material)["Kd_a"] = make_float3(0.55f, 0.56f, 0.6f);
-    (*box_material)["Kd_b"] = make_float3(0.42f, 0.2f, 0.07f);
-    (*box_material)["Ks"] = make_float3(0.5f);
-    (*box_material)["phong_exponent"] = 60.0f;
-    (*box_material)["Kr"] = make_float3(0.35f);
-    (*box_material)["pattern"] = 1u;
-    (*box_material)["pattern_scale"] = 1.2f;
-    auto glass_material = ctx.create_material();
-    glass_material->set_name("crystal");
-    glass_material->set_closest_hit(fog::kRadianceRay,
-                                    ctx.create_program(LUCENT_PROGRAM(fog::fog_glass)));
-    glass_material->set_any_hit(fog::kShadowRay,
-                                ctx.create_program(LUCENT_PROGRAM(fog::fog_glass_shadow)));
-    (*glass_material)["ior"] = 1.5f;
-    (*glass_material)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
-    (*glass_material)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
+    SolidMaterials m{ctx.create_material(), ctx.create_material(), ctx.create_material()};
+    m.floor->set_name("floor tiles");
+    m.floor->set_closest_hit(fog::kRadianceRay, phong);
+    m.floor->set_any_hit(fog::kShadowRay, opaque);
+    (*m.floor)["Kd_a"] = make_float3(0.75f, 0.72f, 0.66f);
+    (*m.floor)["Kd_b"] = make_float3(0.45f, 0.42f, 0.38f);
+    (*m.floor)["Ks"] = make_float3(0.1f);
+    (*m.floor)["phong_exponent"] = 40.0f;
+    (*m.floor)["Kr"] = make_float3(0.1f);
+    (*m.floor)["pattern"] = 0u;
+    (*m.floor)["pattern_scale"] = 2.0f;
+    m.box->set_name("rusty box");
+    m.box->set_closest_hit(fog::kRadianceRay, phong);
+    m.box->set_any_hit(fog::kShadowRay, opaque);
+    (*m.box)["Kd_a"] = make_float3(0.55f, 0.56f, 0.6f);
+    (*m.box)["Kd_b"] = make_float3(0.42f, 0.2f, 0.07f);
+    (*m.box)["Ks"] = make_float3(0.5f);
+    (*m.box)["phong_exponent"] = 60.0f;
+    (*m.box)["Kr"] = make_float3(0.35f);
+    (*m.box)["pattern"] = 1u;
+    (*m.box)["pattern_scale"] = 1.2f;
+    m.glass->set_name("crystal");
+    m.glass->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog::fog_glass)));
+    m.glass->set_any_hit(fog::kShadowRay,
+                         ctx.create_program(LUCENT_PROGRAM(fog::fog_glass_shadow)));
+    (*m.glass)["ior"] = 1.5f;
+    (*m.glass)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
+    (*m.glass)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
+    return m;
+}
 
+/// The triangles in a GeometryGroup of their own: it gets the triangle BVH's fast
+/// traversal, which a group holding the fog box (a custom primitive) would lose.
+std::shared_ptr<GeometryGroup> solid_group(Context& ctx, const SolidMaterials& materials) {
     auto attributes = ctx.create_program(LUCENT_PROGRAM(fog::fog_mesh_attributes));
-    // The triangles in a GeometryGroup of their own: it gets the triangle BVH's fast
-    // traversal, which a group holding the fog box (a custom primitive) would lose.
     auto solids = ctx.create_geometry_group();
     auto add_mesh = [&](const Mesh& mesh, const std::shared_ptr<Material>& material,
                         const char* name) {
@@ -186,67 +158,117 @@ FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
         instance->add_material(material);
         solids->add_child(instance);
     };
-    add_mesh(floor_mesh(), floor_material, "floor");
+    add_mesh(floor_mesh(), materials.floor, "floor");
     add_mesh(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)),
-             box_material, "box");
-    add_mesh(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), glass_material, "crystal");
+             materials.box, "box");
+    add_mesh(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), materials.glass, "crystal");
+    return solids;
+}
 
-    if (options.fog) {
-        // Sebald §3.1: a box with the floor's x, z extent and the fog's height.
-        auto fog_material = ctx.create_material();
-        fog_material->set_name("fog");
-        fog_material->set_closest_hit(fog::kRadianceRay,
-                                      ctx.create_program(LUCENT_PROGRAM(fog::fog_volume)));
-        fog_material->set_any_hit(fog::kShadowRay,
-                                  ctx.create_program(LUCENT_PROGRAM(fog::fog_volume_shadow)));
-        (*fog_material)["density"] = options.density;
-        (*fog_material)["step"] = options.step;
-        (*fog_material)["noise_scale"] = options.noise_scale;
-        (*fog_material)["noise"] = unsigned(options.noise);
-        (*fog_material)["falloff"] = unsigned(options.falloff);
-        (*fog_material)["rounds"] = options.rounds;
-        (*fog_material)["fog_color"] = make_float3(0.62f, 0.66f, 0.72f);
-        auto fog_box = ctx.create_geometry();
-        fog_box->set_name("fog box");
-        fog_box->set_primitive_count(1);
-        fog_box->set_bounding_box_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_bounds)));
-        fog_box->set_intersection_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_intersect)));
-        auto instance = ctx.create_geometry_instance();
-        instance->set_geometry(fog_box);
-        // On the instance: its intersection and its closest hit both read them.
-        (*instance)["box_min"] = make_float3(-kFloorHalf, 0.0f, -kFloorHalf);
-        (*instance)["box_max"] = make_float3(kFloorHalf, options.height, kFloorHalf);
-        instance->add_material(fog_material);
-        auto fog_group = ctx.create_geometry_group();
-        fog_group->add_child(instance);
-        auto top = ctx.create_group();
-        top->add_child(solids);
-        top->add_child(fog_group);
-        ctx["top_object"] = top;
-        ctx["solid_object"] = solids;
-    } else {
-        ctx["top_object"] = solids;
-    }
+/// Sebald §3.1: a box with the floor's x, z extent and the fog's height, in a group of its
+/// own beside the solids; both under the top object.
+void add_fog_box(Context& ctx, const FogOptions& options,
+                 const std::shared_ptr<GeometryGroup>& solids) {
+    auto fog_material = ctx.create_material();
+    fog_material->set_name("fog");
+    fog_material->set_closest_hit(fog::kRadianceRay,
+                                  ctx.create_program(LUCENT_PROGRAM(fog::fog_volume)));
+    fog_material->set_any_hit(fog::kShadowRay,
+                              ctx.create_program(LUCENT_PROGRAM(fog::fog_volume_shadow)));
+    (*fog_material)["density"] = options.density;
+    (*fog_material)["step"] = options.step;
+    (*fog_material)["noise_scale"] = options.noise_scale;
+    (*fog_material)["noise"] = unsigned(options.noise);
+    (*fog_material)["falloff"] = unsigned(options.falloff);
+    (*fog_material)["rounds"] = options.rounds;
+    (*fog_material)["fog_color"] = make_float3(0.62f, 0.66f, 0.72f);
+    auto fog_box = ctx.create_geometry();
+    fog_box->set_name("fog box");
+    fog_box->set_primitive_count(1);
+    fog_box->set_bounding_box_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_bounds)));
+    fog_box->set_intersection_program(ctx.create_program(LUCENT_PROGRAM(fog::fog_box_intersect)));
+    auto instance = ctx.create_geometry_instance();
+    instance->set_geometry(fog_box);
+    // On the instance: its intersection and its closest hit both read them.
+    (*instance)["box_min"] = make_float3(-kFloorHalf, 0.0f, -kFloorHalf);
+    (*instance)["box_max"] = make_float3(kFloorHalf, options.height, kFloorHalf);
+    instance->add_material(fog_material);
+    auto fog_group = ctx.create_geometry_group();
+    fog_group->add_child(instance);
+    auto top = ctx.create_group();
+    top->add_child(solids);
+    top->add_child(fog_group);
+    ctx["top_object"] = top;
+    ctx["solid_object"] = solids;
+}
 
+/// The miss program: the equirectangular map `file` (.hdr or .exr), or the procedural sky
+/// when it is empty.
+std::shared_ptr<Program> environment_program(Context& ctx, const std::string& file) {
     auto miss = ctx.create_program(LUCENT_PROGRAM(fog::fog_environment));
     DiffuseTextures textures(ctx);  // a white texel stands in when there is no map
-    if (options.environment.empty()) {
+    if (file.empty()) {
         (*miss)["environment"] = textures("");
         (*miss)["has_environment"] = 0u;
-    } else {
-        const scene::TextureImage map = scene::load_linear_image(options.environment);
-        auto texels = ctx.create_buffer<float4>(BufferType::kInput, map.width, map.height);
-        texels->upload(map.texels);
-        auto sampler = ctx.create_texture_sampler();
-        sampler->set_buffer(texels);
-        sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kClampToEdge);
-        sampler->set_filter(FilterMode::kLinear);
-        (*miss)["environment"] = sampler;
-        (*miss)["has_environment"] = 1u;
+        return miss;
     }
-    ctx.set_miss_program(fog::kRadianceRay, miss);
+    const scene::TextureImage map = scene::load_linear_image(file);
+    auto texels = ctx.create_buffer<float4>(BufferType::kInput, map.width, map.height);
+    texels->upload(map.texels);
+    auto sampler = ctx.create_texture_sampler();
+    sampler->set_buffer(texels);
+    sampler->set_wrap_mode(WrapMode::kRepeat, WrapMode::kClampToEdge);
+    sampler->set_filter(FilterMode::kLinear);
+    (*miss)["environment"] = sampler;
+    (*miss)["has_environment"] = 1u;
+    return miss;
+}
 
-    m->camera = ctx.create_buffer<fog::CameraFrame>(BufferType::kInput, 1);
+}  // namespace
+
+FogOptions read_fog_options(const OptionValues& v) {
+    FogOptions o;
+    o.fog = v.on("fog");
+    o.step = v.number("step");
+    o.height = v.number("height");
+    o.density = v.number("density");
+    o.noise_scale = v.number("noise_scale");
+    o.noise = v.on("noise");
+    o.falloff = v.on("falloff");
+    o.rounds = unsigned(v.integer("rounds"));
+    o.device = unsigned(v.integer("device"));
+    o.seed = unsigned(v.integer("seed"));
+    o.max_depth = unsigned(v.integer("max_depth"));
+    o.environment = v.text("environment");
+    o.orbit_degrees = v.number("orbit");
+    o.eye_height = v.number("eye_height");
+    o.eye_distance = v.number("eye_distance");
+    return o;
+}
+
+struct FogScene::Impl {
+    Context ctx;
+    FogOptions options;
+    unsigned width, height;
+    std::shared_ptr<Buffer> camera, output;
+
+    Impl(const FogOptions& o, unsigned w, unsigned h, const ContextOptions& c)
+        : ctx(c), options(o), width(w), height(h) {}
+};
+
+FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
+                   const ContextOptions& context_options)
+    : m(std::make_unique<Impl>(options, width, height, context_options)) {
+    Context& ctx = m->ctx;
+    set_up_context(ctx, options);
+    const std::shared_ptr<GeometryGroup> solids = solid_group(ctx, create_materials(ctx));
+    if (options.fog)
+        add_fog_box(ctx, options, solids);
+    else
+        ctx["top_object"] = solids;
+    ctx.set_miss_program(fog::kRadianceRay, environment_program(ctx, options.environment));
+
+    m->camera = ctx.create_buffer<sample_common::PinholeCamera>(BufferType::kInput, 1);
     m->output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
     auto camera = ctx.create_program(LUCENT_PROGRAM(fog::fog_camera));
     (*camera)["camera"] = m->camera;
@@ -271,9 +293,9 @@ const LaunchReport& FogScene::render(float orbit_degrees) {
 }
 
 const LaunchReport& FogScene::render(const scene::Camera& camera) {
-    const PinholeFrame frame = pinhole_frame(camera, float(m->width) / float(m->height));
     // The camera is data in a buffer: moving it re-uploads 48 bytes, it recompiles nothing.
-    m->camera->upload(std::vector<fog::CameraFrame>{{camera.eye, frame.U, frame.V, frame.W}});
+    m->camera->upload(std::vector<sample_common::PinholeCamera>{
+        pinhole_camera(camera, float(m->width) / float(m->height))});
     m->ctx.launch(0, m->width, m->height);
     return m->ctx.last_launch();
 }

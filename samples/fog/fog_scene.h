@@ -7,7 +7,7 @@
 #include <string>
 
 #include "lucent/context.h"
-#include "samples/sample.h"
+#include "samples/options.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
@@ -29,8 +29,8 @@ struct FogOptions {
     float eye_distance = 20.0f;  // the orbit's radius, in x and z
 };
 
-/// Reads FogOptions from a sample's --set values (the fog SampleInfo's options).
-FogOptions read_fog_options(const RenderSettings& settings, const SampleInfo& info);
+/// FogOptions from the fog sample's checked option values.
+FogOptions read_fog_options(const OptionValues& values);
 
 class FogScene {
   public:

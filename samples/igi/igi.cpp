@@ -1,32 +1,28 @@
 // Host setup of the IGI sample: the scene as triangles with per-triangle materials, its
 // lights as point emitters, a second graph of per-triangle boxes for imperfect visibility,
-// and the passes of seed Fig. 3 as entry points launched in order each frame.
-#include "samples/igi/igi.h"
-
+// and the passes of seed Fig. 3 as entry points launched in order each frame. `lucent view`
+// runs the same frame, the camera in a buffer.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
+#include "samples/camera_session.h"
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
 #include "samples/scene_setup.h"
 #include "samples/settings_error.h"
+#include "samples/stages.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
 /// The scene's lights as IGI's point emitters: point lights as they are; each area light as
 /// a side x side grid of cosine lobes at its cells' centres, sharing its power L A pi.
-std::vector<igi::PointLight> point_emitters(const scene::Scene& input, int side) {
-    std::vector<igi::PointLight> lights;
+std::vector<igi::PointEmitter> point_emitters(const scene::Scene& input, int side) {
+    std::vector<igi::PointEmitter> lights;
     for (const auto& l : input.point_lights)
         lights.push_back({l.position, l.intensity, make_float3(0.0f)});
     for (const auto& a : input.area_lights) {
@@ -61,73 +57,67 @@ std::shared_ptr<Buffer> triangle_boxes(Context& ctx, const scene::Mesh& mesh) {
     return buffer;
 }
 
-IgiConfig read_config(const RenderSettings& settings, const SampleInfo& info) {
-    IgiConfig c;
-    c.paths = unsigned(get_int_option(settings, info, "vpls", 1, 65536));
-    c.bounces = unsigned(get_int_option(settings, info, "bounces", 1, 8));
-    c.downsample = unsigned(get_int_option(settings, info, "downsample", 1, 16));
-    c.interleave = unsigned(get_int_option(settings, info, "interleave", 1, 8));
-    c.layers = get_int_option(settings, info, "reflection_layer", 0, 1) ? 2u : 1u;
-    c.width = settings.width;
-    c.height = settings.height;
-    const int slices = get_int_option(settings, info, "vpl_slices", 0, 64);
-    c.slices = slices > 0 ? unsigned(slices) : auto_indirect_slices(c);
-    return c;
-}
+/// The sample's --set options, checked: the frame's configuration and the variables.
+struct IgiOptions {
+    IgiConfig config;
+    float min_d_fraction, depth_threshold, normal_threshold, sigma;
+    int max_depth, imperfect, area_side;
 
-RenderResult render_igi(const RenderSettings& settings) {
-    const SampleInfo& info = igi_sample_info();
-    check_options(settings, info);
-    const IgiConfig config = read_config(settings, info);
-    const float min_d_fraction = get_float_option(settings, info, "min_d", 0.0f, 10.0f);
-    const int max_depth = get_int_option(settings, info, "max_depth", 1, 16);
-    const int imperfect = get_int_option(settings, info, "imperfect_visibility", 0, 1);
-    const float depth_threshold = get_float_option(settings, info, "depth_threshold", 0.0f, 10.0f);
-    const float normal_threshold =
-        get_float_option(settings, info, "normal_threshold", -1.0f, 1.0f);
-    const float sigma = get_float_option(settings, info, "sigma", 0.1f, 16.0f);
-    const int area_side = get_int_option(settings, info, "area_samples", 1, 64);
-    const Clock::time_point setup_start = Clock::now();
-    const scene::Scene input =
-        scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
-    const std::vector<igi::PointLight> lights = point_emitters(input, area_side);
-    if (lights.empty())
-        throw SettingsError("igi: scene '" + input.name +
-                            "' has no lights; IGI traces its particles from point and area "
-                            "lights (try --scene cornell, or add a light to a JSON scene)");
+    IgiOptions(const OptionValues& v, const RenderSettings& settings)
+        : min_d_fraction(v.number("min_d")),
+          depth_threshold(v.number("depth_threshold")),
+          normal_threshold(v.number("normal_threshold")),
+          sigma(v.number("sigma")),
+          max_depth(v.integer("max_depth")),
+          imperfect(v.on("imperfect_visibility")),
+          area_side(v.integer("area_samples")) {
+        config.paths = unsigned(v.integer("vpls"));
+        config.bounces = unsigned(v.integer("bounces"));
+        config.downsample = unsigned(v.integer("downsample"));
+        config.interleave = unsigned(v.integer("interleave"));
+        config.layers = v.on("reflection_layer") ? 2u : 1u;
+        config.width = settings.width;
+        config.height = settings.height;
+        const int slices = v.integer("vpl_slices");
+        config.slices = slices > 0 ? unsigned(slices) : auto_indirect_slices(config);
+    }
+};
 
-    RenderResult out;
-    Context ctx(settings.context_options());
-    out.backend = ctx.backend_name();
-    out.backend_notice = ctx.backend_notice();
-    ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance");
+/// The visibility-only ray types, the recursion depth and the context-wide variables. The
+/// radiance and particle ray types follow with the graph they trace (add_graphs).
+void set_up_context(Context& ctx, const IgiOptions& o, float extent) {
     ctx.set_ray_type<igi::ShadowPayload>(igi::kShadowRay, "shadow", /*expects_closest_hit=*/false);
-    ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle");
     ctx.set_ray_type<igi::ShadowPayload>(igi::kVplShadowRay, "vpl shadow",
                                          /*expects_closest_hit=*/false);
-    ctx.set_max_recursion_depth(unsigned(max_depth) + 1);
-
-    const float extent = scene_extent(input);
+    ctx.set_max_recursion_depth(unsigned(o.max_depth) + 1);
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
-    ctx["min_d"] = min_d_fraction * extent;
-    ctx["max_depth"] = unsigned(max_depth);
-    ctx["bounces"] = config.bounces;
-    ctx["downsample"] = config.downsample;
-    ctx["interleave"] = config.interleave;
-    ctx["reflection_layer"] = config.layers > 1 ? 1u : 0u;
-    ctx["slices"] = config.slices;
-    ctx["depth_threshold"] = depth_threshold;
-    ctx["normal_threshold"] = normal_threshold;
-    ctx["sigma"] = sigma;
+    ctx["min_d"] = o.min_d_fraction * extent;
+    ctx["max_depth"] = unsigned(o.max_depth);
+    ctx["bounces"] = o.config.bounces;
+    ctx["downsample"] = o.config.downsample;
+    ctx["interleave"] = o.config.interleave;
+    ctx["reflection_layer"] = o.config.layers > 1 ? 1u : 0u;
+    ctx["slices"] = o.config.slices;
+    ctx["depth_threshold"] = o.depth_threshold;
+    ctx["normal_threshold"] = o.normal_threshold;
+    ctx["sigma"] = o.sigma;
+    ctx["imperfect_visibility"] = unsigned(o.imperfect);
+}
 
+/// The point emitters and the VPL buffer their particles fill.
+void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, const IgiConfig& config) {
     auto light_buffer =
-        ctx.create_buffer<igi::PointLight>(BufferType::kInput, unsigned(lights.size()));
+        ctx.create_buffer<igi::PointEmitter>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
-    auto vpls =
+    ctx["vpls"] =
         ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
-    ctx["vpls"] = vpls;
+}
 
+/// The scene's triangles ("top_object", traced by radiance and particle rays) and, for
+/// imperfect visibility (seed §4.1), a second graph of one box per triangle as custom
+/// primitives ("vpl_shadow_object", traced only by VPL shadow rays).
+void add_graphs(Context& ctx, const scene::Scene& input) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
     std::vector<std::shared_ptr<Material>> materials;
@@ -141,9 +131,7 @@ RenderResult render_igi(const RenderSettings& settings) {
         (*material)["Ke"] = m.emission;
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(igi::igi_attributes));
-    // Imperfect visibility (seed §4.1): a second graph, one box per triangle as custom
-    // primitives, traced only by VPL shadow rays.
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal));
     auto boxes = ctx.create_geometry_group();
     auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_bounds));
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_intersect));
@@ -163,21 +151,16 @@ RenderResult render_igi(const RenderSettings& settings) {
     auto top = mesh_group(ctx, input, attributes, materials, add_boxes);
     ctx["top_object"] = top;
     ctx["vpl_shadow_object"] = boxes;
-    ctx["imperfect_visibility"] = unsigned(imperfect);
     // Radiance and particle rays trace the scene; the boxes need none of their programs.
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
+}
 
-    // The images of seed Fig. 3: full resolution G-buffer and direct image, the indirect
-    // irradiance at 1/N resolution, merged, and upsampled.
-    const IgiImages images = create_igi_images(ctx, config);
-    const PinholeFrame frame =
-        pinhole_frame(input.camera, float(settings.width) / float(settings.height));
+/// The passes of seed Fig. 3 as entry points, each reading and writing its images.
+void add_passes(Context& ctx, const IgiConfig& config, const IgiImages& images,
+                const CameraBuffer& camera_buffer) {
     auto camera = ctx.create_program(LUCENT_PROGRAM(igi::igi_camera));
-    (*camera)["eye"] = input.camera.eye;
-    (*camera)["W"] = frame.W;
-    (*camera)["U"] = frame.U;
-    (*camera)["V"] = frame.V;
+    (*camera)["camera"] = camera_buffer.buffer();
     auto indirect = ctx.create_program(LUCENT_PROGRAM(igi::igi_indirect));
     (*indirect)["indirect"] = config.slices > 1 ? images.indirect_slices : images.indirect;
     auto indirect_sum = ctx.create_program(LUCENT_PROGRAM(igi::igi_indirect_sum));
@@ -202,67 +185,146 @@ RenderResult render_igi(const RenderSettings& settings) {
     ctx.set_ray_generation_program(igi::kComposeEntry, compose);
     ctx.set_ray_generation_program(igi::kIndirectSumEntry, indirect_sum);
     ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi::igi_miss)));
-    out.stages.push_back({"scene setup", ms_since(setup_start),
-                          input.name + ", " + std::to_string(input.triangle_count()) +
-                              " triangles, " + std::to_string(lights.size()) + " point emitters"});
-
-    render_igi_frames(ctx, config, settings, out);
-    out.image = image_from_output(*images.output);
-    if (settings.keep_layers) {
-        out.layers["direct"] = image_from_output(*images.direct);
-        out.layers["albedo"] = image_from_output(*images.gbuffer_albedo);
-        out.layers["normal"] = image_from_output(*images.gbuffer_normal);
-        out.layers["position"] = image_from_output(*images.gbuffer_position);
-        out.layers["indirect"] = image_from_output(*images.irradiance_at_full_resolution(config));
-        out.layers["indirect_low"] = image_from_output(*images.indirect);
-        if (config.layers > 1) {  // the first reflected hits (the reflection layer)
-            out.layers["reflected_weight"] = image_from_output(*images.gbuffer_albedo, 1);
-            out.layers["reflected_indirect"] =
-                image_from_output(*images.irradiance_at_full_resolution(config), 1);
-        }
-    }
-    return out;
 }
+
+/// The intermediate images, for tests (RenderSettings::keep_layers).
+void keep_layers(const IgiConfig& config, const IgiImages& images, RenderResult& out) {
+    out.layers["direct"] = image_from_output(*images.direct);
+    out.layers["albedo"] = image_from_output(*images.gbuffer_albedo);
+    out.layers["normal"] = image_from_output(*images.gbuffer_normal);
+    out.layers["position"] = image_from_output(*images.gbuffer_position);
+    out.layers["indirect"] = image_from_output(*images.irradiance_at_full_resolution(config));
+    out.layers["indirect_low"] = image_from_output(*images.indirect);
+    if (config.layers > 1) {  // the first reflected hits (the reflection layer)
+        out.layers["reflected_weight"] = image_from_output(*images.gbuffer_albedo, 1);
+        out.layers["reflected_indirect"] =
+            image_from_output(*images.irradiance_at_full_resolution(config), 1);
+    }
+}
+
+/// What a render and a session build: the scene of settings.scene (default: cornell) in
+/// `ctx` with its point emitters, the images of seed Fig. 3 (full resolution G-buffer and
+/// direct image, the indirect irradiance at 1/N resolution, merged, and upsampled) and the
+/// passes, the camera reading `camera`.
+struct IgiScene {
+    scene::Scene input;
+    std::vector<igi::PointEmitter> lights;
+    IgiImages images;
+
+    IgiScene(Context& ctx, const RenderSettings& settings, const IgiOptions& options,
+             const CameraBuffer& camera)
+        : input(scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene)),
+          lights(point_emitters(input, options.area_side)) {
+        if (lights.empty())
+            throw SettingsError("igi: scene '" + input.name +
+                                "' has no lights; IGI traces its particles from point and area "
+                                "lights (try --scene cornell, or add a light to a JSON scene)");
+        set_up_context(ctx, options, scene_extent(input));
+        add_lights(ctx, lights, options.config);
+        add_graphs(ctx, input);
+        images = create_igi_images(ctx, options.config);
+        add_passes(ctx, options.config, images, camera);
+    }
+};
+
+/// `lucent view`: the scene built once, its frame (the passes of Fig. 3) launched again when
+/// the camera moves. The options are variables baked at build time or size its buffers, so
+/// an option rebuilds the scene.
+class IgiSession final : public CameraSession {
+  public:
+    IgiSession(const Sample& sample, const RenderSettings& settings, const IgiOptions& options)
+        : CameraSession(sample, settings),
+          m_config(options.config),
+          m_scene(context(), settings, options, camera()) {
+        start_at(m_scene.input.camera, pinhole_camera(m_scene.input.camera, settings.aspect()));
+    }
+
+    FrameResult frame() override {
+        RenderSettings once = settings();
+        once.repeat = 1;
+        once.progress = nullptr;
+        RenderResult passes;
+        render_igi_frames(context(), m_config, once, passes);
+        return frame_of(std::move(passes), *m_scene.images.output);
+    }
+
+  private:
+    IgiConfig m_config;
+    IgiScene m_scene;
+};
+
+class IgiSample final : public Sample {
+  public:
+    IgiSample()
+        : Sample(
+              "igi",
+              "Instant Global Illumination (Marques and Santos, seed §4): VPLs from the lights "
+              "along Halton paths, direct light, specular reflections, Eq. (1), and the paper's "
+              "three accelerations",
+              {
+                  SampleOption::integer("vpls", 180, 1, 65536, "light paths traced from the lights"),
+                  SampleOption::integer("bounces", 1, 1, 8,
+                                        "VPLs per path: diffuse bounces recorded"),
+                  SampleOption::number(
+                      "min_d", 0.1f, 0.0f, 10.0f,
+                      "Eq. (1)'s bounding distance, as a fraction of the scene's size"),
+                  SampleOption::integer("max_depth", 4, 1, 16,
+                                        "deepest specular reflection tree"),
+                  SampleOption::toggle("imperfect_visibility", false,
+                                       "1: VPL shadow rays against the triangles' bounding boxes "
+                                       "(seed §4.1), 0: exact"),
+                  SampleOption::integer(
+                      "downsample", 1, 1, 16,
+                      "N: indirect light at 1/N of the resolution, joint bilateral upsampling"),
+                  SampleOption::integer("interleave", 1, 1, 8,
+                                        "M: VPLs split into M x M subsets over M x M pixel "
+                                        "tiles, merged by the discontinuity buffer"),
+                  SampleOption::integer("vpl_slices", 0, 0, 64,
+                                        "threads sharing a pixel's VPLs in the indirect pass; 0: "
+                                        "as many as give about 2^20 work items"),
+                  SampleOption::toggle(
+                      "reflection_layer", true,
+                      "1: the first reflected hit's indirect light is a G-buffer layer of its own, "
+                      "downsampled and interleaved like the primary hit's; 0: inline, as in the "
+                      "paper"),
+                  SampleOption::number(
+                      "depth_threshold", 0.1f, 0.0f, 10.0f,
+                      "discontinuity buffer: largest relative depth difference of neighbours"),
+                  SampleOption::number(
+                      "normal_threshold", 0.9f, -1.0f, 1.0f,
+                      "discontinuity buffer: smallest cosine between neighbours' normals"),
+                  SampleOption::number(
+                      "sigma", 1.0f, 0.1f, 16.0f,
+                      "upsampling: spatial Gaussian's sigma in low-resolution pixels"),
+                  SampleOption::integer("area_samples", 4, 1, 64,
+                                        "each area light becomes a side x side grid of point "
+                                        "emitters; the side"),
+              }) {}
+
+    RenderResult render(const RenderSettings& settings) const override {
+        const IgiOptions options(read_options(settings), settings);
+        const Clock::time_point setup_start = Clock::now();
+        Context ctx(settings.context_options());
+        RenderResult out = result_for(ctx);
+        CameraBuffer camera(ctx);
+        const IgiScene scene(ctx, settings, options, camera);
+        camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
+        out.stages.push_back({"scene setup", ms_since(setup_start),
+                              scene.input.name + ", " +
+                                  std::to_string(scene.input.triangle_count()) + " triangles, " +
+                                  std::to_string(scene.lights.size()) + " point emitters"});
+        render_igi_frames(ctx, options.config, settings, out);
+        out.image = image_from_output(*scene.images.output);
+        if (settings.keep_layers) keep_layers(options.config, scene.images, out);
+        return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        return std::make_unique<IgiSession>(*this, settings, IgiOptions(read_options(settings), settings));
+    }
+};
+
+const RegisterSample<IgiSample> kRegistered(/*help_order=*/30);
 
 }  // namespace
-
-const SampleInfo& igi_sample_info() {
-    static const SampleInfo info{
-        "igi",
-        "Instant Global Illumination (Marques and Santos, seed §4): VPLs from the lights along "
-        "Halton paths, direct light, specular reflections, Eq. (1), and the paper's three "
-        "accelerations",
-        {
-            {"vpls", "180", "light paths traced from the lights (1..65536)"},
-            {"bounces", "1", "VPLs per path: diffuse bounces recorded (1..8)"},
-            {"min_d", "0.1",
-             "Eq. (1)'s bounding distance, as a fraction of the scene's size (0..10)"},
-            {"max_depth", "4", "deepest specular reflection tree (1..16)"},
-            {"imperfect_visibility", "0",
-             "1: VPL shadow rays against the triangles' bounding boxes (seed §4.1), 0: exact"},
-            {"downsample", "1",
-             "N: indirect light at 1/N of the resolution, joint bilateral upsampling (1..16)"},
-            {"interleave", "1",
-             "M: VPLs split into M x M subsets over M x M pixel tiles, merged by the "
-             "discontinuity buffer (1..8)"},
-            {"vpl_slices", "0",
-             "threads sharing a pixel's VPLs in the indirect pass; 0: as many as give "
-             "about 2^20 work items (0..64)"},
-            {"reflection_layer", "1",
-             "1: the first reflected hit's indirect light is a G-buffer layer of its own, "
-             "downsampled and interleaved like the primary hit's; 0: inline, as in the paper"},
-            {"depth_threshold", "0.1",
-             "discontinuity buffer: largest relative depth difference of neighbours (0..10)"},
-            {"normal_threshold", "0.9",
-             "discontinuity buffer: smallest cosine between neighbours' normals (-1..1)"},
-            {"sigma", "1",
-             "upsampling: spatial Gaussian's sigma in low-resolution pixels (0.1..16)"},
-            {"area_samples", "4",
-             "each area light becomes a side x side grid of point emitters; the side (1..64)"},
-        },
-        render_igi,
-    };
-    return info;
-}
-
 }  // namespace lucent::samples

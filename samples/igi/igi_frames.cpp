@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "samples/igi/igi_programs.h"
+#include "samples/stages.h"
 
 namespace lucent::samples {
 

@@ -15,6 +15,7 @@
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/common_programs.h"
 
 namespace igi {
 
@@ -38,24 +39,24 @@ enum : unsigned {
 /// A light the particles start from and the direct stage samples. Isotropic when `normal`
 /// is zero; otherwise a cosine lobe around `normal` (a piece of an area light), whose
 /// intensity along the normal is `intensity`.
-struct PointLight {
+struct PointEmitter {
     float3 position;
     float3 intensity;
     float3 normal;
 };
 
-LUCENT_HD inline bool is_oriented(const PointLight& light) {
+LUCENT_HD inline bool is_oriented(const PointEmitter& light) {
     return dot(light.normal, light.normal) > 0.0f;
 }
 
 /// Radiant intensity of `light` towards the unit direction `w` (from the light).
-LUCENT_HD inline float3 intensity_towards(const PointLight& light, float3 w) {
+LUCENT_HD inline float3 intensity_towards(const PointEmitter& light, float3 w) {
     if (!is_oriented(light)) return light.intensity;
     return light.intensity * lc_max(0.0f, dot(light.normal, w));
 }
 
 /// Total flux: 4 pi I for an isotropic light, pi I for a cosine lobe.
-LUCENT_HD inline float3 flux(const PointLight& light) {
+LUCENT_HD inline float3 flux(const PointEmitter& light) {
     return light.intensity * (is_oriented(light) ? 3.14159265f : 4.0f * 3.14159265f);
 }
 
@@ -67,9 +68,8 @@ struct Vpl {
     float3 radiance;
 };
 
-struct HitAttributes {
-    float3 geometric_normal;  // object space, not normalised
-};
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal).
+using HitAttributes = sample_common::MeshNormal;
 
 /// One layer of the G-buffer of Fig. 3 at a hit: position, normal, the weight of its
 /// irradiance in the pixel (rho for the primary hit, Ks rho for a reflected one) and the
@@ -117,14 +117,7 @@ LUCENT_HD inline float smoothing(float a, float b, float d) {
     return t * t;
 }
 
-LUCENT_HD inline float3 cosine_direction(float3 n, float u1, float u2) {
-    const float r = sqrtf(u1), phi = 6.2831853f * u2;
-    const float3 t =
-        normalize(cross(n, fabsf(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
-    const float3 b = cross(n, t);
-    return normalize(t * (r * cosf(phi)) + b * (r * sinf(phi)) +
-                     n * sqrtf(lc_max(0.0f, 1.0f - u1)));
-}
+using sample_common::cosine_direction;
 
 /// Fractional part, for Cranley-Patterson rotations of a Halton point.
 LUCENT_HD inline float wrap01(float x) {
@@ -133,7 +126,7 @@ LUCENT_HD inline float wrap01(float x) {
 
 // ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
-    lucent::BufferView<const PointLight> lights;
+    lucent::BufferView<const PointEmitter> lights;
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
     unsigned bounces;
     float scene_epsilon;
@@ -146,12 +139,12 @@ LUCENT_RECORD(GenerateRecord, lights, vpls, bounces, scene_epsilon, top_object)
 /// height x layers: layer 0 the primary hits, layer 1 (with the reflection layer) the first
 /// reflected hits.
 struct CameraRecord {
-    float3 eye, U, V, W;
+    lucent::BufferView<sample_common::PinholeCamera> camera;  // one element
     lucent::BufferView<float4> direct;  // direct + specular (+ inline indirect below the tree)
     lucent::BufferView<float4> gbuffer_position, gbuffer_normal, gbuffer_albedo;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, direct, gbuffer_position, gbuffer_normal, gbuffer_albedo,
+LUCENT_RECORD(CameraRecord, camera, direct, gbuffer_position, gbuffer_normal, gbuffer_albedo,
               top_object)
 
 /// What Eq. (1) needs wherever it is evaluated: the VPLs and how to test their visibility.
@@ -166,7 +159,7 @@ struct IndirectParams {
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
-    lucent::BufferView<const PointLight> lights;
+    lucent::BufferView<const PointEmitter> lights;
     lucent::BufferView<const Vpl> vpls;
     float min_d;
     unsigned max_depth;
@@ -236,12 +229,6 @@ struct ParticleRecord {
     float3 Kd;
 };
 LUCENT_RECORD(ParticleRecord, Kd)
-
-struct MeshRecord {
-    lucent::BufferView<const float3> positions;
-    lucent::BufferView<const uint3> triangles;
-};
-LUCENT_RECORD(MeshRecord, positions, triangles)
 
 /// The crude geometry of imperfect visibility: each triangle's box, lo and hi, two float4
 /// per triangle (made on the host), so a test reads one box rather than an index and three
@@ -318,7 +305,7 @@ LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
     // Paths go round the lights; each light walks its own Halton sequence (index i), rotated
     // per light (Cranley-Patterson) so that lights of one area light do not share directions.
     const unsigned count = rec.lights.count(), light_index = path % count;
-    const igi::PointLight light = rec.lights[light_index];
+    const igi::PointEmitter light = rec.lights[light_index];
     const unsigned i = path / count + 1;
     const float r2 = igi::halton(light_index + 1, 5), r3 = igi::halton(light_index + 1, 7);
     const float u1 = igi::wrap01(igi::halton(i, 2) + r2), u2 = igi::wrap01(igi::halton(i, 3) + r3);
@@ -363,12 +350,12 @@ LUCENT_CLOSEST_HIT(igi_particle_hit, igi::ParticleRecord, igi::ParticlePayload,
 // ---- the direct stage: direct light, the specular tree, the G-buffer -----------------------
 LUCENT_RAY_GENERATION(igi_camera, igi::CameraRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
-    const float sx = 2.0f * (p.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (p.y + 0.5f) / n.y;
+    const sample_common::PinholeCamera c = rec.camera[0u];
     igi::RadiancePayload prd{};
     prd.surfel.distance = -1.0f;
     prd.reflected.distance = -1.0f;
     lucent::trace(rec.top_object,
-                  lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
+                  lucent::make_ray(c.eye, sample_common::pixel_centre_direction(c, p, n),
                                    igi::kRadianceRay, 0.0f),
                   prd);
     rec.direct[make_uint2(p.x, p.y)] = make_float4(prd.color, 1.0f);
@@ -392,7 +379,7 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
     const float3 albedo = rec.Kd * (1.0f / 3.14159265f);
     if (max_component(rec.Kd) > 0.0f) {
         for (unsigned l = 0; l < rec.lights.count(); ++l) {
-            const igi::PointLight light = rec.lights[l];
+            const igi::PointEmitter light = rec.lights[l];
             const float3 to = light.position - x;
             const float d2 = dot(to, to), d = sqrtf(d2), c = dot(n, to) / d;
             if (c <= 0.0f) continue;
@@ -433,12 +420,6 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
 
 LUCENT_MISS(igi_miss, lucent::NoRecord, igi::RadiancePayload) {
     prd.color = make_float3(0.0f);
-}
-
-LUCENT_ATTRIBUTE(igi_attributes, igi::MeshRecord, igi::HitAttributes) {
-    const uint3 t = rec.triangles[prim];
-    attr.geometric_normal =
-        cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
 }
 
 // ---- the indirect stage: Eq. (1) at the primary hits (seed §4.2, §4.3) --------------------

@@ -1,26 +1,23 @@
 // Host setup of the path tracer: the scene's triangles with one Material per scene material
 // (its closest hit chosen by MaterialKind), the area and point lights in buffers, and the
-// progressive loop: one launch per sample per pixel into the accumulation buffer.
-#include "samples/pathtracer/pathtracer.h"
-
+// progressive loop: one launch per sample per pixel into the accumulation buffer. `lucent
+// view` runs the same camera program, one sample per pixel per frame, accumulated while the
+// camera rests.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <vector>
 
+#include "samples/camera_session.h"
 #include "samples/pathtracer/pathtracer_programs.h"
-#include "samples/pathtracer/pathtracer_scene.h"
 #include "samples/scene_setup.h"
+#include "samples/stages.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 /// True when an emitting triangle of the scene lies on the light's parallelogram: the light
 /// is then geometry that BSDF-sampled rays can hit, as MIS needs.
@@ -61,33 +58,45 @@ void add_light_geometry(scene::Scene& s, float tolerance) {
     }
 }
 
-}  // namespace
+/// The sample's --set options, checked.
+struct PathOptions {
+    int max_depth = 8, rr_depth = 3, nee = 1;
+    float environment = 0, exposure = 1;
+    int reinhard = 0, seed = 0;
 
-PathOptions read_path_options(const RenderSettings& settings) {
-    const SampleInfo& info = pathtracer_sample_info();
-    check_options(settings, info);
-    PathOptions o;
-    o.max_depth = get_int_option(settings, info, "max_depth", 1, 256);
-    o.rr_depth = get_int_option(settings, info, "rr_depth", 1, 256);
-    o.nee = get_int_option(settings, info, "nee", 0, 1);
-    o.environment = get_float_option(settings, info, "environment", 0.0f, 1e6f);
-    o.exposure = get_float_option(settings, info, "exposure", 0.0f, 1e6f);
-    o.reinhard = get_int_option(settings, info, "reinhard", 0, 1);
-    o.seed = get_int_option(settings, info, "seed", 0, 1 << 30);
-    return o;
-}
+    explicit PathOptions(const OptionValues& v)
+        : max_depth(v.integer("max_depth")),
+          rr_depth(v.integer("rr_depth")),
+          nee(v.on("nee")),
+          environment(v.number("environment")),
+          exposure(v.number("exposure")),
+          reinhard(v.on("reinhard")),
+          seed(v.integer("seed")) {}
+};
 
-void set_path_camera_options(Program& camera, const PathOptions& o) {
+/// Sets the options that are variables: of the camera program and of the miss program.
+void set_variables(Program& camera, Program& miss, const PathOptions& o) {
     camera["max_depth"] = unsigned(o.max_depth);
     camera["rr_depth"] = unsigned(o.rr_depth);
     camera["nee"] = unsigned(o.nee);
     camera["seed"] = unsigned(o.seed);
     camera["exposure"] = o.exposure;
     camera["reinhard"] = unsigned(o.reinhard);
+    miss["environment"] = make_float3(o.environment);
 }
 
-PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
-                           const PathOptions& options) {
+/// What build() made that the render loop and the session need.
+struct PathScene {
+    scene::Camera camera;                   // the scene's own camera
+    std::shared_ptr<Buffer> accum, output;  // width x height float4
+    std::shared_ptr<Program> camera_program, miss;
+    std::string note;                       // "cornell, 32 triangles"
+};
+
+/// Builds the scene of settings.scene (default: cornell) into `ctx`, the camera program at
+/// entry 0 reading `camera`.
+PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions& options,
+                const CameraBuffer& camera) {
     scene::Scene input = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
     const float extent = scene_extent(input);
     const float epsilon = std::max(1e-4f, 1e-4f * extent);
@@ -98,7 +107,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
                                                 /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(2);  // the path loop's rays, then shadow rays from hits
 
-    bind_lights<pathtracer::PointLight, pathtracer::AreaLight>(ctx, input);
+    bind_lights(ctx, input);
     ctx["scene_epsilon"] = epsilon;
 
     std::shared_ptr<Program> closest_hits[] = {
@@ -120,7 +129,7 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
         (*material)["ior"] = m.ior;
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_attributes));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
     PathScene out;
@@ -129,37 +138,20 @@ PathScene build_path_scene(Context& ctx, const RenderSettings& settings,
         ctx.create_buffer<float4>(BufferType::kInputOutput, settings.width, settings.height);
     out.output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
     out.miss = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_miss));
-    (*out.miss)["environment"] = make_float3(options.environment);
     ctx.set_miss_program(pathtracer::kRadianceRay, out.miss);
+    out.camera_program = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_camera));
+    (*out.camera_program)["camera"] = camera.buffer();
+    (*out.camera_program)["accum"] = out.accum;
+    (*out.camera_program)["output"] = out.output;
+    set_variables(*out.camera_program, *out.miss, options);
+    ctx.set_ray_generation_program(0, out.camera_program);
     out.note = input.name + ", " + std::to_string(input.triangle_count()) + " triangles";
     return out;
 }
 
-namespace {
-
-RenderResult render_pathtracer(const RenderSettings& settings) {
-    const PathOptions options = read_path_options(settings);
+/// Launches settings.spp frames (default 64) into the accumulation buffer and times them.
+void render_frames(Context& ctx, const RenderSettings& settings, RenderResult& out) {
     const unsigned spp = settings.spp ? settings.spp : 64;
-    const Clock::time_point setup_start = Clock::now();
-    RenderResult out;
-    Context ctx(settings.context_options());
-    out.backend = ctx.backend_name();
-    out.backend_notice = ctx.backend_notice();
-    const PathScene scene = build_path_scene(ctx, settings, options);
-
-    const PinholeFrame frame =
-        pinhole_frame(scene.camera, float(settings.width) / float(settings.height));
-    auto camera = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_camera));
-    (*camera)["eye"] = scene.camera.eye;
-    (*camera)["W"] = frame.W;
-    (*camera)["U"] = frame.U;
-    (*camera)["V"] = frame.V;
-    (*camera)["accum"] = scene.accum;
-    (*camera)["output"] = scene.output;
-    set_path_camera_options(*camera, options);
-    ctx.set_ray_generation_program(0, camera);
-    out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
-    auto& output = scene.output;
 
     // Progressive accumulation: the frame number lives in the accumulation buffer (its w),
     // so launches change nothing on the host and the compiled scene (and on the GPU the
@@ -191,31 +183,90 @@ RenderResult render_pathtracer(const RenderSettings& settings) {
                   spp, 1000.0 / median,
                   double(settings.width) * settings.height / (median * 1000.0));
     out.stages.push_back({"render", render_ms, note});
-    out.image = image_from_output(*output);
-    return out;
 }
+
+/// `lucent view`: progressive. Each frame adds one sample per pixel to the accumulation
+/// buffer, whose w counts them; moving the camera or an option clears it.
+class PathSession final : public CameraSession {
+  public:
+    PathSession(const Sample& sample, const RenderSettings& settings, const PathOptions& options)
+        : CameraSession(sample, settings) {
+        m_scene = build(context(), settings, options, camera());
+        set_output(m_scene.output);
+        start_at(m_scene.camera, pinhole_camera(m_scene.camera, settings.aspect()));
+        reset();
+    }
+
+    bool progressive() const override { return true; }
+
+    void reset() override {
+        // The sample count is the accumulation's w: zero restarts the average (and the
+        // random streams, so a resting camera converges to the sample's own render).
+        const size_t pixels = size_t(settings().width) * settings().height;
+        m_scene.accum->upload(std::vector<float4>(pixels, make_float4(0.0f, 0.0f, 0.0f, 0.0f)));
+        m_samples = 0;
+    }
+
+    FrameResult frame() override {
+        FrameResult out = CameraSession::frame();
+        out.samples = ++m_samples;
+        return out;
+    }
+
+  private:
+    bool apply_options(const OptionValues& values) override {
+        set_variables(*m_scene.camera_program, *m_scene.miss, PathOptions(values));
+        return true;
+    }
+
+    PathScene m_scene;
+    unsigned m_samples = 0;
+};
+
+class PathtracerSample final : public Sample {
+  public:
+    PathtracerSample()
+        : Sample("pathtracer",
+                 "Progressive path tracer (seed CACM §6.2): the bounce loop in ray generation, "
+                 "Lambert, GGX metal, glass and coated materials, next-event estimation with "
+                 "MIS, Russian roulette; --spp frames averaged (default 64); try --scene "
+                 "cornell-materials",
+                 {
+                     SampleOption::integer("max_depth", 8, 1, 256, "path segments from the eye"),
+                     SampleOption::integer("rr_depth", 3, 1, 256,
+                                           "bounces before Russian roulette starts"),
+                     SampleOption::toggle("nee", true,
+                                          "1: light sampling with MIS, 0: BSDF sampling only"),
+                     SampleOption::number("environment", 0.0f, 0.0f, 1e6f,
+                                          "uniform radiance of every ray that escapes"),
+                     SampleOption::number("exposure", 1.0f, 0.0f, 1e6f, "multiplies the image"),
+                     SampleOption::toggle(
+                         "reinhard", false,
+                         "1: Reinhard tone mapping L / (1 + L) after the exposure"),
+                     SampleOption::integer("seed", 0, 0, 1 << 30,
+                                           "selects an independent set of random streams"),
+                 }) {}
+
+    RenderResult render(const RenderSettings& settings) const override {
+        const PathOptions options(read_options(settings));
+        const Clock::time_point setup_start = Clock::now();
+        Context ctx(settings.context_options());
+        RenderResult out = result_for(ctx);
+        CameraBuffer camera(ctx);
+        const PathScene scene = build(ctx, settings, options, camera);
+        camera.set(pinhole_camera(scene.camera, settings.aspect()));
+        out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
+        render_frames(ctx, settings, out);
+        out.image = image_from_output(*scene.output);
+        return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        return std::make_unique<PathSession>(*this, settings, PathOptions(read_options(settings)));
+    }
+};
+
+const RegisterSample<PathtracerSample> kRegistered(/*help_order=*/50);
 
 }  // namespace
-
-const SampleInfo& pathtracer_sample_info() {
-    static const SampleInfo info{
-        "pathtracer",
-        "Progressive path tracer (seed CACM §6.2): the bounce loop in ray generation, Lambert, "
-        "GGX metal, glass and coated materials, next-event estimation with MIS, Russian "
-        "roulette; --spp frames averaged (default 64); try --scene cornell-materials",
-        {
-            {"max_depth", "8", "path segments from the eye (1..256)"},
-            {"rr_depth", "3", "bounces before Russian roulette starts (1..256)"},
-            {"nee", "1", "1: light sampling with MIS, 0: BSDF sampling only"},
-            {"environment", "0", "uniform radiance of every ray that escapes (0..1e6)"},
-            {"exposure", "1", "multiplies the image (0..1e6)"},
-            {"reinhard", "0", "1: Reinhard tone mapping L / (1 + L) after the exposure"},
-            {"seed", "0", "selects an independent set of random streams (0..2^30)"},
-        },
-        render_pathtracer,
-        open_pathtracer_session,
-    };
-    return info;
-}
-
 }  // namespace lucent::samples

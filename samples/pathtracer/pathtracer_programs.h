@@ -7,6 +7,7 @@
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/common_programs.h"
 #include "samples/pathtracer/pathtracer_bsdf.h"
 
 namespace pathtracer {
@@ -16,16 +17,8 @@ LUCENT_MODULE(pathtracer, lucent::kUsesOccluded)
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1 };
 
-struct PointLight {
-    float3 position;
-    float3 intensity;
-};
-/// An emitting parallelogram corner + s edge1 + t edge2 (s, t in [0, 1]); it emits on the
-/// side cross(edge1, edge2) points to (scene::AreaLight).
-struct AreaLight {
-    float3 corner, edge1, edge2;
-    float3 emission;
-};
+using sample_common::AreaLight;
+using sample_common::PointLight;
 
 /// What a bounce hands back to the ray-generation loop.
 struct PathPayload {
@@ -44,9 +37,8 @@ struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occlu
     float visible;
 };
 
-struct HitAttributes {
-    float3 geometric_normal;  // object space, not normalised; faces outwards by winding
-};
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal).
+using HitAttributes = sample_common::MeshNormal;
 
 /// PCG-RXS-M-XS 32 (O'Neill 2014) as a stream: advances the state, returns [0, 1).
 LUCENT_HD inline float next_random(unsigned& state) {
@@ -94,7 +86,7 @@ LUCENT_HD inline float area_light_pdf(lucent::BufferView<AreaLight> lights, floa
 }
 
 struct CameraRecord {
-    float3 eye, U, V, W;                // W: to the image centre; U, V: half its extent
+    lucent::BufferView<sample_common::PinholeCamera> camera;  // one element
     lucent::BufferView<float4> accum;   // running sums; w counts the samples (the frame)
     lucent::BufferView<float4> output;  // the average, exposed and tone mapped
     lucent::Handle top_object;
@@ -105,7 +97,7 @@ struct CameraRecord {
     float exposure;
     unsigned reinhard;  // 1: L / (1 + L) per channel after the exposure
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, accum, output, top_object, max_depth, rr_depth, nee, seed,
+LUCENT_RECORD(CameraRecord, camera, accum, output, top_object, max_depth, rr_depth, nee, seed,
               exposure, reinhard)
 
 struct SurfaceRecord {
@@ -123,12 +115,6 @@ struct MissRecord {
     float3 environment;  // uniform radiance from every direction
 };
 LUCENT_RECORD(MissRecord, environment)
-
-struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
-};
-LUCENT_RECORD(MeshRecord, positions, triangles)
 
 /// Nothing between `from` and `distance` along `direction`: an occlusion query (every
 /// surface opaque, no programs run).
@@ -219,8 +205,7 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
 
 // ---- the path loop (CACM Figure 8) -----------------------------------------------------------
 /// One more sample of the pixel at the launch index into rec.accum, and the mean into
-/// rec.output. Shared by the sample's camera and the viewer's, which differ only in where the
-/// frame is.
+/// rec.output.
 LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
     const uint2 pixel = make_uint2(i.x, i.y);
@@ -229,7 +214,8 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     // A uniformly jittered position in the pixel: the box filter's antialiasing.
     const float sx = 2.0f * (float(i.x) + next_random(rng)) / float(n.x) - 1.0f;
     const float sy = 1.0f - 2.0f * (float(i.y) + next_random(rng)) / float(n.y);
-    float3 origin = rec.eye, direction = normalize(rec.W + sx * rec.U + sy * rec.V);
+    const sample_common::PinholeCamera camera = rec.camera[0u];
+    float3 origin = camera.eye, direction = sample_common::camera_direction(camera, sx, sy);
     float3 radiance = make_float3(0.0f), throughput = make_float3(1.0f);
     float previous_pdf = 0.0f;
     bool previous_delta = true;  // the camera's ray is found by no other strategy
@@ -275,47 +261,8 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     rec.output[pixel] = make_float4(mean, 1.0f);
 }
 
-/// The viewer's camera frame: data in a 1-element buffer, so moving the camera re-uploads
-/// 48 bytes instead of changing variables (which recompiles the scene).
-struct ViewFrame {
-    float3 eye, U, V, W;
-};
-
-struct ViewCameraRecord {
-    lucent::BufferView<ViewFrame> camera;
-    lucent::BufferView<float4> accum;
-    lucent::BufferView<float4> output;
-    lucent::Handle top_object;
-    unsigned max_depth, rr_depth, nee, seed;
-    float exposure;
-    unsigned reinhard;
-};
-LUCENT_RECORD(ViewCameraRecord, camera, accum, output, top_object, max_depth, rr_depth, nee, seed,
-              exposure, reinhard)
-
-
 LUCENT_RAY_GENERATION(pt_camera, pathtracer::CameraRecord) {
     pathtracer::trace_pixel(rec);
-}
-
-/// `lucent view`'s camera: pt_camera with the frame read from a buffer.
-LUCENT_RAY_GENERATION(pt_view_camera, pathtracer::ViewCameraRecord) {
-    const pathtracer::ViewFrame c = rec.camera[0u];
-    pathtracer::CameraRecord frame;
-    frame.eye = c.eye;
-    frame.U = c.U;
-    frame.V = c.V;
-    frame.W = c.W;
-    frame.accum = rec.accum;
-    frame.output = rec.output;
-    frame.top_object = rec.top_object;
-    frame.max_depth = rec.max_depth;
-    frame.rr_depth = rec.rr_depth;
-    frame.nee = rec.nee;
-    frame.seed = rec.seed;
-    frame.exposure = rec.exposure;
-    frame.reinhard = rec.reinhard;
-    pathtracer::trace_pixel(frame);
 }
 
 LUCENT_MISS(pt_miss, pathtracer::MissRecord, pathtracer::PathPayload) {
@@ -339,12 +286,6 @@ LUCENT_CLOSEST_HIT(pt_dielectric, pathtracer::SurfaceRecord, pathtracer::PathPay
 LUCENT_CLOSEST_HIT(pt_coated, pathtracer::SurfaceRecord, pathtracer::PathPayload,
                    pathtracer::HitAttributes) {
     pathtracer::shade<pathtracer::kCoated>(rec, prd, attr);
-}
-
-LUCENT_ATTRIBUTE(pt_attributes, pathtracer::MeshRecord, pathtracer::HitAttributes) {
-    const uint3 t = rec.triangles[prim];
-    attr.geometric_normal =
-        cross(rec.positions[t.y] - rec.positions[t.x], rec.positions[t.z] - rec.positions[t.x]);
 }
 
 }  // namespace pathtracer

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/common_programs.h"
 
 namespace radiosity {
 
@@ -15,10 +16,7 @@ LUCENT_MODULE(radiosity, lucent::kUsesOccluded)
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kPhotonRay = 2 };
 enum : unsigned { kPhotonEntry = 0, kGBufferEntry = 1, kShadeEntry = 2, kEntryCount = 3 };
 
-struct AreaLight {
-    float3 corner, edge1, edge2;  // emits towards cross(edge1, edge2)
-    float3 emission;              // radiance
-};
+using sample_common::AreaLight;  // emission: radiance
 
 /// A virtual point light. Unmerged: a diffuse emitter, intensity power / pi x cos around
 /// `normal`. Merged (VplGrid): at a cell's centre with the power-weighted mean normal, or
@@ -35,10 +33,8 @@ LUCENT_HD inline float3 vpl_intensity(const Vpl& vpl, float3 w) {
     return vpl.power * (lc_max(0.0f, dot(vpl.normal, w)) / 3.14159265f);
 }
 
-struct HitAttributes {
-    float3 geometric_normal;  // object space, not normalised
-    float2 uv;
-};
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal_uv).
+using HitAttributes = sample_common::MeshNormalUv;
 
 struct SurfacePayload {  // radiance and photon rays: what was hit
     float3 position, normal, albedo, emission;
@@ -55,21 +51,7 @@ LUCENT_HD inline float2 random2(unsigned stream, unsigned index) {
     return make_float2(lucent::tea_unit_float(r.x), lucent::tea_unit_float(r.y));
 }
 
-LUCENT_HD inline float3 cosine_direction(float3 n, float u1, float u2) {
-    const float r = sqrtf(u1), phi = 6.2831853f * u2;
-    const float3 t =
-        normalize(cross(n, fabsf(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
-    const float3 b = cross(n, t);
-    return normalize(t * (r * cosf(phi)) + b * (r * sinf(phi)) +
-                     n * sqrtf(lc_max(0.0f, 1.0f - u1)));
-}
-
-struct MeshRecord {
-    lucent::BufferView<float3> positions;
-    lucent::BufferView<uint3> triangles;
-    lucent::BufferView<float2> uvs;  // per vertex; empty when the mesh has none
-};
-LUCENT_RECORD(MeshRecord, positions, triangles, uvs)
+using sample_common::cosine_direction;
 
 struct SurfaceRecord {
     float3 Kd, Ke;
@@ -90,18 +72,18 @@ LUCENT_RECORD(PhotonRecord, area_lights, vpls, bounces, roulette, vpl_offset, sc
               top_object)
 
 struct GBufferRecord {
-    float3 eye, U, V, W;
+    lucent::BufferView<sample_common::PinholeCamera> camera;  // one element
     lucent::BufferView<float4> gbuffer_position;  // xyz, w = distance (< 0: background)
     lucent::BufferView<float4> gbuffer_normal;
     lucent::BufferView<float4> gbuffer_albedo;
     lucent::BufferView<float4> gbuffer_emission;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(GBufferRecord, eye, U, V, W, gbuffer_position, gbuffer_normal, gbuffer_albedo,
+LUCENT_RECORD(GBufferRecord, camera, gbuffer_position, gbuffer_normal, gbuffer_albedo,
               gbuffer_emission, top_object)
 
 struct ShadeRecord {
-    float3 eye;
+    lucent::BufferView<sample_common::PinholeCamera> camera;  // the G-buffer's
     lucent::BufferView<float4> gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission;
     lucent::BufferView<float4> output;
     lucent::BufferView<AreaLight> area_lights;
@@ -115,7 +97,7 @@ struct ShadeRecord {
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(ShadeRecord, eye, gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission,
+LUCENT_RECORD(ShadeRecord, camera, gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission,
               output, area_lights, area_samples, vpls, gi, vpl_shadows, show_vpls, clamp_distance,
               dot_radius, scene_epsilon, top_object)
 
@@ -223,11 +205,11 @@ LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
 // ---- the G-buffer: what each pixel sees ----------------------------------------------------
 LUCENT_RAY_GENERATION(radiosity_gbuffer, radiosity::GBufferRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
-    const float sx = 2.0f * (p.x + 0.5f) / n.x - 1.0f, sy = 1.0f - 2.0f * (p.y + 0.5f) / n.y;
+    const sample_common::PinholeCamera c = rec.camera[0u];
     radiosity::SurfacePayload hit{};
     hit.distance = -1.0f;
     lucent::trace(rec.top_object,
-                  lucent::make_ray(rec.eye, normalize(rec.W + sx * rec.U + sy * rec.V),
+                  lucent::make_ray(c.eye, sample_common::pixel_centre_direction(c, p, n),
                                    radiosity::kRadianceRay, 0.0f),
                   hit);
     const uint2 pixel = make_uint2(p.x, p.y);
@@ -252,17 +234,6 @@ LUCENT_CLOSEST_HIT(radiosity_surface, radiosity::SurfaceRecord, radiosity::Surfa
     prd.distance = lucent::t_hit();
 }
 
-LUCENT_ATTRIBUTE(radiosity_attributes, radiosity::MeshRecord, radiosity::HitAttributes) {
-    const uint3 t = rec.triangles[prim];
-    const float3 p0 = rec.positions[t.x], p1 = rec.positions[t.y], p2 = rec.positions[t.z];
-    attr.geometric_normal = cross(p1 - p0, p2 - p0);
-    attr.uv = make_float2(0.0f, 0.0f);
-    if (rec.uvs.count() > 0) {
-        const float w = 1.0f - barycentrics.x - barycentrics.y;
-        attr.uv = w * rec.uvs[t.x] + barycentrics.x * rec.uvs[t.y] + barycentrics.y * rec.uvs[t.z];
-    }
-}
-
 // ---- deferred shading: direct light plus every VPL -----------------------------------------
 LUCENT_RAY_GENERATION(radiosity_shade, radiosity::ShadeRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
@@ -280,13 +251,14 @@ LUCENT_RAY_GENERATION(radiosity_shade, radiosity::ShadeRecord) {
     if (rec.show_vpls && position.w >= 0.0f) {
         // A VPL in front of what the pixel sees, within the dot's angular radius of its ray:
         // drawn in its own colour at full brightness.
-        const float3 ray = radiosity::xyz(position) - rec.eye;
+        const float3 eye = rec.camera[0u].eye;
+        const float3 ray = radiosity::xyz(position) - eye;
         const float seen = length(ray), cos_radius = cosf(rec.dot_radius);
         for (unsigned k = 0; k < rec.vpls.count(); ++k) {
             const radiosity::Vpl vpl = rec.vpls[k];
             const float peak = max_component(vpl.power);
             if (peak <= 0.0f) continue;
-            const float3 to = vpl.position - rec.eye;
+            const float3 to = vpl.position - eye;
             const float d = length(to);
             if (d < seen && dot(to / d, ray / seen) > cos_radius) color = vpl.power / peak;
         }

@@ -3,44 +3,49 @@
 // glass sphere, three materials, point lights, and two ray types (radiance, shadow).
 #include "samples/whitted/whitted.h"
 
-#include "samples/scene_setup.h"
-
-#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <vector>
 
 #include "lucent.h"
+#include "samples/camera_session.h"
+#include "samples/scene_setup.h"
 #include "samples/settings_error.h"
+#include "samples/stages.h"
 #include "samples/whitted/whitted_programs.h"
-#include "samples/whitted/whitted_scene.h"
 
 namespace lucent::samples {
 namespace {
 
 constexpr const char* kSceneName = "whitted";
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-/// The pinhole frame of the camera programs: W from the eye to the image centre, U and V
-/// from the centre to the right and top edges.
-struct CameraFrame {
-    float3 U, V, W;
-};
-
-CameraFrame camera_frame(const WhittedLayout& layout, float aspect) {
+/// The sample's own pinhole camera: W from the eye to the look-at point (not of unit length),
+/// U and V from the image centre to its right and top edges.
+sample_common::PinholeCamera camera_frame(const WhittedLayout& layout, float aspect) {
     float3 W = layout.lookat - layout.eye;
     float distance = length(W);
     float3 U = normalize(cross(W, layout.up));
     float3 V = normalize(cross(U, W));
     float half_height =
         distance * std::tan(0.5f * layout.vfov_degrees * std::numbers::pi_v<float> / 180.0f);
-    return {U * (half_height * aspect), V * half_height, W};
+    return {layout.eye, U * (half_height * aspect), V * half_height, W};
 }
+
+/// The sample's --set options, checked.
+struct WhittedOptions {
+    int antialiasing = 0;
+    float aa_threshold = 0.1f;
+    int max_depth = 6;
+    int shadows = 1;
+    int lights = 1;
+
+    explicit WhittedOptions(const OptionValues& v)
+        : antialiasing(v.on("aa")),
+          aa_threshold(v.number("aa_threshold")),
+          max_depth(v.integer("max_depth")),
+          shadows(v.on("shadows")),
+          lights(v.integer("lights")) {}
+};
 
 /// Up to three white point lights; their colours share one unit of intensity so the
 /// exposure stays the same whatever the count.
@@ -58,39 +63,8 @@ std::vector<whitted::BasicLight> make_lights(const WhittedLayout& layout, int co
     return lights;
 }
 
-RenderResult render_whitted(const RenderSettings& settings) {
-    const WhittedOptions options = read_whitted_options(settings);
-    RenderResult out;
-    const Clock::time_point setup_start = Clock::now();
-
-    Context ctx(settings.context_options());
-    out.backend = ctx.backend_name();
-    out.backend_notice = ctx.backend_notice();
-    auto output = build_whitted_scene(ctx, options, settings.width, settings.height);
-
-    const WhittedLayout& layout = whitted_layout();
-    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_camera));
-    const CameraFrame frame = camera_frame(layout, float(settings.width) / float(settings.height));
-    (*camera)["eye"] = layout.eye;
-    (*camera)["U"] = frame.U;
-    (*camera)["V"] = frame.V;
-    (*camera)["W"] = frame.W;
-    (*camera)["antialiasing"] = options.antialiasing;
-    (*camera)["aa_threshold"] = options.aa_threshold;
-    ctx.set_ray_generation_program(0, camera);
-    out.stages.push_back({"scene setup", ms_since(setup_start)});
-
-    timed_launch(ctx, 0, settings, out);
-
-    out.image = image_from_output(*output);
-    return out;
-}
-
-}  // namespace
-
-WhittedOptions read_whitted_options(const RenderSettings& settings) {
-    const SampleInfo& info = whitted_sample_info();
-    check_options(settings, info);
+/// The scene's size and name checked; SettingsError on bad input.
+void check_scene(const RenderSettings& settings) {
     if (!settings.scene.empty() && settings.scene != kSceneName)
         throw SettingsError("--scene " + settings.scene +
                             ": the whitted sample has one built-in scene; accepted names are "
@@ -98,35 +72,41 @@ WhittedOptions read_whitted_options(const RenderSettings& settings) {
     if (settings.width == 0 || settings.height == 0)
         throw SettingsError("whitted: image size " + std::to_string(settings.width) + "x" +
                             std::to_string(settings.height) + " is empty; give --size WxH");
-    WhittedOptions o;
-    o.antialiasing = get_int_option(settings, info, "aa", 0, 1);
-    o.aa_threshold = get_float_option(settings, info, "aa_threshold", 0.0f, 1.0f);
-    o.max_depth = get_int_option(settings, info, "max_depth", 1, 31);
-    o.shadows = get_int_option(settings, info, "shadows", 0, 1);
-    o.lights = get_int_option(settings, info, "lights", 1, 3);
-    return o;
 }
 
-std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& options,
-                                            unsigned width, unsigned height) {
+/// The options that are variables: changed in place by the session.
+void set_variables(Context& ctx, Program& camera, const WhittedOptions& options) {
+    camera["antialiasing"] = options.antialiasing;
+    camera["aa_threshold"] = options.aa_threshold;
+    // Radiance rays nest max_depth deep below the camera's; each may cast shadow rays.
+    ctx.set_max_recursion_depth(unsigned(options.max_depth) + 2);
+    ctx["max_depth"] = options.max_depth;
+    ctx["shadows"] = options.shadows;
+}
+
+/// Ray types, exceptions, the output buffer (context variable output_buffer) of width x
+/// height, and the camera (reading `camera_buffer`, entry 0), exception and miss programs.
+std::shared_ptr<Buffer> create_programs(Context& ctx, const WhittedOptions& options,
+                                        unsigned width, unsigned height,
+                                        const CameraBuffer& camera_buffer) {
     const WhittedLayout& layout = whitted_layout();
-    const int max_depth = options.max_depth;
     ctx.set_ray_type<whitted::RadiancePayload>(whitted::kRadianceRay, "radiance");
     // Shadow rays need only any-hit (attenuate or stop) and no miss program: a ray that
     // reaches the light returns the attenuation the glass left it.
     ctx.set_ray_type<whitted::ShadowPayload>(whitted::kShadowRay, "shadow",
                                              /*expects_closest_hit=*/false);
-    // Radiance rays nest max_depth deep below the camera's; each may cast shadow rays.
-    ctx.set_max_recursion_depth(unsigned(max_depth) + 2);
     ctx.set_exception_enabled(kExceptionStackOverflow, true);
     ctx.set_exception_enabled(kExceptionBufferIndexOutOfBounds, true);
 
-    // ---- output, exception and miss programs (the caller adds the camera) --------------
     auto output = ctx.create_buffer<float4>(BufferType::kOutput, width, height);
     output->set_name("output_buffer");
     ctx["output_buffer"] = output;
 
     ctx.set_entry_point_count(1);
+    auto camera = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_camera));
+    (*camera)["camera"] = camera_buffer.buffer();
+    ctx.set_ray_generation_program(0, camera);
+    set_variables(ctx, *camera, options);
     auto exception = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_exception));
     (*exception)["bad_color"] = make_float3(1.0f, 0.0f, 1.0f);
     ctx.set_exception_program(0, exception);
@@ -134,8 +114,15 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     auto miss = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_miss));
     (*miss)["bg_color"] = layout.background;
     ctx.set_miss_program(whitted::kRadianceRay, miss);
+    return output;
+}
 
-    // ---- geometry: three primitive types, each with its own programs (§6.1) ------------
+/// The three primitive types, each with its own programs (§6.1).
+struct Shapes {
+    std::shared_ptr<Geometry> floor, metal_sphere, glass_sphere;
+};
+
+Shapes create_shapes(Context& ctx, const WhittedLayout& layout) {
     auto floor = ctx.create_geometry();
     floor->set_name("floor");
     floor->set_primitive_count(1);
@@ -172,8 +159,15 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     (*glass_sphere)["center"] = layout.glass_center;
     (*glass_sphere)["radius_outer"] = layout.glass_radius;
     (*glass_sphere)["radius_inner"] = layout.glass_radius - layout.glass_thickness;
+    return {floor, metal_sphere, glass_sphere};
+}
 
-    // ---- materials ------------------------------------------------------------------------
+struct Materials {
+    std::shared_ptr<Material> floor, metal, glass;
+};
+
+/// The checker floor, the metal and the glass, with their shadow programs.
+Materials create_materials(Context& ctx, const WhittedLayout& layout) {
     auto opaque_shadow = ctx.create_program(LUCENT_PROGRAM(whitted::whitted_opaque_shadow));
 
     // Checker floor: the colours of Whitted's red and yellow checkers, 1 x 1 unit squares,
@@ -233,32 +227,45 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
         make_float3(std::log(0.83f), std::log(0.83f), std::log(0.83f));
     (*glass_material)["cutoff_color"] = make_float3(0.034f, 0.055f, 0.085f);
     (*glass_material)["importance_cutoff"] = 0.01f;
+    return {floor_material, metal_material, glass_material};
+}
 
-    // ---- instances, one GeometryGroup ------------------------------------------------
+/// One instance per shape with its material, in one GeometryGroup.
+std::shared_ptr<GeometryGroup> scene_group(Context& ctx, const WhittedLayout& layout,
+                                           const Shapes& shapes, const Materials& materials) {
     auto floor_instance = ctx.create_geometry_instance();
     floor_instance->set_name("floor");
-    floor_instance->set_geometry(floor);
-    floor_instance->add_material(floor_material);
+    floor_instance->set_geometry(shapes.floor);
+    floor_instance->add_material(materials.floor);
 
     auto metal_instance = ctx.create_geometry_instance();
     metal_instance->set_name("metal sphere");
-    metal_instance->set_geometry(metal_sphere);
-    metal_instance->add_material(metal_material);
+    metal_instance->set_geometry(shapes.metal_sphere);
+    metal_instance->add_material(materials.metal);
     // On the instance: intersection programs see GeometryInstance scope before Geometry's.
     (*metal_instance)["sphere"] = make_float4(layout.metal_center, layout.metal_radius);
 
     auto glass_instance = ctx.create_geometry_instance();
     glass_instance->set_name("glass sphere");
-    glass_instance->set_geometry(glass_sphere);
-    glass_instance->add_material(glass_material);
+    glass_instance->set_geometry(shapes.glass_sphere);
+    glass_instance->add_material(materials.glass);
 
     auto group = ctx.create_geometry_group();
     group->set_name("whitted scene");
     group->add_child(floor_instance);
     group->add_child(metal_instance);
     group->add_child(glass_instance);
+    return group;
+}
 
-    // ---- context-wide variables ---------------------------------------------------------
+/// Builds the whole scene into `ctx`, the camera program reading `camera` at entry 0; returns
+/// the float4 output buffer (context variable output_buffer) of width x height.
+std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options, unsigned width,
+                                    unsigned height, const CameraBuffer& camera_buffer) {
+    const WhittedLayout& layout = whitted_layout();
+    auto output = create_programs(ctx, options, width, height, camera_buffer);
+    const Shapes shapes = create_shapes(ctx, layout);
+    auto group = scene_group(ctx, layout, shapes, create_materials(ctx, layout));
     const std::vector<whitted::BasicLight> lights = make_lights(layout, options.lights);
     auto light_buffer =
         ctx.create_buffer<whitted::BasicLight>(BufferType::kInput, unsigned(lights.size()));
@@ -269,10 +276,87 @@ std::shared_ptr<Buffer> build_whitted_scene(Context& ctx, const WhittedOptions& 
     ctx["top_shadower"] = group;
     ctx["ambient_light_color"] = make_float3(layout.ambient);
     ctx["scene_epsilon"] = 1e-3f;
-    ctx["max_depth"] = max_depth;
-    ctx["shadows"] = options.shadows;
     return output;
 }
+
+/// `lucent view`: the scene built once; the options that are variables change in place (a
+/// recompile, no rebuild); the number of lights (a buffer's size) rebuilds it.
+class WhittedSession final : public CameraSession {
+  public:
+    WhittedSession(const Sample& sample, const RenderSettings& settings,
+                   const WhittedOptions& options)
+        : CameraSession(sample, settings), m_lights(options.lights) {
+        set_output(build_scene(context(), options, settings.width, settings.height, camera()));
+        m_camera = context().ray_generation_program(0);
+        const WhittedLayout& layout = whitted_layout();
+        scene::Camera start;
+        start.eye = layout.eye;
+        start.look = layout.lookat;
+        start.up = layout.up;
+        start.fov_degrees = layout.vfov_degrees;
+        start_at(start, camera_frame(layout, settings.aspect()));
+    }
+
+  private:
+    bool apply_options(const OptionValues& values) override {
+        const WhittedOptions o(values);
+        if (o.lights != m_lights) return false;
+        set_variables(context(), *m_camera, o);
+        return true;
+    }
+
+    int m_lights;
+    std::shared_ptr<Program> m_camera;
+};
+
+class WhittedSample final : public Sample {
+  public:
+    WhittedSample()
+        : Sample(kSceneName,
+                 "Whitted's sphere scene (OptiX paper §6.1, Fig. 7): checkered floor, metal and "
+                 "glass-shell spheres, shadow rays, optional adaptive antialiasing",
+                 {
+                     SampleOption::toggle(
+                         "aa", false,
+                         "adaptive antialiasing: 0 = 1 ray per pixel, 1 = 4 rays, 16 where they "
+                         "differ"),
+                     SampleOption::number(
+                         "aa_threshold", 0.1f, 0.0f, 1.0f,
+                         "largest per-channel difference among the 4 rays before 16 are traced"),
+                     SampleOption::integer("max_depth", 6, 1, 31,
+                                           "deepest reflection/refraction ray tree"),
+                     SampleOption::toggle(
+                         "shadows", true,
+                         "shadow rays: 0 = off, 1 = on (glass casts a lighter shadow)"),
+                     SampleOption::integer("lights", 1, 1, 3,
+                                           "number of point lights, sharing one intensity"),
+                 }) {}
+
+    RenderResult render(const RenderSettings& settings) const override {
+        const WhittedOptions options(read_options(settings));
+        check_scene(settings);
+        const Clock::time_point setup_start = Clock::now();
+        Context ctx(settings.context_options());
+        RenderResult out = result_for(ctx);
+        CameraBuffer camera(ctx);
+        camera.set(camera_frame(whitted_layout(), settings.aspect()));
+        auto output = build_scene(ctx, options, settings.width, settings.height, camera);
+        out.stages.push_back({"scene setup", ms_since(setup_start)});
+        timed_launch(ctx, 0, settings, out);
+        out.image = image_from_output(*output);
+        return out;
+    }
+
+    std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
+        const WhittedOptions options(read_options(settings));
+        check_scene(settings);
+        return std::make_unique<WhittedSession>(*this, settings, options);
+    }
+};
+
+const RegisterSample<WhittedSample> kRegistered(/*help_order=*/10);
+
+}  // namespace
 
 const WhittedLayout& whitted_layout() {
     static const WhittedLayout layout = [] {
@@ -302,33 +386,13 @@ const WhittedLayout& whitted_layout() {
 
 float2 whitted_project(float3 p, unsigned width, unsigned height) {
     const WhittedLayout& layout = whitted_layout();
-    const CameraFrame frame = camera_frame(layout, float(width) / float(height));
+    const sample_common::PinholeCamera frame = camera_frame(layout, float(width) / float(height));
     // U, V, W are orthogonal: the coordinates of p - eye in that frame, then divide by depth.
     const float3 q = p - layout.eye;
     const float depth = dot(q, frame.W) / dot(frame.W, frame.W);
     const float sx = dot(q, frame.U) / dot(frame.U, frame.U) / depth;
     const float sy = dot(q, frame.V) / dot(frame.V, frame.V) / depth;
     return make_float2(0.5f * (sx + 1.0f) * float(width), 0.5f * (1.0f - sy) * float(height));
-}
-
-const SampleInfo& whitted_sample_info() {
-    static const SampleInfo info{
-        kSceneName,
-        "Whitted's sphere scene (OptiX paper §6.1, Fig. 7): checkered floor, metal and "
-        "glass-shell spheres, shadow rays, optional adaptive antialiasing",
-        {
-            {"aa", "0",
-             "adaptive antialiasing: 0 = 1 ray per pixel, 1 = 4 rays, 16 where they differ"},
-            {"aa_threshold", "0.1",
-             "largest per-channel difference among the 4 rays before 16 are traced (0..1)"},
-            {"max_depth", "6", "deepest reflection/refraction ray tree (1..31)"},
-            {"shadows", "1", "shadow rays: 0 = off, 1 = on (glass casts a lighter shadow)"},
-            {"lights", "1", "number of point lights, sharing one intensity (1..3)"},
-        },
-        &render_whitted,
-        &open_whitted_session,
-    };
-    return info;
 }
 
 }  // namespace lucent::samples

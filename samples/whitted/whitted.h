@@ -1,14 +1,12 @@
 // The Whitted sample (OptiX paper §6.1, Fig. 7): Whitted's sphere scene, ray traced with a
 // pinhole camera, Phong/metal/glass materials, shadow rays and optional adaptive
-// antialiasing. Programs in whitted_programs.h, host setup in whitted.cpp.
+// antialiasing. Programs in whitted_programs.h; the sample (WhittedSample, registered as
+// "whitted") in whitted.cpp. This header gives tests the scene's layout.
 #pragma once
 
-#include "samples/sample.h"
+#include "lucent/device/types.h"
 
 namespace lucent::samples {
-
-/// The sample's name, options and render function, for the registry.
-const SampleInfo& whitted_sample_info();
 
 /// Where things are in the Whitted scene (world units, y up), for tests that probe the image.
 struct WhittedLayout {

@@ -6,13 +6,15 @@
 // whose any-hit programs either stop the ray (opaque) or attenuate it (glass).
 //
 // Single source: compiled by g++ into the host (CPU backend) and by NVRTC for the GPU, so
-// it uses only lucent/device.h and the C math functions.
+// it uses only lucent/device.h, the C math functions and the samples' shared pinhole camera
+// (samples/common/camera.h).
 //
 // Everything lives in namespace `whitted`, the namespace of its module: the host names a
 // program as LUCENT_PROGRAM(whitted::whitted_camera).
 #pragma once
 
 #include "lucent/device.h"
+#include "samples/common/camera.h"
 
 namespace whitted {
 
@@ -65,13 +67,13 @@ struct HitAttributes {
 // ---- records (the programs' variables) ---------------------------------------
 
 struct CameraRecord {
-    float3 eye, U, V, W;  // pinhole frame: W to the image centre, U/V to its edges
+    BufferView<sample_common::PinholeCamera> camera;  // one element: W to the image centre
     BufferView<float4> output_buffer;
     Handle top_object;
     int antialiasing;    // 0: one ray per pixel; 1: adaptive 4 → 16 samples
     float aa_threshold;  // colour difference (max channel) that triggers supersampling
 };
-LUCENT_RECORD(CameraRecord, eye, U, V, W, output_buffer, top_object, antialiasing, aa_threshold)
+LUCENT_RECORD(CameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold)
 
 struct ExceptionRecord {
     BufferView<float4> output_buffer;
@@ -267,13 +269,14 @@ LUCENT_HD inline float3 facing_world_normal(const HitAttributes& attr) {
 }
 
 /// Colour seen along the camera ray through image-plane point (sx, sy) in [-1, 1]^2.
-LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, float sx, float sy) {
-    float3 direction = normalize(sx * rec.U + sy * rec.V + rec.W);
+LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, const sample_common::PinholeCamera& c,
+                                      float sx, float sy) {
+    float3 direction = normalize(sx * c.U + sy * c.V + c.W);
     RadiancePayload prd;
     prd.result = make_float3(0.0f);
     prd.importance = 1.0f;
     prd.depth = 0;
-    lucent::trace(rec.top_object, lucent::make_ray(rec.eye, direction, kRadianceRay, 0.0f), prd);
+    lucent::trace(rec.top_object, lucent::make_ray(c.eye, direction, kRadianceRay, 0.0f), prd);
     return prd.result;
 }
 
@@ -283,8 +286,8 @@ LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, float sx, float s
 /// whether the pixel is smooth; if any differs from their mean by more than aa_threshold, the
 /// other twelve cells of a 4x4 grid are traced too and all sixteen averaged (adaptive
 /// supersampling: only edges, shadow borders and checker borders pay for it).
-/// Shared by the sample's camera and the viewer's, which differ only in where the frame is.
 LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
+    const sample_common::PinholeCamera camera = rec.camera[0u];
     uint3 index = lucent::launch_index();
     uint3 size = lucent::launch_size();
     float inv_w = 1.0f / float(size.x), inv_h = 1.0f / float(size.y);
@@ -292,7 +295,7 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
     auto sample = [&](float fx, float fy) {
         float sx = 2.0f * (float(index.x) + fx) * inv_w - 1.0f;
         float sy = 1.0f - 2.0f * (float(index.y) + fy) * inv_h;
-        return whitted::camera_sample(rec, sx, sy);
+        return whitted::camera_sample(rec, camera, sx, sy);
     };
 
     float3 color;
@@ -326,39 +329,8 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
     rec.output_buffer[make_uint2(index.x, index.y)] = make_float4(color, 1.0f);
 }
 
-/// The viewer's camera frame: data in a 1-element buffer, so moving the camera re-uploads
-/// 48 bytes instead of changing variables (which recompiles the scene).
-struct ViewFrame {
-    float3 eye, U, V, W;
-};
-
-struct ViewCameraRecord {
-    BufferView<ViewFrame> camera;
-    BufferView<float4> output_buffer;
-    Handle top_object;
-    int antialiasing;
-    float aa_threshold;
-};
-LUCENT_RECORD(ViewCameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold)
-
-
 LUCENT_RAY_GENERATION(whitted_camera, whitted::CameraRecord) {
     whitted::render_pixel(rec);
-}
-
-/// `lucent view`'s camera: the same pixels as whitted_camera, the frame read from a buffer.
-LUCENT_RAY_GENERATION(whitted_view_camera, whitted::ViewCameraRecord) {
-    const whitted::ViewFrame c = rec.camera[0u];
-    whitted::CameraRecord frame;
-    frame.eye = c.eye;
-    frame.U = c.U;
-    frame.V = c.V;
-    frame.W = c.W;
-    frame.output_buffer = rec.output_buffer;
-    frame.top_object = rec.top_object;
-    frame.antialiasing = rec.antialiasing;
-    frame.aa_threshold = rec.aa_threshold;
-    whitted::render_pixel(frame);
 }
 
 /// Marks a pixel whose launch raised an exception with an unmistakable colour.
