@@ -35,6 +35,7 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     Transform,
     TriangleMesh,
     __version__,
+    cuda_built,
     modules,
     render,
     samples,

@@ -36,6 +36,11 @@ PYBIND11_MODULE(_lucent, m) {
               "(TriangleMesh), the engine's host API (Context and what it creates), and the "
               "samples (render).";
     m.attr("__version__") = lucent::version();
+#ifdef LUCENT_HAVE_CUDA
+    m.attr("cuda_built") = true;  // the CUDA backend (and jit_check_sm) is in this build
+#else
+    m.attr("cuda_built") = false;
+#endif
     bind_errors(m);
     bind_programs(m);
     bind_buffers(m);

@@ -85,7 +85,7 @@ RayQueryMesh::RayQueryMesh(const float* vertices, size_t vertex_count, const uin
     ctx.set_ray_generation_program(kAnyEntry, m_any);
 
     // The batch buffers start at one ray; the first query sizes them.
-    m_capacity = 1;
+    m_count = 1;
     m_origins = ctx.create_buffer<float3>(BufferType::kInput, 1);
     m_directions = ctx.create_buffer<float3>(BufferType::kInput, 1);
     m_tmin = ctx.create_buffer<float>(BufferType::kInput, 1);
@@ -127,9 +127,11 @@ void RayQueryMesh::update(const float* vertices, size_t vertex_count, bool rebui
 }
 
 void RayQueryMesh::load_rays(const RayArrays& rays) {
-    if (rays.count > m_capacity) {
-        m_capacity = rays.count;
-        const unsigned n = unsigned(m_capacity);
+    // Output buffers must have the launch's size: a batch of another size resizes them all
+    // (a recompile, no BVH work).
+    if (rays.count != m_count) {
+        m_count = rays.count;
+        const unsigned n = unsigned(m_count);
         for (Buffer* b : {m_origins.get(), m_directions.get(), m_t.get(), m_prim.get(), m_uv.get(),
                           m_normal.get(), m_blocked.get()})
             b->resize(n);
@@ -140,10 +142,9 @@ void RayQueryMesh::load_rays(const RayArrays& rays) {
     m_directions->unmap();
     for (auto [buffer, values, count] : {std::tuple{&m_tmin, rays.tmin, rays.tmin_count},
                                          std::tuple{&m_tmax, rays.tmax, rays.tmax_count}}) {
-        // One value for all rays, or one per ray: a per-ray buffer is never of size 1.
+        // One value for all rays (size 1), or one per ray: a batch of one ray is both.
         Buffer& b = **buffer;
-        if (count == 1 ? b.count() != 1 : b.count() < count || b.count() == 1)
-            b.resize(unsigned(count == 1 ? 1 : std::max(count, size_t(2))));
+        if (b.count() != count) b.resize(unsigned(count));
         std::memcpy(b.map<float>(), values, count * sizeof(float));
         b.unmap();
     }

@@ -69,7 +69,7 @@ class RayQueryMesh {
     LaunchReport last_launch() const;
 
   private:
-    /// Copies the rays into the input buffers, growing them when needed.
+    /// Copies the rays into the input buffers, sizing every batch buffer to the batch.
     void load_rays(const RayArrays& rays);
 
     mutable std::mutex m_mutex;
@@ -78,8 +78,8 @@ class RayQueryMesh {
     std::shared_ptr<Buffer> m_vertices;
     std::shared_ptr<Acceleration> m_accel;
     std::shared_ptr<Program> m_closest, m_any;
-    // Rays in, answers out: sized for the largest batch so far (a batch uses the front).
-    size_t m_capacity = 0;
+    // Rays in, answers out: sized for the last batch.
+    size_t m_count = 0;
     std::shared_ptr<Buffer> m_origins, m_directions, m_tmin, m_tmax;
     std::shared_ptr<Buffer> m_t, m_prim, m_uv, m_normal, m_blocked;
 };
