@@ -1,6 +1,8 @@
 // Variables from Python: `scope["name"] = value` on a Context, Program, Material,
 // GeometryInstance or Geometry, with the value's kind chosen from the Python value (a
-// record field then checks it, as in C++: int and unsigned convert when they fit).
+// record field then checks it, as in C++: int and unsigned convert when they fit). A
+// Python float is a float, an int an int (or unsigned beyond 2^31), a tuple or list of 2-4
+// numbers a float vector, a numpy array its dtype's vector (float32, int32, uint32).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -49,7 +51,18 @@ VariableValue integer_value(const VariableScope& scope, const std::string& name,
 VariableValue array_value(const VariableScope& scope, const std::string& name,
                           const py::handle& value) {
     py::module_ np = py::module_::import("numpy");
-    py::array a = np.attr("asarray")(value);
+    py::array a;
+    if (py::isinstance<py::tuple>(value) || py::isinstance<py::list>(value)) {
+        // A tuple or list is a float vector: (0, 0, 1) is a position or colour far more
+        // often than an int3, which a numpy int32 or uint32 array gives.
+        try {
+            a = np.attr("asarray")(value, "float32");
+        } catch (const py::error_already_set&) {
+            bad_value(scope, name, value, "a sequence that is not of numbers");
+        }
+    } else {
+        a = np.attr("asarray")(value);
+    }
     const char kind = a.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
         bad_value(scope, name, value, "a sequence of " + describe_array(a));
