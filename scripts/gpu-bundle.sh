@@ -33,6 +33,7 @@ cp "$build/lucent" "$out/bin/"
 prefix="$PWD/$build/prefix"
 cmake --install "$build" --prefix "$prefix" > /dev/null
 for dir in examples/*/; do
+  [ -f "$dir/CMakeLists.txt" ] || continue  # examples/python: scripts, run by gpu-check.sh python
   name=$(basename "$dir")
   cmake -S "$dir" -B "$build/examples/$name" -G Ninja -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_FLAGS="-mavx2 -mfma" > /dev/null
