@@ -58,6 +58,7 @@ class Reference:
 
     def __init__(self, vertices, indices, origins, directions, tmin=0.0, tmax=np.inf,
                  edge=2e-5, gap=2e-5):
+        self.triangle_count = len(indices)
         t, u, v = all_hits(vertices, indices, origins, directions)
         tmin = np.broadcast_to(np.asarray(tmin, np.float64), (len(origins),))[:, None]
         tmax = np.broadcast_to(np.asarray(tmax, np.float64), (len(origins),))[:, None]
