@@ -18,12 +18,13 @@ BackendKind backend_kind(const std::string& name, const char* what) {
 void bind_errors(py::module_& m) {
     // lucent::Error (a wrong call, a failed compile or launch) as lucent.Error, a
     // RuntimeError; its message names the object and the fix.
-    static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+    // Never freed: a static object's destructor would run after the interpreter is gone.
+    static auto* error = new py::exception<Error>(m, "Error", PyExc_RuntimeError);
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const Error& e) {
-            error(e.what());
+            PyErr_SetString(error->ptr(), e.what());
         }
     });
 }
