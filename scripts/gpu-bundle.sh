@@ -21,6 +21,8 @@ fi
 suites="programs device_api nodes variables exceptions validation occlusion whitted backend igi radiosity
         fog pathtracer multi_device gpu_bvh_builder display modules"
 targets="lucent_cli lucent_embed_module"
+python=0  # the Python module: its objects travel, and gpu-check.sh's `python` step links it there
+if grep -q '^LUCENT_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then python=1; targets="$targets lucent_python"; fi
 for t in $suites; do targets="$targets ${t}_test"; done
 cmake --build "$build" -j"$(nproc)" --target $targets
 rm -rf "$out"
@@ -31,6 +33,7 @@ cp "$build/lucent" "$out/bin/"
 prefix="$PWD/$build/prefix"
 cmake --install "$build" --prefix "$prefix" > /dev/null
 for dir in examples/*/; do
+  [ -f "$dir/CMakeLists.txt" ] || continue  # examples/python: scripts, run by gpu-check.sh python
   name=$(basename "$dir")
   cmake -S "$dir" -B "$build/examples/$name" -G Ninja -DCMAKE_BUILD_TYPE=Release \
         -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_FLAGS="-mavx2 -mfma" > /dev/null
@@ -38,6 +41,20 @@ for dir in examples/*/; do
   cp "$build/examples/$name/$name" "$out/bin/example-$name"
 done
 strip --strip-unneeded "$out"/bin/*  # symbols are not needed there, and the carry is 64 MiB
+if [ "$python" = 1 ]; then
+  # The GPU machine's Python is another version than the one built for here, so the
+  # extension is linked there (gpu-check.sh python) from the bindings' sources in the tree,
+  # these static libraries and objects, and the Debian libraries they load (not the C and
+  # C++ runtimes: that machine's own, newer ones serve).
+  mkdir -p "$out/python/lib" "$out/python/objects" "$out/python/so"
+  cp "$build"/liblucent.a "$build"/liblucent_scene.a "$build"/liblucent_samples.a "$out/python/lib/"
+  cp "$build"/CMakeFiles/lucent_sample_programs.dir/lucent_modules/*/*.o \
+     "$build"/python/CMakeFiles/lucent_python.dir/lucent_modules/*/*.o "$out/python/objects/"
+  for lib in $(ldd "$build"/python/lucent/_lucent*.so | awk '/=>/ {print $3}' |
+               grep -vE '/(libc|libm|libstdc\+\+|libgcc_s|libpthread|libdl|librt)\.so'); do
+    cp -L "$lib" "$out/python/so/"
+  done
+fi
 for lib in $(ldd "$out"/bin/* | awk '/=>/ {print $3}' | sort -u); do cp -L "$lib" "$out/lib/"; done
 cp -L /lib64/ld-linux-x86-64.so.2 "$out/lib/"
 scenes=../shared/scenes

@@ -3,7 +3,7 @@
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
 # with steps: render examples samples tests igi pathtracer fog tea sanitizer bench builder present sweep profile
-# hotspots multi (several GPUs: MULTI_SUITES picks the suites run through --devices)
+# hotspots multi python (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench).
 set -uo pipefail
 out=${OUT:-gpu-out}
@@ -267,6 +267,30 @@ builder)
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj --subdivide 2 --repeat 9
     echo "== bench build --backend cuda: dragon cut twice (1.6M triangles)"
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/dragon.obj --subdivide 2 --repeat 9
+    ;;
+python)
+    # The Python module linked for this machine's python3 (another version than the build
+    # machine's) from the tree's bindings and the bundle's objects; then its tests with
+    # backend "cuda", and TriangleMesh on the BENCH.md rays beside `bench rays --backend cuda`.
+    P=$B/python
+    pkg=/tmp/lucent-python/lucent
+    mkdir -p "$pkg"
+    cp python/lucent/*.py "$pkg/"
+    printf '#!/bin/sh\nexec %s %s "$@"\n' "$PWD/$R" "$PWD/$B/bin/lucent" > /tmp/lucent-cli
+    chmod +x /tmp/lucent-cli
+    ext=$(python3 -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
+    echo "== linking the Python module for $(python3 --version) ($ext)"
+    g++ -O2 -std=c++20 -shared -fPIC -fvisibility=hidden -DLUCENT_HAVE_CUDA=1 \
+        -Ipython/src -I. -Iinclude $(python3 -m pybind11 --includes) python/src/*.cpp \
+        $P/objects/*.o -Wl,--start-group $P/lib/*.a -Wl,--end-group -Wl,--exclude-libs,ALL \
+        $P/so/*.so* -ldl -lpthread -o "$pkg/_lucent$ext" 2>&1 | grep -v "warning: " | head -20
+    export LD_LIBRARY_PATH=$PWD/$P/so PYTHONPATH=/tmp/lucent-python LUCENT_CLI=/tmp/lucent-cli
+    export LUCENT_SCENES_DIR=/work/shared/scenes
+    echo "== the Python tests on the GPU (LUCENT_TEST_BACKEND=cuda)"
+    LUCENT_TEST_BACKEND=cuda python3 -m pytest -q -p no:cacheprovider python/tests 2>&1 | tail -25
+    echo "== TriangleMesh on the BENCH.md rays of sponza on the GPU, beside bench rays --backend cuda"
+    python3 examples/python/bench_rays.py --backend cuda --lucent /tmp/lucent-cli \
+        --scene /work/shared/scenes/sponza.obj --rounds 3
     ;;
 present)
     echo "== display frames on the GPU: bit for bit the host's encoding"

@@ -9,6 +9,7 @@ packages=(
   libfftw3-dev libopenexr-dev clang libclang-rt-14-dev
   libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   xvfb xauth
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 
 missing=()

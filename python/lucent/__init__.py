@@ -1,0 +1,43 @@
+"""Lucent, a programmable ray tracing engine, from Python.
+
+- Ray queries on numpy arrays: ``TriangleMesh(vertices, indices).intersect(origins,
+  directions)`` and ``.occluded(...)``, on the CPU or the GPU.
+- The engine's host API: ``Context`` and what it creates (buffers as numpy arrays, the node
+  graph, variables, programs of the modules compiled into this extension), and launches.
+- The samples: ``render("igi", scene="cornell", size=(512, 512), vpls=64)`` returns an
+  (H, W, 4) float32 image; ``samples()`` lists them with their options.
+
+docs/python.md in the repository is the tutorial.
+"""
+
+from ._lucent import (  # noqa: F401  (the extension is the whole API)
+    ALL_EXCEPTIONS,
+    Acceleration,
+    Buffer,
+    Context,
+    Error,
+    Geometry,
+    GeometryBase,
+    GeometryGroup,
+    GeometryInstance,
+    GeometryTriangles,
+    Group,
+    LaunchReport,
+    MappedBuffer,
+    Material,
+    ModuleInfo,
+    Node,
+    NodeWithChildren,
+    Program,
+    RayHits,
+    Selector,
+    TextureSampler,
+    Transform,
+    TriangleMesh,
+    __version__,
+    cuda_built,
+    modules,
+    render,
+    samples,
+    types,
+)

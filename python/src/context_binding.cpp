@@ -1,0 +1,201 @@
+// lucent.Context from Python: the backend, entry points and ray types, program modules,
+// object creation and launch (lucent/context.h), and the LaunchReport a launch leaves.
+// A launch runs without the GIL; a Context and what it creates are used from one Python
+// thread at a time, as in C++.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+
+#include "bindings.h"
+
+namespace lucent::python {
+
+namespace {
+
+/// The payload type of a ray type: a type name, or a Program whose payload it takes.
+const TypeInfo& payload_type(const py::handle& payload) {
+    if (py::isinstance<Program>(payload)) {
+        const Program& p = payload.cast<const Program&>();
+        if (!p.desc().payload)
+            throw py::value_error("set_ray_type: payload " + p.describe() +
+                                  " takes no payload; give a miss, closest-hit or any-hit "
+                                  "program, or the payload's type name");
+        return *p.desc().payload;
+    }
+    if (py::isinstance<py::str>(payload))
+        return type_by_name(payload.cast<std::string>(), "set_ray_type: payload");
+    throw py::type_error("set_ray_type: payload must be a type name or a Program; got " +
+                         py::repr(payload).cast<std::string>());
+}
+
+ContextOptions context_options(const std::string& backend, unsigned threads, int jit_check_sm,
+                               const py::object& devices) {
+    ContextOptions options;
+    options.backend = backend_kind(backend, "Context: backend");
+    options.threads = threads;
+    options.jit_check_sm = jit_check_sm;
+    if (!devices.is_none()) {
+        std::string list;
+        if (py::isinstance<py::str>(devices)) {
+            list = devices.cast<std::string>();
+        } else {
+            for (const py::handle& d : devices)
+                list += (list.empty() ? "" : ",") + py::str(d).cast<std::string>();
+        }
+        options.devices = parse_device_list(list);
+    }
+    return options;
+}
+
+}  // namespace
+
+void bind_context(py::module_& m) {
+    py::class_<LaunchReport>(m, "LaunchReport",
+                             "Exceptions and timings of a launch (milliseconds).")
+        .def_readonly("compile_ms", &LaunchReport::compile_ms)
+        .def_readonly("accel_ms", &LaunchReport::accel_ms)
+        .def_readonly("launch_ms", &LaunchReport::launch_ms)
+        .def_readonly("recompiled", &LaunchReport::recompiled)
+        .def_readonly("jit_ms", &LaunchReport::jit_ms)
+        .def_readonly("jit_cached", &LaunchReport::jit_cached)
+        .def_readonly("kernel_ms", &LaunchReport::kernel_ms)
+        .def_readonly("exchange_ms", &LaunchReport::exchange_ms)
+        .def_property_readonly("exception_count", &LaunchReport::exception_count)
+        .def_property_readonly("exceptions",
+                               [](const LaunchReport& r) {
+                                   py::dict d;
+                                   for (const auto& [code, e] : r.exceptions)
+                                       d[py::str(exception_name(code))] = py::make_tuple(
+                                           e.count, py::make_tuple(e.first_index.x,
+                                                                   e.first_index.y,
+                                                                   e.first_index.z));
+                                   return d;
+                               },
+                               "{name: (count, first launch index)}")
+        .def("summary", &LaunchReport::summary)
+        .def("__repr__", [](const LaunchReport& r) {
+            return "<lucent.LaunchReport: launch " + std::to_string(r.launch_ms) + " ms, " +
+                   std::to_string(r.exception_count()) + " exceptions>";
+        });
+
+    py::class_<Context, std::shared_ptr<Context>> ctx(
+        m, "Context", "Owns the entry points, ray types and objects of a scene, and launches.");
+    ctx.def(py::init([](const std::string& backend, unsigned threads, int jit_check_sm,
+                        const py::object& devices) {
+                ContextOptions options = context_options(backend, threads, jit_check_sm, devices);
+                py::gil_scoped_release release;  // a CUDA context takes a while to start
+                return std::make_shared<Context>(std::move(options));
+            }),
+            py::arg("backend") = "auto", py::arg("threads") = 0u, py::arg("jit_check_sm") = 0,
+            py::arg("devices") = py::none(),
+            "backend: 'auto', 'cpu' or 'cuda'; threads: CPU workers (0: one per core); "
+            "jit_check_sm: with the CPU backend, also compile the GPU megakernel for this "
+            "compute capability (90: sm_90) at each compile, without a GPU; devices: '0,1', "
+            "'cpu,0', 'all' or a list, to spread launches over several devices.")
+        .def_property_readonly("backend", &Context::backend_name)
+        .def_property_readonly("backend_notice", &Context::backend_notice)
+        .def_property_readonly("device_count", &Context::device_count)
+        .def_property("random_seed", &Context::random_seed, &Context::set_random_seed)
+        .def_property("entry_point_count", &Context::entry_point_count,
+                      &Context::set_entry_point_count)
+        .def("set_ray_generation_program", &Context::set_ray_generation_program, py::arg("entry"),
+             py::arg("program"))
+        .def("ray_generation_program", &Context::ray_generation_program)
+        .def("set_exception_program", &Context::set_exception_program, py::arg("entry"),
+             py::arg("program"))
+        .def("exception_program", &Context::exception_program)
+        .def(
+            "set_ray_type",
+            [](Context& c, unsigned index, std::string name, const py::handle& payload,
+               bool expects_closest_hit, std::vector<std::shared_ptr<Node>> roots) {
+                c.set_ray_type(index, RayTypeDesc{std::move(name), &payload_type(payload),
+                                                  expects_closest_hit, std::move(roots)});
+            },
+            py::arg("index"), py::arg("name"), py::arg("payload"),
+            py::arg("expects_closest_hit") = true, py::arg("roots") = std::vector<std::shared_ptr<Node>>{},
+            "Declares ray type `index`; payload: the payload's type name, or a program that "
+            "takes it (its miss or closest hit).")
+        .def_property_readonly("ray_type_count", &Context::ray_type_count)
+        .def("ray_type_name",
+             [](const Context& c, unsigned index) { return c.ray_type(index).name; })
+        .def("set_miss_program", &Context::set_miss_program, py::arg("ray_type"),
+             py::arg("program"))
+        .def("miss_program", &Context::miss_program)
+        .def_property("max_recursion_depth", &Context::max_recursion_depth,
+                      &Context::set_max_recursion_depth)
+        .def("set_exception_enabled", &Context::set_exception_enabled, py::arg("code"),
+             py::arg("enabled"), "An exception code, or lucent.ALL_EXCEPTIONS.")
+        .def("exception_enabled", &Context::exception_enabled)
+        .def_property("print_enabled", &Context::print_enabled, &Context::set_print_enabled)
+        .def(
+            "add_module",
+            [](Context& c, const std::string& name) -> const ModuleInfo& {
+                return c.add_module(name);
+            },
+            py::arg("name"), py::return_value_policy::reference,
+            "Makes a module compiled into this extension (lucent.modules()) available to "
+            "create_program by name.")
+        .def(
+            "create_program",
+            [](Context& c, const std::string& name, const std::optional<std::string>& module) {
+                if (!module) return c.create_program(name);
+                return c.create_program(c.add_module(*module), name);
+            },
+            py::arg("name"), py::arg("module") = py::none(),
+            "The program `name` of an added module (or of `module`, which is added).")
+        .def(
+            "create_buffer",
+            [](Context& c, const std::string& type, const std::string& element,
+               const py::handle& size) {
+                const std::vector<unsigned> s = parse_buffer_size(size);
+                const TypeInfo& e = type_by_name(element, "create_buffer: element");
+                return c.create_buffer(buffer_type_from(type), e, s[0], s.size() > 1 ? s[1] : 0,
+                                       s.size() > 2 ? s[2] : 0);
+            },
+            py::arg("type"), py::arg("element"), py::arg("size"),
+            "type: 'input', 'output' or 'input_output'; element: a type name ('float3', "
+            "'uint', ...: lucent.types()); size: width, (width, height) or (width, height, "
+            "depth).")
+        .def("create_texture_sampler", &Context::create_texture_sampler)
+        .def(
+            "create_acceleration",
+            [](Context& c, const std::string& builder) {
+                return c.create_acceleration(builder_from_name(builder));
+            },
+            py::arg("builder") = "sah")
+        .def("create_group", &Context::create_group)
+        .def("create_geometry_group", &Context::create_geometry_group)
+        .def("create_transform", &Context::create_transform)
+        .def("create_selector", &Context::create_selector)
+        .def("create_geometry_instance", &Context::create_geometry_instance)
+        .def("create_geometry", &Context::create_geometry)
+        .def("create_geometry_triangles", &Context::create_geometry_triangles)
+        .def("create_material", &Context::create_material)
+        .def("validate", &Context::validate, py::call_guard<py::gil_scoped_release>(),
+             "Checks everything a launch would, without launching; raises lucent.Error.")
+        .def(
+            "launch",
+            [](Context& c, unsigned entry, unsigned width, unsigned height, unsigned depth) {
+                {
+                    py::gil_scoped_release release;
+                    if (depth)
+                        c.launch(entry, width, height ? height : 1, depth);
+                    else if (height)
+                        c.launch(entry, width, height);
+                    else
+                        c.launch(entry, width);
+                }
+                return c.last_launch();
+            },
+            py::arg("entry"), py::arg("width"), py::arg("height") = 0u, py::arg("depth") = 0u,
+            "Runs entry point `entry` over width (x height (x depth)) launch indices; "
+            "returns the LaunchReport.")
+        .def_property_readonly("last_launch", &Context::last_launch)
+        .def("__repr__", [](const Context& c) { return "<lucent.Context on " + c.backend_name() + ">"; });
+    add_variable_access(ctx);
+    m.attr("ALL_EXCEPTIONS") = kAllExceptions;
+}
+
+}  // namespace lucent::python

@@ -1,0 +1,179 @@
+// The node graph from Python: Group, GeometryGroup, Transform, Selector, GeometryInstance,
+// Geometry, GeometryTriangles, Material, Acceleration and TextureSampler, as the C++ API
+// has them (lucent/nodes.h); a Context creates each (context_binding.cpp).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+#include "array_args.h"
+#include "bindings.h"
+
+namespace lucent::python {
+
+namespace {
+
+Builder builder_from(const std::string& name) {
+    if (name == "sah") return Builder::kBinnedSah;
+    if (name == "none") return Builder::kNone;
+    if (name == "gpu_hploc") return Builder::kGpuHploc;
+    throw py::value_error("builder: expected 'sah', 'none' or 'gpu_hploc'; got '" + name + "'");
+}
+
+const char* builder_name(Builder b) {
+    switch (b) {
+        case Builder::kBinnedSah: return "sah";
+        case Builder::kNone: return "none";
+        case Builder::kGpuHploc: return "gpu_hploc";
+    }
+    return "?";
+}
+
+WrapMode wrap_from(const std::string& name) {
+    if (name == "repeat") return WrapMode::kRepeat;
+    if (name == "clamp") return WrapMode::kClampToEdge;
+    if (name == "mirror") return WrapMode::kMirror;
+    throw py::value_error("wrap mode: expected 'repeat', 'clamp' or 'mirror'; got '" + name + "'");
+}
+
+template <class T>
+std::string repr(const T& object) {
+    return "<lucent." + object.describe() + ">";
+}
+
+}  // namespace
+
+Builder builder_from_name(const std::string& name) {
+    return builder_from(name);
+}
+
+void bind_nodes(py::module_& m) {
+    py::class_<Acceleration, std::shared_ptr<Acceleration>>(m, "Acceleration",
+                                                            "The BVH of a Group or GeometryGroup.")
+        .def_property("builder", [](const Acceleration& a) { return builder_name(a.builder()); },
+                      [](Acceleration& a, const std::string& b) { a.set_builder(builder_from(b)); },
+                      "'sah' (binned SAH), 'none' (every child tested) or 'gpu_hploc' (built "
+                      "on the GPU by the CUDA backend)")
+        .def_property("refit", &Acceleration::refit, &Acceleration::set_refit,
+                      "Refit instead of rebuilding when only vertices moved")
+        .def("mark_dirty", &Acceleration::mark_dirty)
+        .def("__repr__", [](const Acceleration& a) { return repr(a); });
+
+    py::class_<TextureSampler, std::shared_ptr<TextureSampler>>(m, "TextureSampler")
+        .def_property("buffer", &TextureSampler::buffer, &TextureSampler::set_buffer,
+                      "A 2D float4 Buffer of texels")
+        .def("set_wrap_mode", [](TextureSampler& t, const std::string& u, const std::string& v) {
+            t.set_wrap_mode(wrap_from(u), wrap_from(v));
+        })
+        .def("set_filter", [](TextureSampler& t, const std::string& f) {
+            if (f != "nearest" && f != "linear")
+                throw py::value_error("filter: expected 'nearest' or 'linear'; got '" + f + "'");
+            t.set_filter(f == "nearest" ? FilterMode::kNearest : FilterMode::kLinear);
+        })
+        .def("__repr__", [](const TextureSampler& t) { return repr(t); });
+
+    py::class_<Node, std::shared_ptr<Node>>(m, "Node", "A node of the scene graph.")
+        .def_property("name", [](const Node& n) { return n.name(); }, &Node::set_name)
+        .def_property_readonly("kind", [](const Node& n) { return std::string(node_kind_name(n.kind())); })
+        .def("__repr__", [](const Node& n) { return repr(n); });
+
+    py::class_<NodeWithChildren, Node, std::shared_ptr<NodeWithChildren>>(m, "NodeWithChildren")
+        .def("add_child", &NodeWithChildren::add_child, py::arg("child"),
+             "Appends a child node; returns its index.")
+        .def("set_child", &NodeWithChildren::set_child)
+        .def("remove_child", &NodeWithChildren::remove_child)
+        .def_property_readonly("child_count", &NodeWithChildren::child_count)
+        .def("child", &NodeWithChildren::child)
+        .def_property_readonly("children", &NodeWithChildren::children);
+
+    py::class_<Group, NodeWithChildren, std::shared_ptr<Group>>(
+        m, "Group", "Children of any node kind under an acceleration structure.")
+        .def_property("acceleration", &Group::acceleration, &Group::set_acceleration);
+
+    py::class_<Selector, NodeWithChildren, std::shared_ptr<Selector>>(
+        m, "Selector", "Children chosen per ray by a visit program.")
+        .def_property("visit_program", &Selector::visit_program, &Selector::set_visit_program);
+
+    py::class_<Transform, Node, std::shared_ptr<Transform>>(
+        m, "Transform", "One child moved by an affine 3x4 matrix (object to world).")
+        .def_property("child", &Transform::child, &Transform::set_child)
+        .def_property(
+            "matrix",
+            [](const Transform& t) {
+                py::array_t<float> a({3, 4});
+                std::memcpy(a.mutable_data(), t.matrix().m, 12 * sizeof(float));
+                return a;
+            },
+            [](Transform& t, const py::handle& value) {
+                py::ssize_t unused = 0;
+                // A (4, 4) matrix's last row must be 0 0 0 1: take the (3, 4) part.
+                py::array a = py::module_::import("numpy").attr("asarray")(value);
+                if (a.ndim() == 2 && a.shape(0) == 4 && a.shape(1) == 4)
+                    a = a.attr("__getitem__")(py::slice(0, 3, 1));
+                py::array_t<float> m = float32_array(
+                    py::module_::import("numpy").attr("ascontiguousarray")(a), "Transform.matrix",
+                    "matrix", {3, 4}, "", unused);
+                t.set_matrix(m.data());
+            },
+            "Row-major (3, 4) float32 (a (4, 4) matrix gives its top three rows)");
+
+    py::class_<GeometryBase, std::shared_ptr<GeometryBase>> geometry_base(m, "GeometryBase");
+    geometry_base.def_property_readonly("primitive_count", &GeometryBase::primitive_count)
+        .def("__repr__", [](const GeometryBase& g) { return repr(g); });
+    add_variable_access(geometry_base);
+
+    py::class_<Geometry, GeometryBase, std::shared_ptr<Geometry>>(
+        m, "Geometry", "Custom primitives: a bounding-box and an intersection program.")
+        .def_property("primitive_count", &Geometry::primitive_count, &Geometry::set_primitive_count)
+        .def_property("bounding_box_program", &Geometry::bounding_box_program,
+                      &Geometry::set_bounding_box_program)
+        .def_property("intersection_program", &Geometry::intersection_program,
+                      &Geometry::set_intersection_program);
+
+    py::class_<GeometryTriangles, GeometryBase, std::shared_ptr<GeometryTriangles>>(
+        m, "GeometryTriangles",
+        "Built-in triangles: a float3 vertex Buffer, an optional uint3 index Buffer and an "
+        "optional uint per-triangle material index Buffer.")
+        .def_property("vertices", &GeometryTriangles::vertices, &GeometryTriangles::set_vertices)
+        .def_property("indices", &GeometryTriangles::indices, &GeometryTriangles::set_indices)
+        .def_property("material_indices", &GeometryTriangles::material_indices,
+                      &GeometryTriangles::set_material_indices)
+        .def_property("attribute_program", &GeometryTriangles::attribute_program,
+                      &GeometryTriangles::set_attribute_program);
+
+    py::class_<Material, std::shared_ptr<Material>> material(
+        m, "Material", "Closest-hit and any-hit programs per ray type.");
+    material.def("set_closest_hit", &Material::set_closest_hit, py::arg("ray_type"),
+                 py::arg("program"))
+        .def("set_any_hit", &Material::set_any_hit, py::arg("ray_type"), py::arg("program"))
+        .def("closest_hit", &Material::closest_hit)
+        .def("any_hit", &Material::any_hit)
+        .def("__repr__", [](const Material& x) { return repr(x); });
+    add_variable_access(material);
+
+    py::class_<GeometryInstance, std::shared_ptr<GeometryInstance>> instance(
+        m, "GeometryInstance", "A geometry bound to its materials.");
+    instance.def_property("geometry", &GeometryInstance::geometry, &GeometryInstance::set_geometry)
+        .def("add_material", &GeometryInstance::add_material, py::arg("material"),
+             "Appends a material; returns its index.")
+        .def("set_material", &GeometryInstance::set_material)
+        .def_property_readonly("material_count", &GeometryInstance::material_count)
+        .def("material", &GeometryInstance::material)
+        .def("__repr__", [](const GeometryInstance& x) { return repr(x); });
+    add_variable_access(instance);
+
+    py::class_<GeometryGroup, Node, std::shared_ptr<GeometryGroup>>(
+        m, "GeometryGroup", "Geometry instances under one acceleration structure.")
+        .def("add_child", &GeometryGroup::add_child, py::arg("instance"),
+             "Appends a GeometryInstance; returns its index.")
+        .def("set_child", &GeometryGroup::set_child)
+        .def("remove_child", &GeometryGroup::remove_child)
+        .def_property_readonly("child_count", &GeometryGroup::child_count)
+        .def("child", &GeometryGroup::child)
+        .def_property_readonly("children", &GeometryGroup::children)
+        .def_property("acceleration", &GeometryGroup::acceleration,
+                      &GeometryGroup::set_acceleration);
+}
+
+}  // namespace lucent::python

@@ -1,0 +1,94 @@
+// The samples from Python, against samples/sample.h: lucent.render(name, scene=..., size=...,
+// backend=..., **options) renders a sample as `lucent render --sample name` does and returns
+// its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples() lists the
+// samples and their options. Options are the CLI's --set values: each keyword becomes
+// "name=value" (True/False become 1/0), checked by the sample.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <utility>
+
+#include "bindings.h"
+#include "samples/sample.h"
+#include "samples/settings_error.h"
+
+namespace lucent::python {
+
+namespace {
+
+std::string option_text(const py::handle& value) {
+    if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "1" : "0";
+    if (py::isinstance<py::float_>(value)) return py::repr(value).cast<std::string>();
+    return py::str(value).cast<std::string>();
+}
+
+py::array_t<float> render(const std::string& name, const std::optional<std::string>& scene,
+                          std::pair<unsigned, unsigned> size, const std::string& backend,
+                          unsigned threads, unsigned spp, int jit_check_sm,
+                          const py::kwargs& options) {
+    samples::RenderSettings settings;
+    settings.width = size.first;
+    settings.height = size.second;
+    if (settings.width == 0 || settings.height == 0 || settings.width > 16384 ||
+        settings.height > 16384)
+        throw py::value_error("render: size must be (width, height), each 1..16384; got (" +
+                              std::to_string(size.first) + ", " + std::to_string(size.second) +
+                              ")");
+    settings.backend = backend_kind(backend, "render: backend");
+    settings.threads = threads;
+    settings.spp = spp;
+    settings.jit_check_sm = jit_check_sm;
+    if (scene) settings.scene = *scene;
+    for (const auto& [key, value] : options)
+        settings.sets[key.cast<std::string>()] = option_text(value);
+    samples::RenderResult result;
+    try {
+        const samples::SampleInfo& info = samples::find_sample(name);
+        samples::check_options(settings, info);
+        py::gil_scoped_release release;
+        result = info.render(settings);
+    } catch (const samples::SettingsError& e) {
+        throw py::value_error(std::string("render: ") + e.what());
+    }
+    const scene::Image& image = result.image;
+    py::array_t<float> rgba({py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(4)});
+    float* out = rgba.mutable_data();
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+        out[4 * i + 0] = image.pixels[i].x;
+        out[4 * i + 1] = image.pixels[i].y;
+        out[4 * i + 2] = image.pixels[i].z;
+        out[4 * i + 3] = 1.0f;
+    }
+    return rgba;
+}
+
+py::dict list_samples() {
+    py::dict all;
+    for (const samples::SampleInfo& info : samples::all_samples()) {
+        py::dict options;
+        for (const samples::SampleOption& o : info.options)
+            options[py::str(o.name)] = py::dict(py::arg("default") = o.default_value,
+                                                py::arg("help") = o.help);
+        all[py::str(info.name)] =
+            py::dict(py::arg("description") = info.description, py::arg("options") = options);
+    }
+    return all;
+}
+
+}  // namespace
+
+void bind_samples(py::module_& m) {
+    m.def("render", &render, py::arg("sample"), py::kw_only(), py::arg("scene") = py::none(),
+          py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
+          py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
+          "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
+          "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
+          "(progressive samples; 0: the sample's default), and the sample's options as "
+          "keywords (vpls=64). Returns the linear RGB image as an (H, W, 4) float32 array, "
+          "row 0 at the top, alpha 1.");
+    m.def("samples", &list_samples,
+          "{name: {'description': ..., 'options': {option: {'default': ..., 'help': ...}}}}");
+}
+
+}  // namespace lucent::python

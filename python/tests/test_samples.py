@@ -1,0 +1,67 @@
+"""lucent.render() gives the very floats `lucent render --out x.pfm` writes for the same
+settings, for every sample; lucent.samples() lists them with their options."""
+import subprocess
+
+import numpy as np
+import pytest
+
+import lucent
+from conftest import BACKEND
+
+
+def read_pfm(path):
+    """A PFM file (rows from the bottom up) as an (H, W, 3) float32 array, row 0 at the top."""
+    data = path.read_bytes()
+    header, rest = data.split(b"\n", 1)
+    size, rest = rest.split(b"\n", 1)
+    scale, pixels = rest.split(b"\n", 1)
+    assert header == b"PF" and float(scale) < 0  # RGB, little-endian
+    w, h = (int(s) for s in size.split())
+    return np.frombuffer(pixels, "<f4").reshape(h, w, 3)[::-1]
+
+
+# (sample, size, spp, options): small images, each sample's default scene.
+CASES = [
+    ("whitted", (64, 48), 0, {}),
+    ("direct", (48, 48), 0, {}),
+    ("igi", (64, 64), 0, {"vpls": 16}),
+    ("igi", (64, 64), 0, {"vpls": 16, "downsample": 2, "interleave": 3, "imperfect_visibility": True}),
+    ("radiosity", (48, 48), 0, {}),
+    ("pathtracer", (32, 32), 4, {}),
+    ("fog", (48, 36), 0, {}),
+]
+
+
+@pytest.mark.parametrize("sample, size, spp, options", CASES,
+                         ids=[f"{c[0]}-{'-'.join(c[3]) or 'defaults'}" for c in CASES])
+def test_render_is_the_cli_image(tmp_path, cli, sample, size, spp, options):
+    image = lucent.render(sample, size=size, backend=BACKEND, spp=spp, **options)
+    assert image.shape == (size[1], size[0], 4) and image.dtype == np.float32
+    assert np.all(image[..., 3] == 1)
+    out = tmp_path / f"{sample}.pfm"
+    args = [cli, "render", "--sample", sample, "--size", f"{size[0]}x{size[1]}", "--backend",
+            BACKEND, "--out", str(out)]
+    if spp:
+        args += ["--spp", str(spp)]
+    for name, value in options.items():
+        args += ["--set", f"{name}={int(value) if isinstance(value, bool) else value}"]
+    subprocess.run(args, check=True, capture_output=True)
+    np.testing.assert_array_equal(image[..., :3], read_pfm(out))
+    assert image[..., :3].max() > 0  # not black
+
+
+def test_render_a_scene_by_name(tmp_path, cli):
+    a = lucent.render("direct", scene="cornell-point", size=(32, 32), backend=BACKEND)
+    out = tmp_path / "d.pfm"
+    subprocess.run([cli, "render", "--sample", "direct", "--scene", "cornell-point", "--size",
+                    "32x32", "--backend", BACKEND, "--out", str(out)], check=True, capture_output=True)
+    np.testing.assert_array_equal(a[..., :3], read_pfm(out))
+
+
+def test_samples_lists_every_sample_with_its_options():
+    listed = lucent.samples()
+    assert set(listed) >= {"whitted", "direct", "igi", "radiosity", "pathtracer", "fog"}
+    igi = listed["igi"]
+    assert igi["description"]
+    assert "vpls" in igi["options"] and igi["options"]["vpls"]["default"]
+    assert igi["options"]["vpls"]["help"]
