@@ -1,8 +1,8 @@
-// The samples from Python, against samples/sample.h: lucent.render(name, scene=..., size=...,
+// The samples from Python, through the Sample classes of samples/sample.h: lucent.render(name, scene=..., size=...,
 // backend=..., **options) renders a sample as `lucent render --sample name` does and returns
 // its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples() lists the
-// samples and their options. Options are the CLI's --set values: each keyword becomes
-// "name=value" (True/False become 1/0), checked by the sample.
+// samples and their typed options. Options are the CLI's --set values: each keyword becomes
+// "name=value" (True/False become 1/0), checked by the sample's own option declarations.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -44,10 +44,10 @@ py::array_t<float> render(const std::string& name, const std::optional<std::stri
         settings.sets[key.cast<std::string>()] = option_text(value);
     samples::RenderResult result;
     try {
-        const samples::SampleInfo& info = samples::find_sample(name);
-        samples::check_options(settings, info);
+        const samples::Sample& sample = samples::find_sample(name);
+        sample.read_options(settings);  // checked before the GIL is released
         py::gil_scoped_release release;
-        result = info.render(settings);
+        result = sample.render(settings);
     } catch (const samples::SettingsError& e) {
         throw py::value_error(std::string("render: ") + e.what());
     }
@@ -63,15 +63,40 @@ py::array_t<float> render(const std::string& name, const std::optional<std::stri
     return rgba;
 }
 
+const char* kind_name(samples::OptionKind kind) {
+    switch (kind) {
+        case samples::OptionKind::kInteger: return "integer";
+        case samples::OptionKind::kNumber: return "number";
+        case samples::OptionKind::kSwitch: return "switch";
+        case samples::OptionKind::kText: break;
+    }
+    return "text";
+}
+
+/// An option's default as a Python value of its kind (int, float, bool or str).
+py::object typed_default(const samples::SampleOption& o) {
+    switch (o.kind) {
+        case samples::OptionKind::kInteger: return py::int_(std::stoi(o.default_value));
+        case samples::OptionKind::kNumber: return py::float_(std::stod(o.default_value));
+        case samples::OptionKind::kSwitch: return py::bool_(o.default_value == "1");
+        case samples::OptionKind::kText: break;
+    }
+    return py::str(o.default_value);
+}
+
 py::dict list_samples() {
     py::dict all;
-    for (const samples::SampleInfo& info : samples::all_samples()) {
+    for (const samples::Sample* sample : samples::all_samples()) {
         py::dict options;
-        for (const samples::SampleOption& o : info.options)
-            options[py::str(o.name)] = py::dict(py::arg("default") = o.default_value,
-                                                py::arg("help") = o.help);
-        all[py::str(info.name)] =
-            py::dict(py::arg("description") = info.description, py::arg("options") = options);
+        for (const samples::SampleOption& o : sample->options) {
+            py::dict option(py::arg("kind") = kind_name(o.kind),
+                            py::arg("default") = typed_default(o), py::arg("help") = o.help);
+            if (o.kind == samples::OptionKind::kInteger || o.kind == samples::OptionKind::kNumber)
+                option["range"] = py::make_tuple(o.lo, o.hi);
+            options[py::str(o.name)] = option;
+        }
+        all[py::str(sample->name)] =
+            py::dict(py::arg("description") = sample->description, py::arg("options") = options);
     }
     return all;
 }
@@ -88,7 +113,8 @@ void bind_samples(py::module_& m) {
           "keywords (vpls=64). Returns the linear RGB image as an (H, W, 4) float32 array, "
           "row 0 at the top, alpha 1.");
     m.def("samples", &list_samples,
-          "{name: {'description': ..., 'options': {option: {'default': ..., 'help': ...}}}}");
+          "{name: {'description': ..., 'options': {option: {'kind': 'integer'|'number'|'switch'|'text', "
+          "'default': ..., 'help': ..., 'range': (lo, hi) for numbers and integers}}}}");
 }
 
 }  // namespace lucent::python

@@ -63,5 +63,13 @@ def test_samples_lists_every_sample_with_its_options():
     assert set(listed) >= {"whitted", "direct", "igi", "radiosity", "pathtracer", "fog"}
     igi = listed["igi"]
     assert igi["description"]
-    assert "vpls" in igi["options"] and igi["options"]["vpls"]["default"]
-    assert igi["options"]["vpls"]["help"]
+    vpls = igi["options"]["vpls"]
+    assert vpls["kind"] == "integer" and isinstance(vpls["default"], int) and vpls["default"] > 0
+    assert vpls["range"][0] <= vpls["default"] <= vpls["range"][1]
+    assert vpls["help"]
+    kinds = {o["kind"] for s in listed.values() for o in s["options"].values()}
+    assert kinds >= {"integer", "number", "switch"}
+    for s in listed.values():
+        for o in s["options"].values():
+            if o["kind"] == "switch":
+                assert isinstance(o["default"], bool)
