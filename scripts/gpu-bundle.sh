@@ -47,7 +47,12 @@ if [ "$python" = 1 ]; then
   # these static libraries and objects, and the Debian libraries they load (not the C and
   # C++ runtimes: that machine's own, newer ones serve).
   mkdir -p "$out/python/lib" "$out/python/objects" "$out/python/so"
-  cp "$build"/liblucent.a "$build"/liblucent_scene.a "$build"/liblucent_samples.a "$out/python/lib/"
+  cp "$build"/liblucent.a "$build"/liblucent_scene.a "$out/python/lib/"
+  # The samples are an object library (their registrars must be linked, not pulled from an
+  # archive): their objects travel by name, samples/igi/igi.cpp.o as samples_igi_igi.cpp.o.
+  (cd "$build/CMakeFiles/lucent_samples.dir" && find samples -name '*.o') | while read -r o; do
+    cp "$build/CMakeFiles/lucent_samples.dir/$o" "$out/python/objects/$(echo "$o" | tr / _)"
+  done
   cp "$build"/CMakeFiles/lucent_sample_programs.dir/lucent_modules/*/*.o \
      "$build"/python/CMakeFiles/lucent_python.dir/lucent_modules/*/*.o "$out/python/objects/"
   for lib in $(ldd "$build"/python/lucent/_lucent*.so | awk '/=>/ {print $3}' |

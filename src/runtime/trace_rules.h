@@ -294,13 +294,20 @@ LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned ins
 
 /// potential_intersection(t), in an intersection program: is t inside the ray's current
 /// interval (tmin, closest)? Elsewhere false.
+/// The context, tmin and closest are read together and combined without a branch: on the
+/// GPU the frame is in local memory, and a branch on the context before the other two reads
+/// put a second memory round trip on every intersection test (Whitted 4 % slower). Outside
+/// an intersection program nothing opens, and candidate_open, which only
+/// report_intersection reads, is cleared.
 template <class P>
 LUCENT_RUNTIME_INLINE bool potential_intersection(const P& p, float t) {
     FrameOf<P>* f = p.thread().frame;
-    if (!f || f->context != ProgramContext::kIntersection) return false;
-    f->candidate_open = t > f->world_ray.tmin && t < f->closest;
-    if (f->candidate_open) f->candidate_t = t;
-    return f->candidate_open;
+    if (!f) return false;
+    const bool open = (f->context == ProgramContext::kIntersection) &
+                      (t > f->world_ray.tmin) & (t < f->closest);
+    f->candidate_open = open;
+    if (open) f->candidate_t = t;
+    return open;
 }
 
 /// report_intersection(material), in an intersection program after potential_intersection
