@@ -1,4 +1,4 @@
-// The IGI sample (seed §4): VPLs light what the lights cannot see, Eq. (1)'s indirect term
+// The IGI sample (IGI paper §4): VPLs light what the lights cannot see, Eq. (1)'s indirect term
 // agrees with a brute-force reference, and each of the paper's accelerations (imperfect
 // visibility, downsampling, interleaving) stays close to the canonical image.
 #include <gtest/gtest.h>
@@ -168,7 +168,7 @@ TEST(Igi, AllThreeAcceleratorsTogether) {
                /*layers=*/true);
     EXPECT_LT(relative_rms(canonical.image, fast.image), 0.10);
     EXPECT_EQ(fast.layers.at("indirect_low").width, 16u) << "indirect at 1/4 resolution";
-    // Every stage of seed Fig. 3 is timed.
+    // Every stage of the IGI paper's Fig. 3 is timed.
     for (const char* stage : lucent::samples::kIgiStageNames) {
         bool found = false;
         for (const auto& s : fast.stages) found |= s.name == stage;

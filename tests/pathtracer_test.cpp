@@ -1,4 +1,4 @@
-// The path tracer (seed CACM §6.2): furnace tests with closed-form answers, chi-square tests
+// The path tracer (OptiX paper §6.2): furnace tests with closed-form answers, chi-square tests
 // of every BSDF's sampling against its pdf (as pbrt and Mitsuba test theirs), Fresnel
 // probabilities of glass, 1/sqrt(spp) convergence, and NEE + MIS against BSDF sampling only.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The fog sample (Sebald, seed §3.1): its options, one frame of FogScene for `lucent render`,
+// The fog sample (Sebald, §3.1): its options, one frame of FogScene for `lucent render`,
 // and for `lucent view` the same scene, its camera in a buffer (FogScene) so a moving camera
 // only re-uploads it. Every option is a material variable or changes the scene's shape (the
 // fog box, the recursion depth), so options rebuild the scene: cheap for these few triangles.
@@ -66,7 +66,7 @@ class FogSample final : public Sample {
     FogSample()
         : Sample(
               "fog",
-              "Volumetric fog (Sebald, seed §3.1) in the OptiX SDK tutorial scene: TEA gradient "
+              "Volumetric fog (Sebald, §3.1) in the OptiX SDK tutorial scene: TEA gradient "
               "noise in x, z times a linear falloff in y, marched along each ray; shadows pass "
               "through",
               {

@@ -1,4 +1,4 @@
-// Volumetric fog in the OptiX SDK's tutorial scene (Sebald, seed §3.1): a tiled floor and a
+// Volumetric fog in the OptiX SDK's tutorial scene (Sebald, §3.1): a tiled floor and a
 // reflective rusty box with procedural textures, a glass crystal (Fresnel, Beer absorption),
 // an environment in the miss program, point lights with shadows; and a box of fog over the
 // floor whose density is TEA gradient noise in x, z times a linear falloff in y.

@@ -1,6 +1,6 @@
 // The fog sample's scene, built once and rendered for any camera on its orbit: the OptiX SDK
 // tutorial's floor, box and crystal, point lights, the environment, and the fog box
-// (Sebald, seed §3.1). The sample renders one frame; `lucent bench fog` renders a path.
+// (Sebald, §3.1). The sample renders one frame; `lucent bench fog` renders a path.
 #pragma once
 
 #include <memory>

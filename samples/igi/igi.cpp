@@ -1,6 +1,6 @@
 // Host setup of the IGI sample: the scene as triangles with per-triangle materials, its
 // lights as point emitters, a second graph of per-triangle boxes for imperfect visibility,
-// and the passes of seed Fig. 3 as entry points launched in order each frame. `lucent view`
+// and the passes of the IGI paper's Fig. 3 as entry points launched in order each frame. `lucent view`
 // runs the same frame, the camera in a buffer.
 #include <algorithm>
 #include <cmath>
@@ -115,7 +115,7 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 }
 
 /// The scene's triangles ("top_object", traced by radiance and particle rays) and, for
-/// imperfect visibility (seed §4.1), a second graph of one box per triangle as custom
+/// imperfect visibility (IGI paper §4.1), a second graph of one box per triangle as custom
 /// primitives ("vpl_shadow_object", traced only by VPL shadow rays).
 void add_graphs(Context& ctx, const scene::Scene& input) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
@@ -156,7 +156,7 @@ void add_graphs(Context& ctx, const scene::Scene& input) {
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
 }
 
-/// The passes of seed Fig. 3 as entry points, each reading and writing its images.
+/// The passes of the IGI paper's Fig. 3 as entry points, each reading and writing its images.
 void add_passes(Context& ctx, const IgiConfig& config, const IgiImages& images,
                 const CameraBuffer& camera_buffer) {
     auto camera = ctx.create_program(LUCENT_PROGRAM(igi::igi_camera));
@@ -203,7 +203,7 @@ void keep_layers(const IgiConfig& config, const IgiImages& images, RenderResult&
 }
 
 /// What a render and a session build: the scene of settings.scene (default: cornell) in
-/// `ctx` with its point emitters, the images of seed Fig. 3 (full resolution G-buffer and
+/// `ctx` with its point emitters, the images of the IGI paper's Fig. 3 (full resolution G-buffer and
 /// direct image, the indirect irradiance at 1/N resolution, merged, and upsampled) and the
 /// passes, the camera reading `camera`.
 struct IgiScene {
@@ -258,7 +258,7 @@ class IgiSample final : public Sample {
     IgiSample()
         : Sample(
               "igi",
-              "Instant Global Illumination (Marques and Santos, seed §4): VPLs from the lights "
+              "Instant Global Illumination (Marques and Santos, §4): VPLs from the lights "
               "along Halton paths, direct light, specular reflections, Eq. (1), and the paper's "
               "three accelerations",
               {
@@ -272,7 +272,7 @@ class IgiSample final : public Sample {
                                         "deepest specular reflection tree"),
                   SampleOption::toggle("imperfect_visibility", false,
                                        "1: VPL shadow rays against the triangles' bounding boxes "
-                                       "(seed §4.1), 0: exact"),
+                                       "(IGI paper §4.1), 0: exact"),
                   SampleOption::integer(
                       "downsample", 1, 1, 16,
                       "N: indirect light at 1/N of the resolution, joint bilateral upsampling"),

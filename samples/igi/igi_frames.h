@@ -1,4 +1,4 @@
-// A frame of the IGI sample: the images its passes hand each other (seed Fig. 3) and the
+// A frame of the IGI sample: the images its passes hand each other (IGI paper, Fig. 3) and the
 // passes launched in order, each timed, as the paper's Fig. 4 and 5 report them.
 #pragma once
 
@@ -40,7 +40,7 @@ IgiImages create_igi_images(Context& ctx, const IgiConfig& config);
 
 /// How many threads share a pixel's VPLs in the indirect pass: enough that the pass has
 /// about kIndirectWorkItems of work, at most one per VPL of an interleaved subset. A
-/// low-resolution image alone leaves a GPU mostly idle: at 1/16 of 800x600 (seed §4.2) the
+/// low-resolution image alone leaves a GPU mostly idle: at 1/16 of 800x600 (IGI paper §4.2) the
 /// pass has 60,000 pixels of its two layers, and ncu saw 9 % achieved occupancy with 7 of 32
 /// lanes active. Sponza, all three accelerations, H200: 1, 2, 4, 8, 16 slices took 1.47,
 /// 0.88, 0.76, 0.68, 0.63 ms. The same on every backend, so images do not depend on it.

@@ -1,4 +1,4 @@
-// Instant Global Illumination (Marques and Santos, seed §4): virtual point lights (VPLs) from
+// Instant Global Illumination (Marques and Santos, §4): virtual point lights (VPLs) from
 // particles traced out of the lights along Halton paths; per pixel, direct light and a
 // Whitted tree of specular reflections; indirect diffuse light from the VPLs by Eq. (1) with
 // the bounded geometry term. As in the paper's Fig. 3 the indirect term of the primary hit
@@ -24,13 +24,13 @@ LUCENT_MODULE(igi, lucent::kUsesOccluded)
 
 enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2, kVplShadowRay = 3 };
 
-/// The passes of a frame, one entry point each (seed Fig. 3).
+/// The passes of a frame, one entry point each (IGI paper, Fig. 3).
 enum : unsigned {
     kDirectEntry = 0,         // full resolution: direct + specular, and the G-buffer
     kVplEntry = 1,            // one thread per light path
     kIndirectEntry = 2,       // Eq. (1) at the primary hits, 1/N resolution, interleaved
-    kDiscontinuityEntry = 3,  // merges the interleaved VPL subsets (seed §4.3)
-    kUpsampleEntry = 4,       // joint bilateral upsampling, Eq. (2) (seed §4.2)
+    kDiscontinuityEntry = 3,  // merges the interleaved VPL subsets (IGI paper §4.3)
+    kUpsampleEntry = 4,       // joint bilateral upsampling, Eq. (2) (IGI paper §4.2)
     kComposeEntry = 5,        // direct + rho / pi x indirect irradiance
     kIndirectSumEntry = 6,    // adds up the indirect pass's VPL slices
     kEntryCount = 7
@@ -134,7 +134,7 @@ struct GenerateRecord {
 };
 LUCENT_RECORD(GenerateRecord, lights, vpls, bounces, scene_epsilon, top_object)
 
-/// The full-resolution G-buffer of the direct stage (seed Fig. 3): position (w: the distance
+/// The full-resolution G-buffer of the direct stage (IGI paper, Fig. 3): position (w: the distance
 /// along the eye path, < 0: no hit), normal and the irradiance's weight, each image width x
 /// height x layers: layer 0 the primary hits, layer 1 (with the reflection layer) the first
 /// reflected hits.
@@ -153,7 +153,7 @@ struct IndirectParams {
     float min_d;  // Eq. (1)'s bounding distance
     float scene_epsilon;
     lucent::Handle top_object;
-    unsigned imperfect_visibility;  // VPL shadow rays against the boxes graph (seed §4.1)
+    unsigned imperfect_visibility;  // VPL shadow rays against the boxes graph (IGI paper §4.1)
     lucent::Handle vpl_shadow_object;
 };
 
@@ -254,7 +254,7 @@ LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float epsi
     return !lucent::occluded(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f));
 }
 
-/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (seed §4.1), against
+/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (IGI paper §4.1), against
 /// the crude second graph of the triangles' bounding boxes (a different root and ray type).
 LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 to) {
     if (p.imperfect_visibility)
@@ -264,7 +264,7 @@ LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 t
 
 /// Eq. (1) at x with normal n over the VPLs first, first + stride, ...: the sum of
 /// Le,k V(x, yk) G(x, yk), with G bounded by f(0.8 min_d, 1.2 min_d, |x - yk|). Incident
-/// irradiance: rho / pi multiplies it at composition (seed §4.2).
+/// irradiance: rho / pi multiplies it at composition (IGI paper §4.2).
 LUCENT_HD inline float3 indirect(const IndirectParams& p, float3 x, float3 n, unsigned first = 0,
                                  unsigned stride = 1) {
     float3 sum = make_float3(0.0f);
@@ -422,7 +422,7 @@ LUCENT_MISS(igi_miss, lucent::NoRecord, igi::RadiancePayload) {
     prd.color = make_float3(0.0f);
 }
 
-// ---- the indirect stage: Eq. (1) at the primary hits (seed §4.2, §4.3) --------------------
+// ---- the indirect stage: Eq. (1) at the primary hits (IGI paper §4.2, §4.3) --------------------
 LUCENT_RAY_GENERATION(igi_indirect, igi::IndirectRecord) {
     const uint3 q = lucent::launch_index();
     const unsigned layer = q.z / rec.slices, slice = q.z % rec.slices;
@@ -455,7 +455,7 @@ LUCENT_RAY_GENERATION(igi_indirect_sum, igi::IndirectSumRecord) {
     rec.indirect[q] = sum;
 }
 
-// The discontinuity buffer (seed §4.3): a pixel averages the irradiance of the neighbours of
+// The discontinuity buffer (IGI paper §4.3): a pixel averages the irradiance of the neighbours of
 // its M x M window whose depth and normal say the surface is continuous.
 LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
     const uint3 q = lucent::launch_index(), size = lucent::launch_size();
@@ -491,7 +491,7 @@ LUCENT_RAY_GENERATION(igi_discontinuity, igi::DiscontinuityRecord) {
     rec.merged[centre] = make_float4(sum / count, 1.0f);  // count >= 1: the centre itself
 }
 
-// Joint bilateral upsampling, Eq. (2) (seed §4.2, after Kopf et al. 2007): a Gaussian over the
+// Joint bilateral upsampling, Eq. (2) (IGI paper §4.2, after Kopf et al. 2007): a Gaussian over the
 // low-resolution neighbours q of p, times the cosine between the full-resolution normals at p~
 // and at q~, normalised.
 LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
@@ -532,7 +532,7 @@ LUCENT_RAY_GENERATION(igi_upsample, igi::UpsampleRecord) {
     rec.full[full] = make_float4(k > 0.0f ? sum / k : nearest, 1.0f);
 }
 
-// Composition (seed Fig. 3): the direct image plus, for each G-buffer layer, its weight (rho,
+// Composition (IGI paper, Fig. 3): the direct image plus, for each G-buffer layer, its weight (rho,
 // or Ks rho through a mirror) / pi times its indirect irradiance.
 LUCENT_RAY_GENERATION(igi_compose, igi::ComposeRecord) {
     const uint3 p = lucent::launch_index();

@@ -227,7 +227,7 @@ class PathtracerSample final : public Sample {
   public:
     PathtracerSample()
         : Sample("pathtracer",
-                 "Progressive path tracer (seed CACM §6.2): the bounce loop in ray generation, "
+                 "Progressive path tracer (OptiX paper §6.2): the bounce loop in ray generation, "
                  "Lambert, GGX metal, glass and coated materials, next-event estimation with "
                  "MIS, Russian roulette; --spp frames averaged (default 64); try --scene "
                  "cornell-materials",

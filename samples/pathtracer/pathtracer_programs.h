@@ -1,5 +1,5 @@
 // A progressive Monte Carlo path tracer in the structure of the OptiX paper's Design Garage
-// (seed CACM §6.2, Figure 8): the ray-generation program iterates over the bounces of a path
+// (OptiX paper §6.2, Figure 8): the ray-generation program iterates over the bounces of a path
 // instead of recursing; each material's closest-hit program returns the next ray, the
 // throughput of the bounce and the light it found (emission, and next-event estimation with
 // multiple importance sampling, Veach 1997 §9.2, power heuristic) through the payload. Every
