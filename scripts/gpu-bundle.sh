@@ -49,10 +49,12 @@ if [ "$python" = 1 ]; then
   mkdir -p "$out/python/lib" "$out/python/objects" "$out/python/so"
   cp "$build"/liblucent.a "$build"/liblucent_scene.a "$out/python/lib/"
   # The samples are an object library (their registrars must be linked, not pulled from an
-  # archive): their objects travel by name, samples/igi/igi.cpp.o as samples_igi_igi.cpp.o.
-  (cd "$build/CMakeFiles/lucent_samples.dir" && find samples -name '*.o') | while read -r o; do
-    cp "$build/CMakeFiles/lucent_samples.dir/$o" "$out/python/objects/$(echo "$o" | tr / _)"
-  done
+  # archive): the objects CMake lists for it travel, samples/igi/igi.cpp.o as
+  # samples_igi_igi.cpp.o.
+  while read -r o; do
+    name=${o#*/lucent_samples.dir/}; name=${name#./}
+    cp "$o" "$out/python/objects/$(echo "$name" | tr / _)"
+  done < "$build/lucent_samples_objects.txt"
   cp "$build"/CMakeFiles/lucent_sample_programs.dir/lucent_modules/*/*.o \
      "$build"/python/CMakeFiles/lucent_python.dir/lucent_modules/*/*.o "$out/python/objects/"
   for lib in $(ldd "$build"/python/lucent/_lucent*.so | awk '/=>/ {print $3}' |
