@@ -70,6 +70,9 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
         ->check(CLI::Range(0u, 4096u).description(""))
         ->capture_default_str();
     r->add_flag("--no-peer", rays.no_peer, "Do not run the peer engine (Embree)");
+    r->add_flag("--programs", rays.programs,
+                "Also trace the ray sets through a program module launched by a Context "
+                "(bench/rays/rays_programs.h): the engine's per-ray path beside the kernels");
     r->add_flag("--json", rays.json, "Machine-readable output");
     r->add_option("--backend", rays.backend, "cpu, auto or cuda")
         ->type_name("KIND")
@@ -154,6 +157,7 @@ int run_bench_rays_command(const BenchRaysArgs& args) {
     options.repeat = args.repeat;
     options.threads = args.threads;
     options.peer = !args.no_peer;
+    options.programs = args.programs;
     options.json = args.json;
 
     // A partial camera would silently mix given and default values: refuse it.

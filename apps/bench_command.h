@@ -16,6 +16,7 @@ struct BenchRaysArgs {
     int repeat = 5;
     unsigned threads = 0;
     bool no_peer = false;
+    bool programs = false;  // --programs
     bool json = false;
 };
 

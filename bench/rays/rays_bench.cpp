@@ -21,6 +21,8 @@
 #include "bench/common/rate.h"
 #include "bench/common/ray_checksums.h"
 #include "bench/common/report.h"
+#include "bench/rays/programs_bench.h"
+#include "bench/rays/ray_sets.h"
 #include "bench/rays/rays_bench.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
@@ -34,49 +36,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr float kPi = 3.14159265358979323846f;
-constexpr float kOffset = 1e-3f;  // secondary ray origins: p + 1e-3 n (BENCH.md)
 constexpr unsigned kChunk = 64;   // rays per work item handed out by the atomic counter
 static_assert(kChunk % 64 == 0, "a chunk's 1-byte results must fill whole cache lines");
-
-uint32_t hash(uint32_t a) {
-    a ^= a >> 16;
-    a *= 0x7feb352du;
-    a ^= a >> 15;
-    a *= 0x846ca68bu;
-    a ^= a >> 16;
-    return a;
-}
-
-/// A set of rays in SoA, and per ray the pixel it came from.
-struct RaySet {
-    std::vector<float3> origin, direction;
-    std::vector<float> tmax;
-    std::vector<uint32_t> pixel;
-    size_t size() const { return origin.size(); }
-    void add(float3 o, float3 d, float t, uint32_t p) {
-        origin.push_back(o);
-        direction.push_back(d);
-        tmax.push_back(t);
-        pixel.push_back(p);
-    }
-};
-
-RaySet primary_rays(const Camera& cam, unsigned w, unsigned h) {
-    const float3 fwd = normalize(cam.look - cam.eye);
-    const float3 right = normalize(cross(fwd, cam.up));
-    const float3 up2 = cross(right, fwd);
-    const float t = std::tan(cam.fov / 2 * kPi / 180);
-    const float a = (float)w / (float)h;
-    RaySet rays;
-    for (unsigned y = 0; y < h; ++y)
-        for (unsigned x = 0; x < w; ++x) {
-            float u = (2 * (x + 0.5f) / w - 1) * t * a;
-            float v = (1 - 2 * (y + 0.5f) / h) * t;
-            rays.add(cam.eye, normalize(fwd + u * right + v * up2), kInfinity, y * w + x);
-        }
-    return rays;
-}
 
 /// Allocates on cache-line boundaries. The threads of a pass write their results in chunks
 /// of kChunk rays; when a chunk's results start mid-line, two threads working on
@@ -105,34 +66,6 @@ struct Hits {
     ResultVector<float> t;
     ResultVector<uint32_t> prim;
 };
-
-/// Shadow and diffuse rays from the primary hits of one engine (BENCH.md).
-void secondary_rays(const RaySet& primary, const Hits& hits, const scene::ObjMesh& mesh,
-                    float3 light, RaySet& shadow, RaySet& diffuse) {
-    for (size_t i = 0; i < primary.size(); ++i) {
-        if (hits.t[i] < 0.0f) continue;
-        const float3 d = primary.direction[i];
-        const float3 p = primary.origin[i] + hits.t[i] * d;
-        const uint3 tri = mesh.indices[hits.prim[i]];
-        const float3 v0 = mesh.positions[tri.x];
-        float3 n = normalize(cross(mesh.positions[tri.y] - v0, mesh.positions[tri.z] - v0));
-        if (dot(n, d) > 0.0f) n = -n;
-        const float3 o = p + kOffset * n;
-        const float3 to_light = light - o;
-        const float dist = length(to_light);
-        shadow.add(o, to_light / dist, dist, primary.pixel[i]);
-
-        const uint32_t h1 = hash(2 * primary.pixel[i] + 1), h2 = hash(h1);
-        const float u1 = (float)(h1 >> 8) / 16777216.0f, u2 = (float)(h2 >> 8) / 16777216.0f;
-        const float r = std::sqrt(u1), phi = 2 * kPi * u2;
-        const float3 tt = normalize(
-            cross(n, std::fabs(n.x) > 0.5f ? make_float3(0, 1, 0) : make_float3(1, 0, 0)));
-        const float3 bb = cross(n, tt);
-        const float3 dir = normalize(tt * (r * std::cos(phi)) + bb * (r * std::sin(phi)) +
-                                     n * std::sqrt(std::max(0.0f, 1 - u1)));
-        diffuse.add(o, dir, kInfinity, primary.pixel[i]);
-    }
-}
 
 /// Seconds for body(i) over every ray, on `threads` threads that take chunks of rays from a
 /// shared counter. The calling thread only waits. With the caller tracing too, Lucent's
@@ -246,7 +179,8 @@ BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float
     sum_hits(peer_hits, res.peer.primary_hits, res.peer.primary_sum_t);
 
     RaySet shadow, diffuse;
-    secondary_rays(primary, lucent_hits, mesh, light, shadow, diffuse);
+    secondary_rays(primary, lucent_hits.t.data(), lucent_hits.prim.data(), mesh, light, shadow,
+                   diffuse);
     ResultVector<unsigned char> lucent_blocked(shadow.size()), peer_blocked(shadow.size());
     p = timed_pair(
         shadow.size(), threads, repeat,
@@ -307,7 +241,54 @@ struct RaysResult {
     bool peer = false;  // the peer ran
     double embree_build_ms = 0;
     std::string differences;  // of the checksums, lucent against embree ("" when they agree)
+    // --programs: the ray sets through rays_programs.h, and its checksums against the kernels'.
+    bool programs = false;
+    ProgramsResult program_figures;
+    std::string program_differences;
 };
+
+/// The programs' figures as an EngineResult, for the shared printers.
+EngineResult engine_of(const ProgramsResult& p) {
+    EngineResult r;
+    static_cast<RayChecksums&>(r) = p;
+    r.primary = p.primary, r.shadow = p.shadow, r.diffuse = p.diffuse;
+    return r;
+}
+
+Json programs_json(const ProgramsResult& p, const EngineResult& kernels, const EngineResult* peer,
+                   const std::string& differences) {
+    Json j = json_engine(engine_of(p));
+    j["backend"] = p.backend;
+    j["timing"] = p.timing;
+    j["ratio_to_kernels"] = Json{{"primary", rounded(median_ratio(p.primary, kernels.primary), 4)},
+                                 {"shadow", rounded(median_ratio(p.shadow, kernels.shadow), 4)},
+                                 {"diffuse", rounded(median_ratio(p.diffuse, kernels.diffuse), 4)}};
+    if (peer)
+        j["ratio_to_embree"] = Json{{"primary", rounded(median_ratio(p.primary, peer->primary), 4)},
+                                    {"shadow", rounded(median_ratio(p.shadow, peer->shadow), 4)},
+                                    {"diffuse", rounded(median_ratio(p.diffuse, peer->diffuse), 4)}};
+    j["checksums_agree"] = differences.empty();
+    return j;
+}
+
+/// The programs' lines: figures, ratios to the kernels (and to Embree), checksums.
+void print_programs(const ProgramsResult& p, const EngineResult& kernels, const EngineResult* peer,
+                    const std::string& differences) {
+    std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
+                p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
+    print_engine("programs ", engine_of(p));
+    auto ratios = [&](const char* what, const EngineResult& b) {
+        std::printf("ratio programs/%s primary %.2fx, shadow %.2fx, diffuse %.2fx\n", what,
+                    median_ratio(p.primary, b.primary), median_ratio(p.shadow, b.shadow),
+                    median_ratio(p.diffuse, b.diffuse));
+    };
+    ratios("kernels", kernels);
+    if (peer) ratios("embree", *peer);
+    if (differences.empty())
+        std::printf("programs' checksums agree with the kernels\n");
+    else
+        std::printf("programs' checksums differ from the kernels: %s\n", differences.c_str());
+}
 
 Json to_json(const RaysResult& r) {
     const RaysOptions& o = *r.options;
@@ -328,6 +309,9 @@ Json to_json(const RaysResult& r) {
                           {"diffuse", rounded(r.engines.diffuse_ratio, 4)}};
         j["checksums_agree"] = r.differences.empty();
     }
+    if (r.programs)
+        j["programs"] = programs_json(r.program_figures, r.engines.lucent,
+                                      r.peer ? &r.engines.peer : nullptr, r.program_differences);
     return j;
 }
 
@@ -344,6 +328,8 @@ void print_text(const RaysResult& r) {
     print_engine("", r.engines.lucent);
     if (!r.peer) {
         if (o.peer) std::printf("embree: not built in, no peer figures\n");
+        if (r.programs)
+            print_programs(r.program_figures, r.engines.lucent, nullptr, r.program_differences);
         return;
     }
     std::printf("embree build %.2f ms\n", r.embree_build_ms);
@@ -356,7 +342,52 @@ void print_text(const RaysResult& r) {
         std::printf("checksums agree with embree\n");
     else
         std::printf("checksums differ from embree: %s\n", r.differences.c_str());
+    if (r.programs)
+        print_programs(r.program_figures, r.engines.lucent, &r.engines.peer, r.program_differences);
 }
+
+#ifdef LUCENT_HAVE_CUDA
+/// `--programs --backend cuda`: the programs on the GPU, their checksums against the CPU
+/// kernels' on the same rays (TriangleAccel, one pass of each set).
+void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, const Camera& cam,
+                       unsigned threads) {
+    accel::TriangleAccel accel;
+    accel.build(mesh.positions, mesh.indices, {});
+    const RaySet primary = primary_rays(cam, options.width, options.height);
+    ProgramsInput in;
+    in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
+    in.backend = BackendKind::kCuda, in.repeat = options.repeat;
+    const ProgramsResult p = run_programs(in);
+    auto none = [](auto&&...) { return false; };
+    const BenchResult kernels = run_engines(
+        primary, mesh, cam.light, threads, 1,
+        [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
+            accel::TriangleHit hit;
+            if (!accel.intersect(o, d, 0.0f, tmax, hit)) return false;
+            t = hit.t;
+            prim = hit.prim;
+            return true;
+        },
+        [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); }, none,
+        none, false);
+    const std::string differences = checksum_differences(p, kernels.lucent, "programs", "kernels");
+    if (options.json) {
+        Json j = json_engine(engine_of(p));
+        j["backend"] = p.backend;
+        j["timing"] = p.timing;
+        j["checksums_agree_with_cpu_kernels"] = differences.empty();
+        print_json(Json{{"scene", options.scene}, {"programs", j}});
+        return;
+    }
+    std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
+                p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
+    print_engine("programs ", engine_of(p));
+    if (differences.empty())
+        std::printf("programs' checksums agree with the CPU kernels\n");
+    else
+        std::printf("programs' checksums differ from the CPU kernels: %s\n", differences.c_str());
+}
+#endif
 
 }  // namespace
 
@@ -379,7 +410,9 @@ int run_bench_rays(const RaysOptions& options) {
         in.camera = cam;
         in.width = options.width, in.height = options.height;
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
-        return cuda::run_bench_rays_cuda(in);
+        const int code = cuda::run_bench_rays_cuda(in);
+        if (code == 0 && options.programs) run_programs_cuda(options, mesh, cam, threads);
+        return code;
 #else
         throw Error(
             "--backend cuda: this lucent was built without the CUDA backend (no CUDA "
@@ -417,6 +450,15 @@ int run_bench_rays(const RaysOptions& options) {
         [&](float3 o, float3 d, float tmax) { return embree_peer->occluded(o, d, 0.0f, tmax); },
         peer);
     result.cpu_isa = accel::cpu_isa_name(accel::active_cpu_isa());
+    if (options.programs) {
+        ProgramsInput in;
+        in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
+        in.backend = BackendKind::kCpu, in.threads = threads, in.repeat = options.repeat;
+        result.programs = true;
+        result.program_figures = run_programs(in);
+        result.program_differences = checksum_differences(
+            result.program_figures, result.engines.lucent, "programs", "kernels");
+    }
     if (peer)
         result.differences =
             checksum_differences(result.engines.lucent, result.engines.peer, "lucent", "embree");

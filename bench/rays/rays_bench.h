@@ -20,6 +20,7 @@ struct RaysOptions {
     unsigned threads = 0;         // 0 = all cores
     bool peer = true;             // run Embree on the same rays when built with it
     bool json = false;            // machine-readable output
+    bool programs = false;  // also the ray sets through a program module (programs_bench.h)
     std::string backend = "cpu";  // "cpu", or "cuda" (rays_bench_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,

@@ -1,0 +1,119 @@
+#include "bench/rays/programs_bench.h"
+
+#include <vector>
+
+#include "bench/rays/rays_programs.h"
+#include "lucent/lucent.h"
+
+namespace lucent::bench {
+
+namespace {
+
+namespace programs = lucent_bench_rays;
+
+constexpr unsigned kPrimaryEntry = 0, kShadowEntry = 1, kDiffuseEntry = 2;
+
+template <class T>
+std::shared_ptr<Buffer> input_buffer(Context& ctx, const std::vector<T>& values) {
+    auto buffer = ctx.create_buffer<T>(BufferType::kInput, unsigned(values.size()));
+    buffer->upload(values);
+    return buffer;
+}
+
+/// A ray-generation program with its own ray set bound to it (its own variable scope).
+std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySet& rays) {
+    auto program = ctx.create_program(name);
+    (*program)["origins"] = input_buffer(ctx, rays.origin);
+    (*program)["directions"] = input_buffer(ctx, rays.direction);
+    (*program)["tmax"] = input_buffer(ctx, rays.tmax);
+    return program;
+}
+
+/// Mrays/s of `repeat` launches of `entry` over `count` rays, after one untimed launch.
+Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing) {
+    std::vector<double> mrays;
+    ctx.launch(entry, unsigned(count));  // compiles the scene and, on the GPU, the megakernel
+    for (int run = 0; run < repeat; ++run) {
+        ctx.launch(entry, unsigned(count));
+        const LaunchReport& report = ctx.last_launch();
+        const bool kernel = report.kernel_ms > 0;
+        timing = kernel ? "kernel" : "launch";
+        const double ms = kernel ? report.kernel_ms : report.launch_ms;
+        mrays.push_back(ms > 0 ? count / (ms * 1e3) : 0.0);
+    }
+    return rate_of(mrays);
+}
+
+}  // namespace
+
+ProgramsResult run_programs(const ProgramsInput& in) {
+    const scene::ObjMesh& mesh = *in.mesh;
+    const RaySet& primary = *in.primary;
+    ContextOptions options;
+    options.backend = in.backend;
+    options.threads = in.threads;
+    Context ctx(options);
+    ctx.add_module("lucent_bench_rays");
+    ctx.set_ray_type<programs::RayHit>(programs::kBenchRay, "bench");
+    ctx.set_miss_program(programs::kBenchRay, ctx.create_program("record_miss"));
+
+    auto triangles = ctx.create_geometry_triangles();
+    triangles->set_vertices(input_buffer(ctx, mesh.positions));
+    triangles->set_indices(input_buffer(ctx, mesh.indices));
+    auto material = ctx.create_material();
+    material->set_closest_hit(programs::kBenchRay, ctx.create_program("record_hit"));
+    auto instance = ctx.create_geometry_instance();
+    instance->set_geometry(triangles);
+    instance->add_material(material);
+    auto group = ctx.create_geometry_group();
+    group->add_child(instance);
+    ctx["scene"] = group;
+
+    ProgramsResult res;
+    res.backend = ctx.backend_name();
+    auto closest_outputs = [&](Program& program, size_t count) {
+        auto t = ctx.create_buffer<float>(BufferType::kOutput, unsigned(count));
+        auto prim = ctx.create_buffer<unsigned>(BufferType::kOutput, unsigned(count));
+        program["t"] = t;
+        program["prim"] = prim;
+        return std::pair{t, prim};
+    };
+    auto sum_hits = [](const float* t, size_t count, size_t& hits, double& sum_t) {
+        for (size_t i = 0; i < count; ++i)
+            if (t[i] >= 0.0f) ++hits, sum_t += t[i];
+    };
+
+    // Primary rays, then the shadow and diffuse sets from their hits (BENCH.md).
+    auto primary_program = program_for(ctx, "closest_rays", primary);
+    auto [primary_t, primary_prim] = closest_outputs(*primary_program, primary.size());
+    // Each set's entry point is added when its rays exist (every entry needs its program).
+    ctx.set_entry_point_count(1);
+    ctx.set_ray_generation_program(kPrimaryEntry, primary_program);
+    res.primary = timed_launches(ctx, kPrimaryEntry, primary.size(), in.repeat, res.timing);
+    const float* t = primary_t->data<float>();
+    sum_hits(t, primary.size(), res.primary_hits, res.primary_sum_t);
+    RaySet shadow, diffuse;
+    secondary_rays(primary, t, primary_prim->data<unsigned>(), mesh, in.light, shadow, diffuse);
+    res.shadow_rays = shadow.size();
+    res.diffuse_rays = diffuse.size();
+    if (shadow.size() == 0) return res;  // no primary hit: nothing more to trace
+
+    auto shadow_program = program_for(ctx, "shadow_rays", shadow);
+    auto blocked = ctx.create_buffer<unsigned char>(BufferType::kOutput, unsigned(shadow.size()));
+    (*shadow_program)["blocked"] = blocked;
+    ctx.set_entry_point_count(2);
+    ctx.set_ray_generation_program(kShadowEntry, shadow_program);
+    res.shadow = timed_launches(ctx, kShadowEntry, shadow.size(), in.repeat, res.timing);
+    const unsigned char* b = blocked->data<unsigned char>();
+    for (size_t i = 0; i < shadow.size(); ++i) res.occluded += b[i];
+
+    auto diffuse_program = program_for(ctx, "closest_rays", diffuse);
+    auto [diffuse_t, diffuse_prim] = closest_outputs(*diffuse_program, diffuse.size());
+    ctx.set_entry_point_count(3);
+    ctx.set_ray_generation_program(kDiffuseEntry, diffuse_program);
+    res.diffuse = timed_launches(ctx, kDiffuseEntry, diffuse.size(), in.repeat, res.timing);
+    sum_hits(diffuse_t->data<float>(), diffuse.size(), res.diffuse_hits, res.diffuse_sum_t);
+    return res;
+}
+
+}  // namespace lucent::bench

@@ -1,0 +1,40 @@
+// `lucent bench rays --programs`: the BENCH.md ray sets traced by an ordinary program
+// module (rays_programs.h) launched through a Context, as a user's programs are, on the CPU
+// or the CUDA backend. Beside the bare kernels' figures it shows what the engine's own
+// per-ray path (ray generation, trace, closest hit or miss) costs.
+#pragma once
+
+#include <string>
+
+#include "bench/common/rate.h"
+#include "bench/common/ray_checksums.h"
+#include "bench/rays/ray_sets.h"
+#include "lucent/context.h"
+#include "scene/obj_mesh.h"
+
+namespace lucent::bench {
+
+struct ProgramsInput {
+    const scene::ObjMesh* mesh = nullptr;
+    const RaySet* primary = nullptr;  // primary_rays(); shadow and diffuse follow from its hits
+    float3 light{0, 0, 0};
+    BackendKind backend = BackendKind::kCpu;
+    unsigned threads = 0;  // CPU workers, 0 = one per core
+    int repeat = 5;        // timed launches per ray set (median), after one warm-up launch
+};
+
+/// Mrays/s per ray set and the checksums, in RayChecksums' terms.
+struct ProgramsResult : RayChecksums {
+    Rate primary, shadow, diffuse;
+    std::string backend;  // the Context's backend name
+    // What a launch's time is: "launch" (the CPU backend's whole launch, programs and
+    // thread pool) or "kernel" (the megakernel alone, CUDA events).
+    std::string timing;
+};
+
+/// Builds the Context (one GeometryTriangles under a GeometryGroup, the module's programs),
+/// launches each ray set `repeat` times after a warm-up and reads back the answers of the
+/// last launch. Throws lucent::Error (no GPU for BackendKind::kCuda, a failed launch).
+ProgramsResult run_programs(const ProgramsInput& input);
+
+}  // namespace lucent::bench
