@@ -1,0 +1,81 @@
+// `lucent bench rays --programs` (bench/rays/programs_bench.h): the ray sets traced by the
+// rays_programs.h module through a Context on the CPU give the checksums of the bare
+// traversal (TriangleAccel) on the same rays.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "accel/triangle_accel.h"
+#include "bench/common/bench_camera.h"
+#include "bench/rays/programs_bench.h"
+#include "bench/rays/ray_sets.h"
+
+namespace {
+
+using namespace lucent;
+using namespace lucent::bench;
+
+/// The checksums of TriangleAccel's closest and any-hit queries on the BENCH.md ray sets.
+RayChecksums kernel_checksums(const scene::ObjMesh& mesh, const RaySet& primary, float3 light) {
+    accel::TriangleAccel accel;
+    accel.build(mesh.positions, mesh.indices, {});
+    RayChecksums c;
+    std::vector<float> t(primary.size());
+    std::vector<uint32_t> prim(primary.size());
+    for (size_t i = 0; i < primary.size(); ++i) {
+        accel::TriangleHit hit;
+        const bool h = accel.intersect(primary.origin[i], primary.direction[i], 0.0f,
+                                       primary.tmax[i], hit);
+        t[i] = h ? hit.t : -1.0f;
+        prim[i] = h ? hit.prim : 0;
+        if (h) ++c.primary_hits, c.primary_sum_t += hit.t;
+    }
+    RaySet shadow, diffuse;
+    secondary_rays(primary, t.data(), prim.data(), mesh, light, shadow, diffuse);
+    c.shadow_rays = shadow.size();
+    for (size_t i = 0; i < shadow.size(); ++i)
+        c.occluded += accel.occluded(shadow.origin[i], shadow.direction[i], 0.0f, shadow.tmax[i]);
+    c.diffuse_rays = diffuse.size();
+    for (size_t i = 0; i < diffuse.size(); ++i) {
+        accel::TriangleHit hit;
+        if (accel.intersect(diffuse.origin[i], diffuse.direction[i], 0.0f, diffuse.tmax[i], hit))
+            ++c.diffuse_hits, c.diffuse_sum_t += hit.t;
+    }
+    return c;
+}
+
+TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
+    const std::string scene = std::string(LUCENT_SCENES_DIR) + "/bunny.obj";
+    const scene::ObjMesh mesh = scene::load_obj_mesh(scene);
+    const Camera cam = find_camera(scene);
+    const RaySet primary = primary_rays(cam, 96, 72);
+    const RayChecksums kernels = kernel_checksums(mesh, primary, cam.light);
+    // Every kind of answer occurs: hits and misses, blocked and free shadow rays.
+    ASSERT_GT(kernels.primary_hits, 0u);
+    ASSERT_LT(kernels.primary_hits, primary.size());
+    ASSERT_GT(kernels.occluded, 0u);
+    ASSERT_LT(kernels.occluded, kernels.shadow_rays);
+    ASSERT_GT(kernels.diffuse_hits, 0u);
+
+    ProgramsInput in;
+    in.mesh = &mesh;
+    in.primary = &primary;
+    in.light = cam.light;
+    in.backend = BackendKind::kCpu;
+    in.threads = 2;
+    in.repeat = 1;
+    const ProgramsResult p = run_programs(in);
+    EXPECT_EQ(checksum_differences(p, kernels, "programs", "kernels"), "");
+    EXPECT_EQ(p.primary_hits, kernels.primary_hits);
+    EXPECT_EQ(p.shadow_rays, kernels.shadow_rays);
+    EXPECT_EQ(p.occluded, kernels.occluded);
+    EXPECT_EQ(p.diffuse_rays, kernels.diffuse_rays);
+    EXPECT_EQ(p.diffuse_hits, kernels.diffuse_hits);
+    EXPECT_GT(p.primary.median, 0.0);
+    EXPECT_GT(p.shadow.median, 0.0);
+    EXPECT_GT(p.diffuse.median, 0.0);
+    EXPECT_EQ(p.timing, "launch");
+}
+
+}  // namespace
