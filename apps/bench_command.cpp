@@ -91,7 +91,10 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     t->add_option("--backend", tea.backend, "cpu, cuda or auto")
         ->type_name("KIND")
         ->capture_default_str();
-    t->add_option("--threads", tea.threads, "CPU worker threads, 0 = one per core")->type_name("N");
+    t->add_option("--threads", tea.threads, "CPU worker threads, 0 = one per core")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 4096u).description(""))
+        ->capture_default_str();
     t->add_option("--megabytes", tea.megabytes, "Output per key variant, 1..65536")
         ->type_name("MB")
         ->check(CLI::Range(1u, 65536u).description(""))

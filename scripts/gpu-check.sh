@@ -15,7 +15,13 @@ steps=${*:-render tests sanitizer bench}
 mkdir -p /work/shared/scenes
 [ -e /work/main ] || ln -s "$PWD" /work/main
 [ -f /work/shared/scenes/sponza.obj ] || tar xzf "$B/scenes.tgz" -C /work/shared/scenes
-export LUCENT_CACHE_DIR=/tmp/lucent-kernel-cache
+# A private scratch folder (mktemp: mode 0700, an unpredictable name) for the kernel cache
+# and the logs, never a fixed path in /tmp that another user could plant first.
+work=$(mktemp -d "${TMPDIR:-/tmp}/lucent-gpu-check.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+export LUCENT_CACHE_DIR=$work/kernel-cache
+# Empties the kernel cache, so the next run compiles cold.
+cold_cache() { rm -rf "$LUCENT_CACHE_DIR"; }
 nvidia-smi -L
 
 # compare A.png B.png LABEL: pixels differing by more than 10/255 (HIPRT's image test).
@@ -35,7 +41,7 @@ PY
 for step in $steps; do
 case $step in
 render)
-    rm -rf "$LUCENT_CACHE_DIR"
+    cold_cache
     echo "== whitted 1024x1024: cold JIT, then cached, 1 spp, median of 500 launches"
     $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose
     $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --out "$out/whitted_cuda.png" --verbose --repeat 500
@@ -45,7 +51,7 @@ render)
 examples)
     # The examples built against the installed package: GPU against CPU, and the JIT of a
     # user's module cold, then from the disk cache.
-    rm -rf "$LUCENT_CACHE_DIR"
+    cold_cache
     for e in first-program ambient-occlusion; do
         echo "== example $e: cuda (cold JIT), cuda (cached), cpu"
         $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
@@ -78,10 +84,10 @@ tests)
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
-            if LUCENT_TEST_BACKEND=cuda $R $B/bin/${t}_test --gtest_filter="$name" > /tmp/one.log 2>&1; then
+            if LUCENT_TEST_BACKEND=cuda $R $B/bin/${t}_test --gtest_filter="$name" > "$work/one.log" 2>&1; then
                 pass=$((pass + 1))
             else
-                fail=$((fail + 1)); echo "-- FAILED $name (exit $?)"; grep -vE "^\[|^Running|^Note:|invoke.cuh|__forceinline__|^ +\^$|note #" /tmp/one.log | head -12
+                fail=$((fail + 1)); echo "-- FAILED $name (exit $?)"; grep -vE "^\[|^Running|^Note:|invoke.cuh|__forceinline__|^ +\^$|note #" "$work/one.log" | head -12
             fi
         done
         echo "${t}_test on the GPU: $pass passed, $fail failed"
@@ -92,11 +98,11 @@ sweep)
     for v in "" "-maxrregcount=96" "-maxrregcount=128" "-DLUCENT_GPU_MIN_BLOCKS=3" \
              "--extra-device-vectorization" "-Xptxas=-dlcm=cg"; do
         echo "-- LUCENT_NVRTC_OPTIONS=$v"
-        LUCENT_NVRTC_OPTIONS="$v" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch|JIT"
+        LUCENT_NVRTC_OPTIONS="$v" $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out "$work/s.png" | grep -E "launch|JIT"
     done
     for c in 50; do
         echo "-- LUCENT_GPU_CARVEOUT=$c (shared memory share, default 0: L1 first)"
-        LUCENT_GPU_CARVEOUT=$c $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out /tmp/s.png | grep -E "launch"
+        LUCENT_GPU_CARVEOUT=$c $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 300 --out "$work/s.png" | grep -E "launch"
     done
     ;;
 samples)
@@ -166,9 +172,9 @@ PY
     $R $B/bin/multi_device_test 2>&1 | tail -25
     for list in 0,0 cpu,0; do
         for t in ${MULTI_SUITES:-programs exceptions igi pathtracer}; do
-            LUCENT_TEST_BACKEND=cuda LUCENT_TEST_DEVICES=$list $R $B/bin/${t}_test > /tmp/md.log 2>&1
-            echo "${t}_test through --devices $list: $(grep -E '^\[  (PASSED|FAILED)  \]' /tmp/md.log | tr '\n' ' ')"
-            grep -E '^\[  FAILED  \] [A-Z]' /tmp/md.log | head -5
+            LUCENT_TEST_BACKEND=cuda LUCENT_TEST_DEVICES=$list $R $B/bin/${t}_test > "$work/md.log" 2>&1
+            echo "${t}_test through --devices $list: $(grep -E '^\[  (PASSED|FAILED)  \]' "$work/md.log" | tr '\n' ' ')"
+            grep -E '^\[  FAILED  \] [A-Z]' "$work/md.log" | head -5
         done
     done
     ;;
@@ -196,7 +202,7 @@ profile)
     echo "== ncu: the Whitted megakernel at 1024x1024"
     ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
-        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
+        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out "$work/p.png" 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
     ;;
 profile_igi)
     echo "== ncu: the IGI indirect pass (canonical, 180 VPLs) on Sponza at 800x600"
@@ -206,7 +212,7 @@ profile_igi)
         --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
         --section WarpStateStats --section MemoryWorkloadAnalysis \
         $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
-        --size 800x600 --repeat 3 --out /tmp/p.png 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -90
+        --size 800x600 --repeat 3 --out "$work/p.png" 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -90
     ;;
 profile_igi_pass)
     # One pass of an IGI frame with all three accelerations, Sponza 800x600, under ncu. Seven
@@ -218,11 +224,11 @@ profile_igi_pass)
     LUCENT_SCENE_PATH=/work/shared/scenes LUCENT_NVRTC_OPTIONS="-lineinfo" ncu \
         --kernel-name lucent_megakernel --launch-skip ${IGI_LAUNCH:-22} --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
-        --section SourceCounters -f -o /tmp/igi_pass \
+        --section SourceCounters -f -o $work/igi_pass \
         $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
         --size 800x600 --set imperfect_visibility=1 --set downsample=4 --set interleave=3 \
-        --repeat 5 --out /tmp/p.png 2>&1 | tail -3
-    ncu -i /tmp/igi_pass.ncu-rep --print-summary none 2>&1 | grep -vE "^==PROF==|^ +-+$" | \
+        --repeat 5 --out "$work/p.png" 2>&1 | tail -3
+    ncu -i $work/igi_pass.ncu-rep --print-summary none 2>&1 | grep -vE "^==PROF==|^ +-+$" | \
         grep -E "Duration|Registers|Occupancy|Warp Cycles|Issued|Eligible|Stall|Block Limit|Threads|Grid" | head -40
     ;;
 profile_cwbvh)
@@ -238,10 +244,10 @@ profile_cwbvh)
 hotspots)
     echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"
     LUCENT_NVRTC_OPTIONS="-lineinfo" ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
-        --section SourceCounters --section WarpStateStats -f -o /tmp/whitted \
-        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out /tmp/p.png 2>&1 | tail -3
-    ncu -i /tmp/whitted.ncu-rep --page source --print-source cuda --csv > "$out/source.csv" 2> "$out/source.err"
-    ncu -i /tmp/whitted.ncu-rep --page source --print-source sass --csv > "$out/sass.csv" 2>> "$out/source.err"
+        --section SourceCounters --section WarpStateStats -f -o $work/whitted \
+        $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out "$work/p.png" 2>&1 | tail -3
+    ncu -i $work/whitted.ncu-rep --page source --print-source cuda --csv > "$out/source.csv" 2> "$out/source.err"
+    ncu -i $work/whitted.ncu-rep --page source --print-source sass --csv > "$out/sass.csv" 2>> "$out/source.err"
     ls -la "$out"; head -c 600 "$out/source.err"
     ;;
 bench)
@@ -273,23 +279,23 @@ python)
     # machine's) from the tree's bindings and the bundle's objects; then its tests with
     # backend "cuda", and TriangleMesh on the BENCH.md rays beside `bench rays --backend cuda`.
     P=$B/python
-    pkg=/tmp/lucent-python/lucent
+    pkg=$work/lucent-python/lucent
     mkdir -p "$pkg"
     cp python/lucent/*.py "$pkg/"
-    printf '#!/bin/sh\nexec %s %s "$@"\n' "$PWD/$R" "$PWD/$B/bin/lucent" > /tmp/lucent-cli
-    chmod +x /tmp/lucent-cli
+    printf '#!/bin/sh\nexec %s %s "$@"\n' "$PWD/$R" "$PWD/$B/bin/lucent" > $work/lucent-cli
+    chmod +x $work/lucent-cli
     ext=$(python3 -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
     echo "== linking the Python module for $(python3 --version) ($ext)"
     g++ -O2 -std=c++20 -shared -fPIC -fvisibility=hidden -DLUCENT_HAVE_CUDA=1 \
         -Ipython/src -I. -Iinclude $(python3 -m pybind11 --includes) python/src/*.cpp \
         $P/objects/*.o -Wl,--start-group $P/lib/*.a -Wl,--end-group -Wl,--exclude-libs,ALL \
         $P/so/*.so* -ldl -lpthread -o "$pkg/_lucent$ext" 2>&1 | grep -v "warning: " | head -20
-    export LD_LIBRARY_PATH=$PWD/$P/so PYTHONPATH=/tmp/lucent-python LUCENT_CLI=/tmp/lucent-cli
+    export LD_LIBRARY_PATH=$PWD/$P/so PYTHONPATH=$work/lucent-python LUCENT_CLI=$work/lucent-cli
     export LUCENT_SCENES_DIR=/work/shared/scenes
     echo "== the Python tests on the GPU (LUCENT_TEST_BACKEND=cuda)"
     LUCENT_TEST_BACKEND=cuda python3 -m pytest -q -p no:cacheprovider python/tests 2>&1 | tail -25
     echo "== TriangleMesh on the BENCH.md rays of sponza on the GPU, beside bench rays --backend cuda"
-    python3 examples/python/bench_rays.py --backend cuda --lucent /tmp/lucent-cli \
+    python3 examples/python/bench_rays.py --backend cuda --lucent $work/lucent-cli \
         --scene /work/shared/scenes/sponza.obj --rounds 3
     ;;
 present)

@@ -32,8 +32,8 @@ figure() {
 
 for round in $(seq "$rounds"); do
     for b in "$base" "$new"; do
-        figure whitted_fps "$b" render --sample whitted --backend cuda --size 1024x1024 --repeat 500 --out /tmp/w.png
-        figure pathtracer_spp_s "$b" render --sample pathtracer --scene cornell --backend cuda --size 1024x1024 --spp 256 --out /tmp/p.png
+        figure whitted_fps "$b" render --sample whitted --backend cuda --size 1024x1024 --repeat 500 --out "$out/w.png"
+        figure pathtracer_spp_s "$b" render --sample pathtracer --scene cornell --backend cuda --size 1024x1024 --spp 256 --out "$out/p.png"
         figure igi_sponza "$b" bench igi --backend cuda --scene "$igi_scene" --frames 50 --vpls 180 --json
         figure fog_fps "$b" bench fog --backend cuda --frames 100 --json
     done

@@ -53,7 +53,10 @@ class Buffer : public ContextObject {
             throw Error(describe() + ": upload of " + std::to_string(values.size()) +
                         " elements into a buffer of " + std::to_string(count()) +
                         "; resize the buffer first");
-        std::memcpy(map<T>(), values.data(), values.size() * sizeof(T));
+        T* mapped = map<T>();
+        // memcpy's pointers must be valid even for no bytes; an empty vector's data() may
+        // be null (UBSan: "null pointer passed as argument 2").
+        if (!values.empty()) std::memcpy(mapped, values.data(), values.size() * sizeof(T));
         unmap();
     }
 

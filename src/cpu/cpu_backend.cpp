@@ -99,7 +99,7 @@ class CpuBackend final : public core::Backend {
                 next_tile = tile_count;  // stop the others early
             }
             set_thread_state(nullptr);
-        });
+        }, unsigned(std::min<uint64_t>(tile_count, ~0u)));  // no more workers than tiles
         if (error) std::rethrow_exception(error);
     }
 
