@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace lucent::samples {
 
@@ -61,8 +62,38 @@ sample_common::PinholeCamera pinhole_camera(const scene::Camera& c, float aspect
 
 std::vector<sample_common::AreaLight> area_lights(const scene::Scene& scene) {
     std::vector<sample_common::AreaLight> areas;
-    for (const auto& l : scene.area_lights) areas.push_back({l.corner, l.edge1, l.edge2, l.emission});
+    for (const auto& l : scene::emitter_lights(scene))
+        areas.push_back({l.corner, l.edge1, l.edge2, l.emission, l.triangle ? 1u : 0u});
     return areas;
+}
+
+float light_power(const sample_common::AreaLight& light) {
+    const float3 e = light.emission;
+    return 3.14159265f * sample_common::light_area(light) * std::max(0.0f, e.x + e.y + e.z);
+}
+
+std::vector<float> light_cdf(const std::vector<sample_common::AreaLight>& lights) {
+    std::vector<double> power;
+    double total = 0;
+    for (const auto& l : lights) total += power.emplace_back(light_power(l));
+    std::vector<float> cdf;
+    double sum = 0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+        sum += total > 0 ? power[i] / total : 1.0 / double(lights.size());
+        cdf.push_back(float(sum));
+    }
+    if (!cdf.empty()) cdf.back() = 1.0f;  // whatever the rounding, pick_light picks one
+    return cdf;
+}
+
+bool report_if_unlit(const scene::Scene& scene, const std::string& sample,
+                     const std::string& fallback) {
+    if (scene::has_lights(scene)) return true;
+    std::fprintf(stderr,
+                 "%s: scene '%s' has no light (no point or area light, no emissive material); "
+                 "%s\n",
+                 sample.c_str(), scene.name.c_str(), fallback.c_str());
+    return false;
 }
 
 void bind_lights(Context& ctx, const scene::Scene& scene) {
@@ -75,8 +106,12 @@ void bind_lights(Context& ctx, const scene::Scene& scene) {
     auto area_buffer =
         ctx.create_buffer<sample_common::AreaLight>(BufferType::kInput, unsigned(areas.size()));
     area_buffer->upload(areas);
+    const std::vector<float> cdf = light_cdf(areas);
+    auto cdf_buffer = ctx.create_buffer<float>(BufferType::kInput, unsigned(cdf.size()));
+    cdf_buffer->upload(cdf);
     ctx["point_lights"] = point_buffer;
     ctx["area_lights"] = area_buffer;
+    ctx["area_light_cdf"] = cdf_buffer;
 }
 
 scene::Image image_from_output(const Buffer& output, unsigned layer) {

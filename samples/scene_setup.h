@@ -36,12 +36,26 @@ std::shared_ptr<GeometryGroup> mesh_group(
     const std::vector<std::shared_ptr<Material>>& materials,
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each = {});
 
-/// The scene's lights as the input buffers "point_lights" and "area_lights" on the context,
-/// in the layouts of samples/common/lights.h (the direct and path tracer samples).
+/// The scene's lights as the input buffers "point_lights", "area_lights" and
+/// "area_light_cdf" (light_cdf of them) on the context, in the layouts of
+/// samples/common/lights.h (the direct and path tracer samples).
 void bind_lights(Context& ctx, const scene::Scene& scene);
 
-/// The scene's area lights in the layout of samples/common/lights.h.
+/// The scene's area lights in the layout of samples/common/lights.h: its declared ones and
+/// its emissive triangles (scene::emitter_lights).
 std::vector<sample_common::AreaLight> area_lights(const scene::Scene& scene);
+
+/// A light's power, pi A L summed over the colour channels (a Lambertian emitter's flux).
+float light_power(const sample_common::AreaLight& light);
+
+/// The cumulative distribution of choosing each light in proportion to its power (the last
+/// entry 1; empty without lights; uniform when none has power), for sample_common::pick_light.
+std::vector<float> light_cdf(const std::vector<sample_common::AreaLight>& lights);
+
+/// When the scene has no light at all (scene::has_lights), one line on stderr naming the
+/// sample, the scene and what the sample does instead (`fallback`); returns whether it has.
+bool report_if_unlit(const scene::Scene& scene, const std::string& sample,
+                     const std::string& fallback);
 
 /// The pinhole camera of a scene::Camera for an image of this aspect (width / height): W
 /// the unit view direction, U and V half the image's width and height at distance 1.

@@ -277,7 +277,12 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
         }
     }
 
-    const json& camera = r.member(root, "camera", "");
+    if (!root.contains("camera")) {  // none given: one that frames the scene
+        if (scene.triangle_count() == 0) r.fail("/camera", "a scene without triangles needs a camera");
+        scene.camera = framing_camera(scene);
+        return scene;
+    }
+    const json& camera = root["camera"];
     r.only(camera, {"eye", "look", "up", "fov"}, "/camera");
     scene.camera.eye = r.vec3(r.member(camera, "eye", "/camera"), "/camera/eye");
     scene.camera.look = r.vec3(r.member(camera, "look", "/camera"), "/camera/look");

@@ -138,7 +138,9 @@ Scene load_obj_scene(const std::string& path) {
         if (!mesh.indices.empty()) scene.meshes.push_back(std::move(mesh));
     }
     if (scene.triangle_count() == 0) fail(path, 0, "the OBJ file has no triangles");
-    // Emissive triangles are what lights an OBJ scene; a camera comes from the JSON wrapper.
+    // Emissive triangles are what lights an OBJ scene (scene::emitter_lights); the camera
+    // frames it, unless a JSON wrapper gives one.
+    scene.camera = framing_camera(scene);
     return scene;
 }
 

@@ -48,11 +48,13 @@ struct PointLight {
     float3 intensity;  // radiant intensity per colour channel
 };
 
-/// An emitting parallelogram: corner + s * edge1 + t * edge2 for s, t in [0, 1]. It emits on
+/// An emitting parallelogram: corner + s * edge1 + t * edge2 for s, t in [0, 1]; or, when
+/// `triangle`, the triangle of s, t >= 0, s + t <= 1 (an emissive mesh triangle). It emits on
 /// one side, the one cross(edge1, edge2) points to (as a ceiling light emits downwards).
 struct AreaLight {
     float3 corner, edge1, edge2;
     float3 emission;  // radiance
+    bool triangle = false;
 };
 
 struct Camera {
@@ -70,6 +72,28 @@ struct Scene {
 
     size_t triangle_count() const;
 };
+
+/// The smallest box holding every vertex of the scene's meshes.
+struct Bounds {
+    float3 lo, hi;
+};
+Bounds scene_bounds(const Scene& scene);
+
+/// A camera on +z of the scene's bounds, looking at their centre, that frames them (what a
+/// scene without a camera of its own gets: an OBJ, or a JSON file without "camera").
+Camera framing_camera(const Scene& scene);
+
+/// Every area light of the scene: its declared ones, then each triangle whose material
+/// emits (Ke in MTL, "emission" in JSON) as a triangle light, unless it lies on a declared
+/// light (the built-in Cornell box's light is both a declared light and its geometry).
+std::vector<AreaLight> emitter_lights(const Scene& scene);
+
+/// True when an emitting triangle of the scene lies on `light` (within `tolerance` of its
+/// plane): the light is then geometry that rays can hit.
+bool has_emitting_geometry(const Scene& scene, const AreaLight& light, float tolerance);
+
+/// True when the scene has a light: a point light, an area light or an emitting triangle.
+bool has_lights(const Scene& scene);
 
 /// The names load_scene accepts without a file.
 std::vector<std::string> builtin_scene_names();

@@ -23,16 +23,13 @@ namespace {
 Scene single_mesh_scene(Mesh mesh) {
     Scene scene;
     scene.name = std::filesystem::path(mesh.name).stem().string();
-    float3 lo = mesh.positions[0], hi = lo;
-    for (const float3& p : mesh.positions) lo = fminf(lo, p), hi = fmaxf(hi, p);
-    const float3 centre = 0.5f * (lo + hi);
-    const float radius = std::max(0.5f * length(hi - lo), 1e-6f);
-    scene.camera = Camera{centre + make_float3(0, 0, 2.8f * radius), centre, {0, 1, 0}, 45};
+    scene.materials.push_back(Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
+    scene.meshes.push_back(std::move(mesh));
+    scene.camera = framing_camera(scene);
+    const float radius = length(scene.camera.eye - scene.camera.look) / 2.8f;
     const float power = 4.0f * radius * radius;  // a few times the mesh's own scale
     scene.point_lights.push_back(
         {scene.camera.eye + make_float3(0, radius, 0), make_float3(power)});
-    scene.materials.push_back(Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
-    scene.meshes.push_back(std::move(mesh));
     return scene;
 }
 }  // namespace

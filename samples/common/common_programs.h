@@ -42,6 +42,13 @@ struct MeshNormalUv {
     float2 uv;
 };
 
+/// The diffuse map's colour at texture coordinate uv: what multiplies a material's Kd (a 1x1
+/// white texel when it has no map, samples/scene_setup.h's DiffuseTextures). OBJ texture
+/// coordinates start at the bottom of the image; texel row 0 is its top.
+LUCENT_HD inline float3 diffuse_texel(const lucent::TextureView& map, float2 uv) {
+    return make_float3(lucent::tex2D(map, make_float2(uv.x, 1.0f - uv.y)));
+}
+
 LUCENT_ATTRIBUTE(mesh_normal, sample_common::MeshRecord, sample_common::MeshNormal) {
     const uint3 t = rec.triangles[prim];
     attr.geometric_normal =

@@ -34,8 +34,15 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
                                             /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(2);  // camera ray, then shadow rays
 
-    // Lights; an emitter with no light source of its own still shows its emission.
+    // Lights: the scene's point and area lights and its emissive triangles; without any, a
+    // headlight at the eye that lights a white surface facing the camera at the scene
+    // camera's distance d to radiance 1 (intensity pi d^2).
     bind_lights(ctx, input);
+    const float d = length(input.camera.look - input.camera.eye);
+    ctx["headlight"] = report_if_unlit(input, "direct", "lighting it with a headlight at the eye")
+                           ? make_float3(0.0f)
+                           : make_float3(3.14159265f * d * d);
+    ctx["camera"] = camera.buffer();
     ctx["area_samples"] = unsigned(options.integer("area_samples"));
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 

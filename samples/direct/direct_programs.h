@@ -42,9 +42,13 @@ struct SurfaceRecord {
     unsigned area_samples;  // per area light: a stratified sqrt(n) x sqrt(n) grid
     float scene_epsilon;
     lucent::Handle top_object;
+    // A scene without lights: a point light of this intensity at the camera's eye (zero:
+    // none), which sees every point the camera's rays hit, so it needs no shadow ray.
+    float3 headlight;
+    lucent::BufferView<const sample_common::PinholeCamera> camera;
 };
 LUCENT_RECORD(SurfaceRecord, Kd, Ke, diffuse_map, point_lights, area_lights, area_samples,
-              scene_epsilon, top_object)
+              scene_epsilon, top_object, headlight, camera)
 
 struct MissRecord {
     float3 background;
@@ -85,9 +89,7 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
                                  ray.direction);
     const float3 origin = p + rec.scene_epsilon * n;
     float3 color = rec.Ke;
-    // OBJ texture coordinates start at the bottom of the image; texel row 0 is its top.
-    const float3 texel =
-        make_float3(lucent::tex2D(rec.diffuse_map, make_float2(attr.uv.x, 1.0f - attr.uv.y)));
+    const float3 texel = sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
     const float3 albedo = rec.Kd * texel * (1.0f / 3.14159265f);  // Lambert: rho / pi
     for (unsigned l = 0; l < rec.point_lights.count(); ++l) {
         const direct::PointLight light = rec.point_lights[l];
@@ -97,21 +99,25 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
             color += albedo * light.intensity *
                      (cos_theta / d2 * direct::visibility(rec, origin, light.position));
     }
+    if (max_component(rec.headlight) > 0.0f) {
+        const float3 to = rec.camera[0u].eye - p;
+        const float d2 = dot(to, to), cos_theta = dot(n, to) / sqrtf(d2);
+        if (cos_theta > 0.0f) color += albedo * rec.headlight * (cos_theta / d2);
+    }
     // Area lights: a stratified grid of points, one shadow ray each (TEA jitter per pixel).
     const uint3 index = lucent::launch_index();
     const unsigned side = rec.area_samples > 1 ? unsigned(sqrtf(float(rec.area_samples))) : 1u;
     for (unsigned l = 0; l < rec.area_lights.count(); ++l) {
         const direct::AreaLight light = rec.area_lights[l];
-        const float3 ln = cross(light.edge1, light.edge2);
-        const float area = length(ln);
-        const float3 light_normal = ln / area;
+        const float area = sample_common::light_area(light);
+        const float3 light_normal = sample_common::light_normal(light);
         float3 sum = make_float3(0.0f);
         for (unsigned s = 0; s < side * side; ++s) {
             const uint2 r = lucent::tea<4>(make_uint2(index.y * 65536u + index.x, s * 16u + l),
                                            lucent::zafar_tea_key());
             const float u = (float(s % side) + lucent::tea_unit_float(r.x)) / float(side);
             const float v = (float(s / side) + lucent::tea_unit_float(r.y)) / float(side);
-            const float3 q = light.corner + u * light.edge1 + v * light.edge2;
+            const float3 q = sample_common::light_point(light, u, v);
             const float3 to = q - p;
             const float d2 = dot(to, to), d = sqrtf(d2);
             // One-sided: the light emits towards cross(edge1, edge2) (scene.h).

@@ -19,27 +19,59 @@ namespace lucent::samples {
 
 namespace {
 
-/// The scene's lights as IGI's point emitters: point lights as they are; each area light as
-/// a side x side grid of cosine lobes at its cells' centres, sharing its power L A pi.
+/// The scene's lights as IGI's point emitters: point lights as they are; each area light
+/// (declared, or an emissive triangle) as a side x side grid of cosine lobes at its cells'
+/// centres (sample_common::light_point's equal-area cells), sharing its power L A pi.
 std::vector<igi::PointEmitter> point_emitters(const scene::Scene& input, int side) {
     std::vector<igi::PointEmitter> lights;
     for (const auto& l : input.point_lights)
         lights.push_back({l.position, l.intensity, make_float3(0.0f)});
-    for (const auto& a : input.area_lights) {
-        const float3 cross_edges = cross(a.edge1, a.edge2);
-        const float area = length(cross_edges);
+    for (const sample_common::AreaLight& a : area_lights(input)) {
+        const float area = sample_common::light_area(a);
         if (!(area > 0.0f)) continue;  // degenerate: emits nothing
-        const float3 normal = cross_edges / area;
+        const float3 normal = sample_common::light_normal(a);
         const float cells = float(side * side);
         for (int j = 0; j < side; ++j)
             for (int i = 0; i < side; ++i) {
                 const float u = (float(i) + 0.5f) / float(side),
                             v = (float(j) + 0.5f) / float(side);
-                lights.push_back(
-                    {a.corner + u * a.edge1 + v * a.edge2, a.emission * (area / cells), normal});
+                lights.push_back({sample_common::light_point(a, u, v),
+                                  a.emission * (area / cells), normal});
             }
     }
     return lights;
+}
+
+/// The light paths shared among the emitters in proportion to their flux (summed over the
+/// colour channels): path p starts at the emitter whose share of the cumulative flux holds
+/// (p + 1/2) / paths, so an emitter of a fraction f of the flux starts about f x paths of
+/// them, a run of consecutive paths, each carrying its flux over its own path count (equal
+/// emitters start equally many, as the paper's round of the lights). An emitter of less than
+/// half a path's share may start none.
+std::vector<igi::LightPath> light_paths(const std::vector<igi::PointEmitter>& lights,
+                                        unsigned paths) {
+    std::vector<double> cumulative;
+    double total = 0;
+    for (const auto& l : lights) {
+        const float3 f = igi::flux(l);
+        total += std::max(0.0f, f.x + f.y + f.z);
+        cumulative.push_back(total);
+    }
+    std::vector<igi::LightPath> out(paths);
+    std::vector<unsigned> count(lights.size(), 0);
+    for (unsigned p = 0; p < paths; ++p) {
+        unsigned e = unsigned(p % lights.size());  // no flux anywhere: take turns
+        if (total > 0) {
+            const double u = (p + 0.5) / paths * total;
+            e = unsigned(std::upper_bound(cumulative.begin(), cumulative.end(), u) -
+                         cumulative.begin());
+            e = std::min(e, unsigned(lights.size() - 1));
+        }
+        out[p].emitter = e;
+        out[p].sequence = ++count[e];
+    }
+    for (auto& path : out) path.flux = igi::flux(lights[path.emitter]) / float(count[path.emitter]);
+    return out;
 }
 
 /// Each triangle's bounding box, lo and hi (two float4), for the boxes graph of imperfect
@@ -104,12 +136,16 @@ void set_up_context(Context& ctx, const IgiOptions& o, float extent) {
     ctx["imperfect_visibility"] = unsigned(o.imperfect);
 }
 
-/// The point emitters and the VPL buffer their particles fill.
+/// The point emitters, where each light path starts, and the VPL buffer their particles fill.
 void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, const IgiConfig& config) {
     auto light_buffer =
         ctx.create_buffer<igi::PointEmitter>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
+    const std::vector<igi::LightPath> paths = light_paths(lights, config.paths);
+    auto path_buffer = ctx.create_buffer<igi::LightPath>(BufferType::kInput, unsigned(paths.size()));
+    path_buffer->upload(paths);
+    ctx["light_paths"] = path_buffer;
     ctx["vpls"] =
         ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
 }
@@ -120,18 +156,24 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 void add_graphs(Context& ctx, const scene::Scene& input) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
+    DiffuseTextures texture_for(ctx);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(igi::kRadianceRay, surface);
         material->set_closest_hit(igi::kParticleRay, particle);
-        (*material)["Kd"] = m.diffuse;
-        (*material)["Ks"] = m.specular;
+        // Glass is the specular tree's refraction and reflection only (igi::dielectric):
+        // neither diffuse nor a mirror, and particles stop at it (no VPL: no albedo).
+        const bool glass = m.kind == scene::MaterialKind::kDielectric;
+        (*material)["Kd"] = glass ? make_float3(0.0f) : m.diffuse;
+        (*material)["Ks"] = glass ? make_float3(0.0f) : m.specular;
         (*material)["Ke"] = m.emission;
+        (*material)["ior"] = glass ? m.ior : 0.0f;
+        (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
     auto boxes = ctx.create_geometry_group();
     auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_bounds));
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_intersect));
@@ -218,7 +260,8 @@ struct IgiScene {
         if (lights.empty())
             throw SettingsError("igi: scene '" + input.name +
                                 "' has no lights; IGI traces its particles from point and area "
-                                "lights (try --scene cornell, or add a light to a JSON scene)");
+                                "lights and emissive triangles (try --scene cornell, give a "
+                                "material Ke in its MTL, or add a light to a JSON scene)");
         set_up_context(ctx, options, scene_extent(input));
         add_lights(ctx, lights, options.config);
         add_graphs(ctx, input);

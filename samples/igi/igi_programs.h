@@ -16,6 +16,7 @@
 
 #include "lucent/device.h"
 #include "samples/common/common_programs.h"
+#include "samples/common/fresnel.h"
 
 namespace igi {
 
@@ -68,8 +69,17 @@ struct Vpl {
     float3 radiance;
 };
 
-/// What a triangle hit gives the hit programs (sample_common::mesh_normal).
-using HitAttributes = sample_common::MeshNormal;
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal_uv): the normal
+/// and the diffuse map's texture coordinate.
+using HitAttributes = sample_common::MeshNormalUv;
+
+/// Which light path starts where: its emitter, its index in that emitter's own Halton
+/// sequence (from 1), and the flux it carries (the emitter's over its paths). The host
+/// shares the paths among the emitters in proportion to their flux (igi.cpp).
+struct LightPath {
+    unsigned emitter, sequence;
+    float3 flux;
+};
 
 /// One layer of the G-buffer of Fig. 3 at a hit: position, normal, the weight of its
 /// irradiance in the pixel (rho for the primary hit, Ks rho for a reflected one) and the
@@ -79,13 +89,14 @@ struct Surfel {
     float distance;
 };
 
-/// The radiance ray's payload. At the primary hit (depth 0), and with the reflection layer at
-/// the first reflected hit (depth 1), the closest hit leaves the indirect term out and hands
-/// the G-buffer layer back instead: `surfel` for its own hit, `reflected` for the hit of its
-/// reflection ray (depth 0 only).
+/// The radiance ray's payload. Where `separate` is set (the primary hit, and with the
+/// reflection layer the first hit a mirror reflects) the closest hit leaves the indirect term
+/// out and hands the G-buffer layer back instead: `surfel` for its own hit, `reflected` for
+/// the hit of its reflection ray (depth 0 only).
 struct RadiancePayload {
     float3 color;
     int depth;
+    unsigned separate;  // 1: hand the G-buffer layer back; 0: the indirect term inline
     Surfel surfel, reflected;
 };
 /// The shadow ray types' declared payload: their rays go through lucent::occluded(), which
@@ -127,12 +138,13 @@ LUCENT_HD inline float wrap01(float x) {
 // ---- records ---------------------------------------------------------------------------
 struct GenerateRecord {
     lucent::BufferView<const PointEmitter> lights;
+    lucent::BufferView<const LightPath> light_paths;  // one per path
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
     unsigned bounces;
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(GenerateRecord, lights, vpls, bounces, scene_epsilon, top_object)
+LUCENT_RECORD(GenerateRecord, lights, light_paths, vpls, bounces, scene_epsilon, top_object)
 
 /// The full-resolution G-buffer of the direct stage (IGI paper, Fig. 3): position (w: the distance
 /// along the eye path, < 0: no hit), normal and the irradiance's weight, each image width x
@@ -159,6 +171,8 @@ struct IndirectParams {
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
+    lucent::TextureView diffuse_map;  // multiplies Kd; a 1x1 white texel when there is none
+    float ior;  // > 0: a smooth dielectric of this index (Fresnel reflection and refraction)
     lucent::BufferView<const PointEmitter> lights;
     lucent::BufferView<const Vpl> vpls;
     float min_d;
@@ -169,7 +183,7 @@ struct SurfaceRecord {
     lucent::Handle vpl_shadow_object;
     unsigned reflection_layer;  // 1: the first reflected hit is G-buffer layer 1
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, ior, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
               imperfect_visibility, vpl_shadow_object, reflection_layer)
 
 // The passes below run over launch_index().z, the G-buffer layer; their images have as many.
@@ -227,8 +241,9 @@ LUCENT_RECORD(ComposeRecord, direct, gbuffer_albedo, indirect, output)
 
 struct ParticleRecord {
     float3 Kd;
+    lucent::TextureView diffuse_map;
 };
-LUCENT_RECORD(ParticleRecord, Kd)
+LUCENT_RECORD(ParticleRecord, Kd, diffuse_map)
 
 /// The crude geometry of imperfect visibility: each triangle's box, lo and hi, two float4
 /// per triangle (made on the host), so a test reads one box rather than an index and three
@@ -302,11 +317,13 @@ LUCENT_HD inline uint2 size2(const lucent::BufferView<T>& b) {
 LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
     const unsigned path = lucent::launch_index().x, paths = lucent::launch_size().x;
     for (unsigned b = 0; b < rec.bounces; ++b) rec.vpls[path * rec.bounces + b] = igi::Vpl{};
-    // Paths go round the lights; each light walks its own Halton sequence (index i), rotated
-    // per light (Cranley-Patterson) so that lights of one area light do not share directions.
-    const unsigned count = rec.lights.count(), light_index = path % count;
+    // The host shared the paths among the lights by flux (LightPath); each light walks its own
+    // Halton sequence (index i), rotated per light (Cranley-Patterson) so that lights of one
+    // area light do not share directions.
+    const igi::LightPath start = rec.light_paths[path];
+    const unsigned light_index = start.emitter;
     const igi::PointEmitter light = rec.lights[light_index];
-    const unsigned i = path / count + 1;
+    const unsigned i = start.sequence;
     const float r2 = igi::halton(light_index + 1, 5), r3 = igi::halton(light_index + 1, 7);
     const float u1 = igi::wrap01(igi::halton(i, 2) + r2), u2 = igi::wrap01(igi::halton(i, 3) + r3);
     float3 direction;
@@ -318,9 +335,8 @@ LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
         direction = make_float3(s * cosf(phi), s * sinf(phi), z);
     }
     float3 origin = light.position;
-    // The light's flux shared by its paths (paths / count of them, rounded).
-    const unsigned light_paths = paths / count + (light_index < paths % count ? 1u : 0u);
-    float3 flux = igi::flux(light) * (1.0f / float(light_paths));
+    float3 flux = start.flux;  // the light's flux shared by its paths
+    (void)paths;
     const unsigned primes[] = {11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71};
     for (unsigned b = 0; b < rec.bounces; ++b) {
         igi::ParticlePayload hit{};
@@ -344,7 +360,41 @@ LUCENT_CLOSEST_HIT(igi_particle_hit, igi::ParticleRecord, igi::ParticlePayload,
     prd.hit = true;
     prd.position = ray.origin + lucent::t_hit() * ray.direction;
     prd.normal = normalize(lucent::object_to_world_normal(attr.geometric_normal));
-    prd.albedo = rec.Kd;
+    prd.albedo = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
+}
+
+/// The radiance along one branch of the specular tree below a hit at `depth`, its hit's
+/// indirect term inline (it hands no G-buffer layer back).
+LUCENT_HD inline float3 inline_branch(const SurfaceRecord& rec, int depth, float3 from,
+                                      float3 towards) {
+    RadiancePayload child{};
+    child.depth = depth + 1;
+    child.separate = 0;
+    child.surfel.distance = -1.0f;
+    lucent::trace(rec.top_object, lucent::make_ray(from, towards, kRadianceRay, 0.0f), child);
+    return child.color;
+}
+
+/// The radiance of a smooth dielectric's two branches of the specular tree at x (the
+/// Whitted tree the paper's direct stage traces for mirrors, here for glass): reflection
+/// weighted by the exact Fresnel reflectance F, refraction by 1 - F and by 1 / eta^2 (the
+/// radiance's compression into the denser side, as the path tracer's glass:
+/// pathtracer_bsdf.h); total internal reflection reflects all. Both branches get their
+/// indirect term inline.
+LUCENT_HD inline float3 dielectric(const SurfaceRecord& rec, int depth, float3 x, float3 direction,
+                                   float3 geometric_normal) {
+    const float3 d = normalize(direction);
+    const float3 ng = normalize(lucent::object_to_world_normal(geometric_normal));
+    const bool outside = dot(ng, d) < 0.0f;  // the winding's front is the outside
+    const float3 n = outside ? ng : -ng;     // towards the incident side
+    const float eta = outside ? rec.ior : 1.0f / rec.ior;  // n_transmitted / n_incident
+    const float f = sample_common::fresnel_dielectric(-dot(d, n), eta);
+    float3 color = make_float3(0.0f);
+    if (f > 0.0f) color += f * inline_branch(rec, depth, x + rec.scene_epsilon * n, reflect(d, n));
+    float3 t;
+    if (f < 1.0f && refract(t, d, n, 1.0f / eta))
+        color += ((1.0f - f) / (eta * eta)) * inline_branch(rec, depth, x - rec.scene_epsilon * n, t);
+    return color;
 }
 
 // ---- the direct stage: direct light, the specular tree, the G-buffer -----------------------
@@ -352,6 +402,7 @@ LUCENT_RAY_GENERATION(igi_camera, igi::CameraRecord) {
     const uint3 p = lucent::launch_index(), n = lucent::launch_size();
     const sample_common::PinholeCamera c = rec.camera[0u];
     igi::RadiancePayload prd{};
+    prd.separate = 1;
     prd.surfel.distance = -1.0f;
     prd.reflected.distance = -1.0f;
     lucent::trace(rec.top_object,
@@ -376,8 +427,9 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
                                  ray.direction);
     const float3 origin = x + rec.scene_epsilon * n;
     float3 color = rec.Ke;
-    const float3 albedo = rec.Kd * (1.0f / 3.14159265f);
-    if (max_component(rec.Kd) > 0.0f) {
+    const float3 rho = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
+    const float3 albedo = rho * (1.0f / 3.14159265f);
+    if (max_component(rho) > 0.0f) {
         for (unsigned l = 0; l < rec.lights.count(); ++l) {
             const igi::PointEmitter light = rec.lights[l];
             const float3 to = light.position - x;
@@ -391,16 +443,19 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
         }
     }
     // The primary hit's indirect term is a stage of its own, and so is the first reflected
-    // hit's with the reflection layer: those hits hand their G-buffer layer back. Deeper hits
-    // get it here.
-    const bool separated = prd.depth == 0 || (prd.depth == 1 && rec.reflection_layer != 0u);
-    if (separated)
-        prd.surfel = igi::Surfel{origin, n, rec.Kd, lucent::t_hit()};
-    else if (max_component(rec.Kd) > 0.0f)
+    // hit's with the reflection layer: those hits hand their G-buffer layer back, whose
+    // albedo is the textured rho, so that composition applies the texture at full resolution
+    // (IGI paper §4.2). Other hits get it here.
+    if (prd.separate)
+        prd.surfel = igi::Surfel{origin, n, rho, lucent::t_hit()};
+    else if (max_component(rho) > 0.0f)
         color += albedo * igi::indirect(igi::indirect_params(rec), origin, n);
+    if (rec.ior > 0.0f && prd.depth + 1 < int(rec.max_depth))
+        color += igi::dielectric(rec, prd.depth, x, ray.direction, attr.geometric_normal);
     if (max_component(rec.Ks) > 0.0f && prd.depth + 1 < int(rec.max_depth)) {
         igi::RadiancePayload reflected{};
         reflected.depth = prd.depth + 1;
+        reflected.separate = prd.depth == 0 && rec.reflection_layer != 0u ? 1u : 0u;
         reflected.surfel.distance = -1.0f;
         lucent::trace(
             rec.top_object,

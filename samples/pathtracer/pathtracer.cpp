@@ -19,32 +19,12 @@ namespace lucent::samples {
 
 namespace {
 
-/// True when an emitting triangle of the scene lies on the light's parallelogram: the light
-/// is then geometry that BSDF-sampled rays can hit, as MIS needs.
-bool has_geometry(const scene::Scene& s, const scene::AreaLight& light, float tolerance) {
-    const float3 normal = cross(light.edge1, light.edge2);
-    const float area2 = dot(normal, normal);
-    for (const scene::Mesh& mesh : s.meshes)
-        for (size_t t = 0; t < mesh.indices.size(); ++t) {
-            if (max_component(s.materials[mesh.materials[t]].emission) <= 0) continue;
-            const uint3 v = mesh.indices[t];
-            const float3 c =
-                (mesh.positions[v.x] + mesh.positions[v.y] + mesh.positions[v.z]) / 3.0f;
-            const float3 w = c - light.corner;
-            const float a = dot(cross(w, light.edge2), normal) / area2;
-            const float b = dot(cross(light.edge1, w), normal) / area2;
-            if (std::fabs(dot(w, normal)) / std::sqrt(area2) <= tolerance && a >= 0 && a <= 1 &&
-                b >= 0 && b <= 1)
-                return true;
-        }
-    return false;
-}
-
 /// A light with no emitting surface (a JSON "area" light) becomes a two-triangle emitter,
-/// so that the light and BSDF strategies cover the same integral.
+/// so that the light and BSDF strategies cover the same integral. (An emissive triangle is
+/// a light already: scene::emitter_lights.)
 void add_light_geometry(scene::Scene& s, float tolerance) {
     for (const scene::AreaLight& light : std::vector<scene::AreaLight>(s.area_lights)) {
-        if (has_geometry(s, light, tolerance)) continue;
+        if (scene::has_emitting_geometry(s, light, tolerance)) continue;
         scene::Material m{"area light", {0, 0, 0}};
         m.emission = light.emission;
         s.materials.push_back(m);
@@ -109,6 +89,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
 
     bind_lights(ctx, input);
     ctx["scene_epsilon"] = epsilon;
+    report_if_unlit(input, "pathtracer", "only the environment option lights it");
 
     std::shared_ptr<Program> closest_hits[] = {
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_lambert)),
@@ -116,12 +97,14 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_dielectric)),
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_coated)),
     };
+    DiffuseTextures texture_for(ctx);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
         material->set_name(m.name);
         material->set_closest_hit(pathtracer::kRadianceRay, closest_hits[int(m.kind)]);
         (*material)["Kd"] = m.diffuse;
+        (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         (*material)["Ks"] = m.specular;
         (*material)["Ke"] = m.emission;
         // Perceptual roughness squared (Burley 2012); a floor keeps GGX finite in float.
@@ -129,7 +112,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         (*material)["ior"] = m.ior;
         materials.push_back(material);
     }
-    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal));
+    auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
     PathScene out;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "lucent/device/vector_math.h"
+#include "samples/common/fresnel.h"
 
 namespace pathtracer {
 
@@ -52,16 +53,8 @@ LUCENT_HD inline float3 sample_cosine_hemisphere(float u1, float u2) {
     return make_float3(r * cosf(phi), r * sinf(phi), sqrtf(lc_max(0.0f, 1.0f - u1)));
 }
 
-/// Unpolarised Fresnel reflectance of a dielectric interface; cos_i >= 0 on the incident
-/// side, eta = n_t / n_i. 1 under total internal reflection.
-LUCENT_HD inline float fresnel_dielectric(float cos_i, float eta) {
-    const float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1.0f) return 1.0f;
-    const float cos_t = sqrtf(1.0f - sin2_t);
-    const float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    const float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    return 0.5f * (rs * rs + rp * rp);
-}
+/// Unpolarised Fresnel reflectance of a dielectric interface (samples/common/fresnel.h).
+using sample_common::fresnel_dielectric;
 
 /// Schlick's approximation (1994) with reflectance f0 at normal incidence.
 LUCENT_HD inline float3 fresnel_schlick(float3 f0, float cos_theta) {

@@ -37,8 +37,9 @@ struct ShadowPayload {  // the shadow ray type's declared payload; lucent::occlu
     float visible;
 };
 
-/// What a triangle hit gives the hit programs (sample_common::mesh_normal).
-using HitAttributes = sample_common::MeshNormal;
+/// What a triangle hit gives the hit programs (sample_common::mesh_normal_uv): the normal
+/// and the texture coordinate of the diffuse map.
+using HitAttributes = sample_common::MeshNormalUv;
 
 /// PCG-RXS-M-XS 32 (O'Neill 2014) as a stream: advances the state, returns [0, 1).
 LUCENT_HD inline float next_random(unsigned& state) {
@@ -62,25 +63,20 @@ LUCENT_HD inline float power_heuristic(float pdf_a, float pdf_b) {
 }
 
 /// Solid-angle pdf with which next_event would choose the point at distance t along the unit
-/// direction from origin: one light of n uniformly, then a uniform point on its area.
-LUCENT_HD inline float area_light_pdf(lucent::BufferView<AreaLight> lights, float3 origin,
+/// direction from origin: light l with probability p(l) (its power's share), then a uniform
+/// point on its area A_l, p(l) / A_l per unit area; per solid angle that is
+/// p(l) / A_l x t^2 / cos(theta_light) (Veach 1997, §8.2.2.2).
+LUCENT_HD inline float area_light_pdf(lucent::BufferView<AreaLight> lights,
+                                      lucent::BufferView<const float> cdf, float3 origin,
                                       float3 direction, float t) {
     float pdf = 0.0f;
-    const unsigned n = lights.count();
-    for (unsigned l = 0; l < n; ++l) {
+    for (unsigned l = 0; l < lights.count(); ++l) {
         const AreaLight light = lights[l];
-        const float3 normal = cross(light.edge1, light.edge2);
-        const float denom = dot(direction, normal);
-        if (denom >= 0.0f) continue;  // its back, which does not emit
-        const float tl = dot(light.corner - origin, normal) / denom;
-        if (fabsf(tl - t) > 1e-3f * t + 1e-6f) continue;  // the hit is not on this light
-        const float3 w = origin + tl * direction - light.corner;
-        const float area2 = dot(normal, normal);
-        const float s = dot(cross(w, light.edge2), normal) / area2;
-        const float v = dot(cross(light.edge1, w), normal) / area2;
-        if (s < 0.0f || s > 1.0f || v < 0.0f || v > 1.0f) continue;
-        const float area = sqrtf(area2), cos_light = fabsf(denom) / area;
-        pdf += tl * tl / (cos_light * area * float(n));
+        const float tl = sample_common::light_hit_distance(light, origin, direction);
+        if (tl <= 0.0f || fabsf(tl - t) > 1e-3f * t + 1e-6f) continue;  // not on this light
+        const float cos_light = -dot(sample_common::light_normal(light), direction);
+        pdf += sample_common::light_probability(cdf, l) * tl * tl /
+               (cos_light * sample_common::light_area(light));
     }
     return pdf;
 }
@@ -102,14 +98,16 @@ LUCENT_RECORD(CameraRecord, camera, accum, output, top_object, max_depth, rr_dep
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
+    lucent::TextureView diffuse_map;  // multiplies Kd; a 1x1 white texel when there is none
     float alpha, ior;
     lucent::BufferView<AreaLight> area_lights;
+    lucent::BufferView<const float> area_light_cdf;  // next-event estimation picks by power
     lucent::BufferView<PointLight> point_lights;
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, alpha, ior, area_lights, point_lights, scene_epsilon,
-              top_object)
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, alpha, ior, area_lights, area_light_cdf,
+              point_lights, scene_epsilon, top_object)
 
 struct MissRecord {
     float3 environment;  // uniform radiance from every direction
@@ -125,27 +123,28 @@ LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 d
         lucent::make_ray(from, direction, kShadowRay, 0.0f, distance - 2.0f * rec.scene_epsilon));
 }
 
-/// Next-event estimation at p: one point on one area light chosen uniformly, weighted by the
-/// power heuristic against BSDF sampling; every point light (delta: no MIS).
+/// Next-event estimation at p: one area light chosen in proportion to its power, a uniform
+/// point on its area, weighted by the power heuristic against BSDF sampling; every point
+/// light (delta: no MIS).
 LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, const Frame& frame,
                                    float3 wo, float3 p, unsigned& rng) {
     float3 sum = make_float3(0.0f);
     const unsigned n = rec.area_lights.count();
     if (n > 0) {
-        unsigned l = unsigned(next_random(rng) * float(n));
-        if (l >= n) l = n - 1;
+        const unsigned l = sample_common::pick_light(rec.area_light_cdf, next_random(rng));
         const float u = next_random(rng), v = next_random(rng);
         const AreaLight light = rec.area_lights[l];
-        const float3 q = light.corner + u * light.edge1 + v * light.edge2;
-        const float3 normal = cross(light.edge1, light.edge2);
-        const float area = length(normal);
+        const float3 q = sample_common::light_point(light, u, v);
+        const float area = sample_common::light_area(light);
         const float3 to = q - p;
         const float d2 = dot(to, to), d = sqrtf(d2);
         const float3 wi = to / d;
-        const float cos_light = -dot(normal, wi) / area;  // > 0 on its emitting side
+        const float cos_light = -dot(sample_common::light_normal(light), wi);  // > 0: emitting side
         const float3 wi_local = to_local(frame, wi);
-        if (cos_light > 0.0f && wi_local.z > 0.0f) {
-            const float pdf_light = d2 / (cos_light * area * float(n));
+        const float chosen = sample_common::light_probability(rec.area_light_cdf, l);
+        if (cos_light > 0.0f && wi_local.z > 0.0f && chosen > 0.0f) {
+            // The area pdf p(l) / A as a solid-angle pdf: times d^2 / cos(theta_light).
+            const float pdf_light = chosen * d2 / (cos_light * area);
             const float3 f = bsdf_eval(bsdf, wo, wi_local);
             if (max_component(f) > 0.0f && unoccluded(rec, p, wi, d)) {
                 const float w = power_heuristic(pdf_light, bsdf_pdf(bsdf, wo, wi_local));
@@ -179,10 +178,12 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
     // Surfaces emit on the side their winding makes the front, as area lights do.
     prd.emitted = outside ? rec.Ke : make_float3(0.0f);
     prd.light_pdf = outside && max_component(rec.Ke) > 0.0f
-                        ? area_light_pdf(rec.area_lights, ray.origin, ray.direction, t)
+                        ? area_light_pdf(rec.area_lights, rec.area_light_cdf, ray.origin,
+                                         ray.direction, t)
                         : 0.0f;
 
-    const Bsdf bsdf{Kind, rec.Kd, rec.Ks, rec.alpha,
+    const float3 diffuse = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
+    const Bsdf bsdf{Kind, diffuse, rec.Ks, rec.alpha,
                     Kind == kDielectric && !outside ? 1.0f / rec.ior : rec.ior};
     const Frame frame = make_frame(n);
     const float3 wo = to_local(frame, -ray.direction);

@@ -19,14 +19,10 @@ namespace lucent::samples {
 
 namespace {
 
-Bounds3 scene_bounds(const scene::Scene& scene) {
-    Bounds3 b{make_float3(1e30f), make_float3(-1e30f)};
-    for (const auto& mesh : scene.meshes)
-        for (const float3& p : mesh.positions) {
-            b.lo = fminf(b.lo, p);
-            b.hi = fmaxf(b.hi, p);
-        }
-    return b;
+/// The scene's bounds as the VPL grid takes them.
+Bounds3 grid_bounds(const scene::Scene& scene) {
+    const scene::Bounds b = scene::scene_bounds(scene);
+    return Bounds3{b.lo, b.hi};
 }
 
 /// The sample's --set options, checked.
@@ -47,13 +43,15 @@ struct Options {
           clamp(v.number("clamp")) {}
 };
 
-/// The scene of settings.scene (default: cornell); SettingsError when it has no area light.
+/// The scene of settings.scene (default: cornell); SettingsError when it has no area light
+/// (declared, or an emissive triangle).
 scene::Scene load_lit_scene(const RenderSettings& settings) {
     scene::Scene input = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
-    if (input.area_lights.empty())
+    if (area_lights(input).empty())
         throw SettingsError("radiosity: scene '" + input.name +
-                            "' has no area light; the photons leave area lights (try --scene "
-                            "cornell, or add {\"type\": \"area\", ...} to a JSON scene's lights)");
+                            "' has no area light nor emissive triangle; the photons leave area "
+                            "lights (try --scene cornell, give a material Ke in its MTL, or add "
+                            "{\"type\": \"area\", ...} to a JSON scene's lights)");
     return input;
 }
 
@@ -114,9 +112,13 @@ Passes create_passes(Context& ctx, const scene::Scene& input, const Options& opt
     auto light_buffer =
         ctx.create_buffer<sample_common::AreaLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
+    const std::vector<float> cdf = light_cdf(lights);
+    auto cdf_buffer = ctx.create_buffer<float>(BufferType::kInput, unsigned(cdf.size()));
+    cdf_buffer->upload(cdf);
     ctx["area_lights"] = light_buffer;
+    ctx["area_light_cdf"] = cdf_buffer;
     p.lights = unsigned(lights.size());
-    p.photons = options.photon_side * options.photon_side * p.lights;
+    p.photons = options.photon_side * options.photon_side;
     p.scattered =
         ctx.create_buffer<radiosity::Vpl>(BufferType::kInputOutput, p.photons * options.bounces);
 
@@ -157,7 +159,7 @@ std::vector<radiosity::Vpl> read_vpls(Buffer& buffer) {
 void merge(const std::vector<radiosity::Vpl>& raw, size_t live, const scene::Scene& input,
            const Options& options, Passes& passes, RenderResult& out) {
     const Clock::time_point merge_start = Clock::now();
-    std::vector<radiosity::Vpl> cells = merge_vpls(raw, scene_bounds(input), options.grid);
+    std::vector<radiosity::Vpl> cells = merge_vpls(raw, grid_bounds(input), options.grid);
     if (cells.empty()) cells.push_back(radiosity::Vpl{});  // no photon hit: nothing to add
     passes.merged->resize(unsigned(cells.size()));
     passes.merged->upload(cells);
@@ -180,11 +182,11 @@ void keep_vpl_layers(const std::vector<radiosity::Vpl>& raw, const Options& opti
     if (options.merge) out.layers["merged_vpl_power"] = vpl_image(read_vpls(*passes.merged));
 }
 
-/// The frame: photons (one thread each, sqrt(N) x sqrt(N) per light, the blog's launch),
+/// The frame: photons (one thread each, sqrt(N) x sqrt(N), the blog's launch; a light each),
 /// merging, the G-buffer and shading, each a stage.
 void render_passes(Context& ctx, const scene::Scene& input, const Options& options,
                    const RenderSettings& settings, Passes& passes, RenderResult& out) {
-    ctx.launch(radiosity::kPhotonEntry, options.photon_side, options.photon_side, passes.lights);
+    ctx.launch(radiosity::kPhotonEntry, options.photon_side, options.photon_side, 1);
     const LaunchReport first = ctx.last_launch();
     add_compile_stages(first, out.stages);
     out.stages.push_back({"photons", first.launch_ms,
@@ -258,7 +260,8 @@ class RadiositySample final : public Sample {
                  {
                      SampleOption::integer(
                          "photons", 1024, 1, 1 << 20,
-                         "photons per area light, traced from a jittered sqrt(N) x sqrt(N) grid"),
+                         "photons, traced from a jittered sqrt(N) x sqrt(N) grid of directions; each "
+                         "from an area light chosen in proportion to its power"),
                      SampleOption::integer("bounces", 3, 1, 16, "most VPLs a photon leaves"),
                      SampleOption::toggle(
                          "roulette", true,

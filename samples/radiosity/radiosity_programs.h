@@ -61,6 +61,7 @@ LUCENT_RECORD(SurfaceRecord, Kd, Ke, diffuse_map)
 
 struct PhotonRecord {
     lucent::BufferView<AreaLight> area_lights;
+    lucent::BufferView<const float> area_light_cdf;  // each light's share of the photons: its power
     lucent::BufferView<Vpl> vpls;  // photons x bounces slots; unused ones have zero power
     unsigned bounces;
     unsigned roulette;  // 1: Russian roulette after the first bounce
@@ -68,7 +69,7 @@ struct PhotonRecord {
     float scene_epsilon;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(PhotonRecord, area_lights, vpls, bounces, roulette, vpl_offset, scene_epsilon,
+LUCENT_RECORD(PhotonRecord, area_lights, area_light_cdf, vpls, bounces, roulette, vpl_offset, scene_epsilon,
               top_object)
 
 struct GBufferRecord {
@@ -119,14 +120,13 @@ LUCENT_HD inline float3 direct_irradiance(const ShadeRecord& rec, float3 x, floa
     const unsigned side = rec.area_samples > 1 ? unsigned(sqrtf(float(rec.area_samples))) : 1u;
     for (unsigned l = 0; l < rec.area_lights.count(); ++l) {
         const AreaLight light = rec.area_lights[l];
-        const float3 ln = cross(light.edge1, light.edge2);
-        const float area = length(ln);
-        const float3 light_normal = ln / area;
+        const float area = sample_common::light_area(light);
+        const float3 light_normal = sample_common::light_normal(light);
         for (unsigned s = 0; s < side * side; ++s) {
             const float2 r = random2(pixel, s * 64u + l);
             const float u = (float(s % side) + r.x) / float(side);
             const float v = (float(s / side) + r.y) / float(side);
-            const float3 q = light.corner + u * light.edge1 + v * light.edge2;
+            const float3 q = sample_common::light_point(light, u, v);
             const float3 to = q - x;
             const float d2 = dot(to, to), d = sqrtf(d2);
             const float cos_x = dot(n, to) / d, cos_light = -dot(light_normal, to) / d;
@@ -163,19 +163,24 @@ LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
     const unsigned photon = (i.z * n.y + i.y) * n.x + i.x;
     for (unsigned b = 0; b < rec.bounces; ++b)
         rec.vpls[photon * rec.bounces + b] = radiosity::Vpl{};
-    const radiosity::AreaLight light = rec.area_lights[i.z];
-    const float3 ln = cross(light.edge1, light.edge2);
-    const float area = length(ln);
-    const float3 light_normal = ln / area;
+    // The light in proportion to its power (one light: always it), so that every photon
+    // carries about the same flux whatever the number of emitters.
+    const unsigned l =
+        sample_common::pick_light(rec.area_light_cdf, radiosity::random2(photon, 0x53u).x);
+    const radiosity::AreaLight light = rec.area_lights[l];
+    const float area = sample_common::light_area(light);
+    const float3 light_normal = sample_common::light_normal(light);
     // A uniform point on the light; the direction from the jittered grid cell (x, y) of the
     // cosine-distributed hemisphere, as the blog's generateHemisphereLightPhoton.
     const float2 at = radiosity::random2(photon, 0x51u);
     const float2 jitter = radiosity::random2(photon, 0x52u);
-    float3 origin = light.corner + at.x * light.edge1 + at.y * light.edge2;
+    float3 origin = sample_common::light_point(light, at.x, at.y);
     float3 direction = radiosity::cosine_direction(
         light_normal, (float(i.x) + jitter.x) / float(n.x), (float(i.y) + jitter.y) / float(n.y));
-    // The light's flux pi L A, shared equally by its n.x * n.y photons.
-    float3 flux = light.emission * (3.14159265f * area / float(n.x * n.y));
+    // The light's flux pi L A over the expected number of its photons, n.x n.y p(l).
+    float3 flux = light.emission *
+                  (3.14159265f * area /
+                   (float(n.x * n.y) * sample_common::light_probability(rec.area_light_cdf, l)));
     for (unsigned b = 0; b < rec.bounces; ++b) {
         radiosity::SurfacePayload hit{};
         hit.distance = -1.0f;
@@ -226,10 +231,7 @@ LUCENT_CLOSEST_HIT(radiosity_surface, radiosity::SurfaceRecord, radiosity::Surfa
     prd.position = ray.origin + lucent::t_hit() * ray.direction;
     prd.normal = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
                              ray.direction);
-    // OBJ texture coordinates start at the bottom of the image; texel row 0 is its top.
-    const float3 texel =
-        make_float3(lucent::tex2D(rec.diffuse_map, make_float2(attr.uv.x, 1.0f - attr.uv.y)));
-    prd.albedo = rec.Kd * texel;
+    prd.albedo = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
     prd.emission = rec.Ke;
     prd.distance = lucent::t_hit();
 }

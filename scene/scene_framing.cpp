@@ -1,0 +1,31 @@
+// The bounds of a scene and the camera that frames them, for scenes that bring no camera.
+#include <algorithm>
+#include <cmath>
+
+#include "lucent/error.h"
+#include "scene/scene.h"
+
+namespace lucent::scene {
+
+Bounds scene_bounds(const Scene& scene) {
+    Bounds b{make_float3(1e30f), make_float3(-1e30f)};
+    for (const Mesh& mesh : scene.meshes)
+        for (const float3& p : mesh.positions) {
+            b.lo = fminf(b.lo, p);
+            b.hi = fmaxf(b.hi, p);
+        }
+    return b;
+}
+
+Camera framing_camera(const Scene& scene) {
+    if (scene.triangle_count() == 0)
+        throw Error("framing_camera: scene '" + scene.name + "' has no triangles to frame");
+    const Bounds b = scene_bounds(scene);
+    const float3 centre = 0.5f * (b.lo + b.hi);
+    const float radius = std::max(0.5f * length(b.hi - b.lo), 1e-6f);
+    // The bounding sphere fits the 45-degree vertical field of view from 2.8 radii away
+    // (sin 22.5 degrees = 0.38 > 1 / 2.8), in front of the +z face.
+    return Camera{centre + make_float3(0, 0, 2.8f * radius), centre, {0, 1, 0}, 45};
+}
+
+}  // namespace lucent::scene
