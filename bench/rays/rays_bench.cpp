@@ -290,6 +290,20 @@ void print_programs(const ProgramsResult& p, const EngineResult& kernels, const 
         std::printf("programs' checksums differ from the kernels: %s\n", differences.c_str());
 }
 
+/// Lucent's bare CPU traversal as the (closest, occluded) bodies run_engines times.
+auto closest_query(const accel::TriangleAccel& accel) {
+    return [&accel](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
+        accel::TriangleHit hit;
+        if (!accel.intersect(o, d, 0.0f, tmax, hit)) return false;
+        t = hit.t;
+        prim = hit.prim;
+        return true;
+    };
+}
+auto occluded_query(const accel::TriangleAccel& accel) {
+    return [&accel](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); };
+}
+
 Json to_json(const RaysResult& r) {
     const RaysOptions& o = *r.options;
     Json j{{"scene", o.scene},
@@ -361,14 +375,7 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     auto none = [](auto&&...) { return false; };
     const BenchResult kernels = run_engines(
         primary, mesh, cam.light, threads, 1,
-        [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
-            accel::TriangleHit hit;
-            if (!accel.intersect(o, d, 0.0f, tmax, hit)) return false;
-            t = hit.t;
-            prim = hit.prim;
-            return true;
-        },
-        [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); }, none,
+        closest_query(accel), occluded_query(accel), none,
         none, false);
     const std::string differences = checksum_differences(p, kernels.lucent, "programs", "kernels");
     if (options.json) {
@@ -436,14 +443,7 @@ int run_bench_rays(const RaysOptions& options) {
     const RaySet primary = primary_rays(cam, options.width, options.height);
     result.engines = run_engines(
         primary, mesh, cam.light, threads, options.repeat,
-        [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
-            accel::TriangleHit hit;
-            if (!accel.intersect(o, d, 0.0f, tmax, hit)) return false;
-            t = hit.t;
-            prim = hit.prim;
-            return true;
-        },
-        [&](float3 o, float3 d, float tmax) { return accel.occluded(o, d, 0.0f, tmax); },
+        closest_query(accel), occluded_query(accel),
         [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
             return embree_peer->intersect(o, d, 0.0f, tmax, t, prim);
         },
