@@ -45,10 +45,28 @@ RayChecksums kernel_checksums(const scene::ObjMesh& mesh, const RaySet& primary,
     return c;
 }
 
+/// A scene that needs no files (CI has no shared scenes): a floor, a back wall and a quad
+/// floating above the floor, so that the camera's rays both hit and miss and the light
+/// above is blocked for part of the floor.
+scene::ObjMesh open_box_with_occluder() {
+    scene::ObjMesh mesh;
+    auto quad = [&](float3 a, float3 b, float3 c, float3 d) {
+        const unsigned base = (unsigned)mesh.positions.size();
+        for (float3 v : {a, b, c, d}) mesh.positions.push_back(v);
+        mesh.indices.push_back(make_uint3(base, base + 1, base + 2));
+        mesh.indices.push_back(make_uint3(base, base + 2, base + 3));
+    };
+    quad(make_float3(-1, 0, -1), make_float3(-1, 0, 1), make_float3(1, 0, 1), make_float3(1, 0, -1));
+    quad(make_float3(-1, 0, -1), make_float3(1, 0, -1), make_float3(1, 1, -1), make_float3(-1, 1, -1));
+    quad(make_float3(-0.3f, 0.6f, -0.3f), make_float3(0.3f, 0.6f, -0.3f),
+         make_float3(0.3f, 0.6f, 0.3f), make_float3(-0.3f, 0.6f, 0.3f));
+    return mesh;
+}
+
 TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
-    const std::string scene = std::string(LUCENT_SCENES_DIR) + "/bunny.obj";
-    const scene::ObjMesh mesh = scene::load_obj_mesh(scene);
-    const Camera cam = find_camera(scene);
+    const scene::ObjMesh mesh = open_box_with_occluder();
+    const Camera cam{make_float3(0, 0.8f, 3), make_float3(0, 0.4f, 0), make_float3(0, 1, 0),
+                     60.0f, make_float3(0.1f, 1.5f, 0.1f)};
     const RaySet primary = primary_rays(cam, 96, 72);
     const RayChecksums kernels = kernel_checksums(mesh, primary, cam.light);
     // Every kind of answer occurs: hits and misses, blocked and free shadow rays.
