@@ -214,11 +214,13 @@ TEST(Modules, RunTimeTextMustMatchTheTextTheProgramEmbeds) {
                  {"test_twin_a", "/elsewhere/twin_a_programs.h", embedded->main}, "another text");
     // The same text is accepted.
     EXPECT_EQ(ctx.add_module(*embedded).name(), "test_twin_a");
-    // A module whose C++ side is not in this program cannot be added by text.
+    // A module whose C++ side is not in this program is compiled at run time, which needs
+    // a program that exports its symbols; this one does not, and the error says so.
     TempDir dir;
     const std::string stranger = dir.write("stranger.h", "namespace s {\nLUCENT_MODULE(stranger)\n}\n");
     expect_error([&] { ctx.add_module(ModuleSource::from_file(stranger)); },
-                 {"stranger", "stranger.h", "include"}, "a module not compiled in");
+                 {"stranger", "stranger.h", "ENABLE_EXPORTS", "include"},
+                 "a module not compiled in");
 }
 
 /// The suites' backend; on the CPU with the JIT check, so the megakernel is made either way.

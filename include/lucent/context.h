@@ -173,8 +173,13 @@ class Context : public VariableScope {
     /// modules there are when none has this name.
     const ModuleInfo& add_module(std::string_view name);
     /// The same with the module's text given at run time (its LUCENT_MODULE names the
-    /// module). Throws Error when this binary embeds a different text for it, or when its
-    /// C++ side is not compiled in.
+    /// module). A module that is not compiled into this binary is compiled now with the
+    /// system's C++ compiler ($LUCENT_CXX, $CXX or c++ on PATH; $LUCENT_CXXFLAGS adds
+    /// flags) into a shared library that is loaded and kept in the kernel cache's folder;
+    /// an executable that does this needs ENABLE_EXPORTS (-rdynamic). Throws Error with the
+    /// compiler's messages when it rejects the text, when no compiler is found, when this
+    /// binary embeds a different text for the module, or when this process already loaded
+    /// another text under its name.
     const ModuleInfo& add_module(ModuleSource source);
     /// The modules this context knows: added, or the modules of the programs it created.
     std::vector<const ModuleInfo*> added_modules() const;

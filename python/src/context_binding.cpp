@@ -131,12 +131,34 @@ void bind_context(py::module_& m) {
         .def_property("print_enabled", &Context::print_enabled, &Context::set_print_enabled)
         .def(
             "add_module",
-            [](Context& c, const std::string& name) -> const ModuleInfo& {
-                return c.add_module(name);
+            [](Context& c, const std::optional<std::string>& module,
+               const std::optional<std::string>& file, const std::string& name,
+               const std::vector<std::string>& include_dirs) -> const ModuleInfo& {
+                if (module && file)
+                    throw py::value_error("Context.add_module: give a module (its name or its "
+                                          "C++ text) or file=, not both");
+                if (!module && !file)
+                    throw py::value_error("Context.add_module: give a module's name "
+                                          "(lucent.modules()), its C++ text, or file=path");
+                // A module's text declares LUCENT_MODULE; a module's name has no spaces.
+                const bool is_text = module && (module->find("LUCENT_MODULE") != std::string::npos ||
+                                                module->find('\n') != std::string::npos);
+                if (module && !is_text) return c.add_module(*module);
+                ModuleSource source = file ? ModuleSource::from_file(*file, include_dirs)
+                                           : ModuleSource::from_text(name, *module, include_dirs);
+                py::gil_scoped_release release;  // a cold compile takes seconds
+                return c.add_module(std::move(source));
             },
-            py::arg("name"), py::return_value_policy::reference,
-            "Makes a module compiled into this extension (lucent.modules()) available to "
-            "create_program by name.")
+            py::arg("module") = py::none(), py::kw_only(), py::arg("file") = py::none(),
+            py::arg("name") = "python_module.h",
+            py::arg("include_dirs") = std::vector<std::string>{},
+            py::return_value_policy::reference,
+            "Makes a program module available to create_program: a module compiled into this "
+            "extension by its name (lucent.modules()), or a module's C++ text (a string with "
+            "its LUCENT_MODULE) or header (file=), which is compiled now with the system's C++ "
+            "compiler for the host (cached on disk) and with NVRTC for the GPU. `name` names "
+            "the text in the compiler's messages; quoted includes are looked up beside it and "
+            "in include_dirs.")
         .def(
             "create_program",
             [](Context& c, const std::string& name, const std::optional<std::string>& module) {

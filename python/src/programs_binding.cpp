@@ -60,7 +60,7 @@ const TypeInfo& type_by_name(const std::string& name, const char* what) {
     for (const TypeInfo* t : module_types()) {
         if (t->name == name) return *t;
         bool builtin = false;
-        for (const NamedType& b : builtin_types()) builtin = builtin || b.type->tag == t->tag;
+        for (const NamedType& b : builtin_types()) builtin = builtin || same_type(*b.type, *t);
         if (!builtin) structs += (structs.empty() ? "" : ", ") + std::string(t->name);
     }
     std::string names;
@@ -71,7 +71,7 @@ const TypeInfo& type_by_name(const std::string& name, const char* what) {
 
 std::string type_name(const TypeInfo& type) {
     for (const NamedType& t : builtin_types())
-        if (t.type->tag == type.tag) return t.name;
+        if (same_type(*t.type, type)) return t.name;
     return std::string(type.name);
 }
 

@@ -55,7 +55,7 @@ void Buffer::resize(unsigned width, unsigned height, unsigned depth) {
 }
 
 void Buffer::check_element(const TypeInfo& requested) const {
-    if (requested.tag != m_element->tag)
+    if (!same_type(requested, *m_element))
         throw Error(describe() + ": accessed as " + std::string(requested.name) +
                     " but its elements are " + std::string(m_element->name) + "; map it with map<" +
                     std::string(m_element->name) + ">()");
@@ -79,7 +79,7 @@ std::string TextureSampler::describe() const {
 
 void TextureSampler::set_buffer(std::shared_ptr<Buffer> texels) {
     if (texels &&
-        (texels->dimensionality() != 2 || texels->element().tag != type_info_of<float4>().tag))
+        (texels->dimensionality() != 2 || !same_type(texels->element(), type_info_of<float4>())))
         throw Error(describe() + ": texels must be a 2D buffer of float4, got " +
                     texels->describe());
     m_buffer = std::move(texels);

@@ -9,6 +9,7 @@
 #include "core/backend.h"
 #include "core/context_state.h"
 #include "core/module_registry.h"
+#include "core/runtime_module.h"
 #include "core/scene_compiler.h"
 #include "lucent/device/tea.h"
 
@@ -249,13 +250,12 @@ const ModuleInfo& Context::add_module(std::string_view name) {
 }
 
 const ModuleInfo& Context::add_module(ModuleSource source) {
+    // A module that is not compiled into the program is compiled now, for the host, with
+    // the system's C++ compiler: the CPU backend runs its programs from that library, and
+    // every backend reads their types from it (the GPU compiles the text again, with NVRTC).
+    // A module loaded that way before is checked against its text the same way.
     const ModuleInfo* info = find_module(source.module);
-    if (!info)
-        throw Error("Context::add_module: " + source.main + " declares module '" + source.module +
-                    "', which is not compiled into this program (it has: " +
-                    detail::known_module_names() +
-                    "); its programs run on the CPU from the compiled header, so include " +
-                    source.main + " in one of the program's files");
+    if (!info || core::is_runtime_module(source.module)) info = &core::load_runtime_module(source);
     if (const ModuleSource* embedded = embedded_module_source(source.module);
         embedded && !embedded->same_text(source))
         throw Error("Context::add_module: module '" + source.module + "' is given as " +
@@ -464,7 +464,7 @@ std::shared_ptr<DisplayFrame> Context::display_frame(const Buffer& output) {
     if (output.owner() != m_impl->shared)
         throw Error("Context::display_frame: " + output.describe() +
                     " belongs to another Context; pass a buffer this Context created");
-    if (output.dimensionality() != 2 || output.element().tag != type_info_of<float4>().tag)
+    if (output.dimensionality() != 2 || !same_type(output.element(), type_info_of<float4>()))
         throw Error("Context::display_frame: " + output.describe() +
                     " is not a 2D buffer of float4; display frames are made from linear RGB "
                     "images such as a launch's float4 output");

@@ -156,7 +156,7 @@ std::string GeometryTriangles::describe() const {
 }
 void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     require(vertices, *this, "vertex buffer");
-    if (vertices->element().tag != type_info_of<float3>().tag || vertices->dimensionality() != 1)
+    if (!same_type(vertices->element(), type_info_of<float3>()) || vertices->dimensionality() != 1)
         throw Error(describe() + ": vertices must be a 1D buffer of float3, got " +
                     vertices->describe());
     m_vertices = std::move(vertices);
@@ -164,8 +164,8 @@ void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
 }
 void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
     if (indices &&
-        (indices->dimensionality() != 1 || (indices->element().tag != type_info_of<uint3>().tag &&
-                                            indices->element().tag != type_info_of<int3>().tag)))
+        (indices->dimensionality() != 1 || (!same_type(indices->element(), type_info_of<uint3>()) &&
+                                            !same_type(indices->element(), type_info_of<int3>()))))
         throw Error(describe() + ": indices must be a 1D buffer of uint3 or int3, got " +
                     indices->describe());
     m_indices = std::move(indices);
@@ -173,7 +173,7 @@ void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
 }
 void GeometryTriangles::set_material_indices(std::shared_ptr<Buffer> material_indices) {
     if (material_indices && (material_indices->dimensionality() != 1 ||
-                             material_indices->element().tag != type_info_of<unsigned>().tag))
+                             !same_type(material_indices->element(), type_info_of<unsigned>())))
         throw Error(describe() + ": material indices must be a 1D buffer of unsigned, got " +
                     material_indices->describe());
     m_material_indices = std::move(material_indices);

@@ -125,7 +125,7 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
             if (value.kind != FieldKind::kBuffer || !value.buffer)
                 throw mismatch("buffer of " + std::string(field.element->name));
             const Buffer& b = *value.buffer;
-            if (b.element().tag != field.element->tag)
+            if (!same_type(b.element(), *field.element))
                 throw Error(where + ": the program reads BufferView<" +
                             std::string(field.element->name) + "> but " + b.describe() + " holds " +
                             std::string(b.element().name) +
@@ -169,7 +169,7 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
             if (p.kind() != ProgramKind::kCallable)
                 throw Error(where + ": " + p.describe() +
                             " is not a callable program; define it with LUCENT_CALLABLE");
-            if (p.desc().signature->tag != field.element->tag)
+            if (!same_type(*p.desc().signature, *field.element))
                 throw Error(where + ": the field wants a callable of signature " +
                             std::string(field.element->name) + " but " + p.describe() + " is " +
                             std::string(p.desc().signature->name));
@@ -184,7 +184,7 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
         }
         case FieldKind::kUserData: {
             if (value.kind != FieldKind::kUserData || !value.user_type ||
-                value.user_type->tag != field.element->tag)
+                !same_type(*value.user_type, *field.element))
                 throw mismatch(std::string(field.element->name) + " (set it with set_user)");
             std::memcpy(dst, value.bytes.data(), field.size);
             return;

@@ -323,7 +323,7 @@ void SceneCompiler::find_reached_instances() {
 void SceneCompiler::check_types() const {
     const CompiledScene& scene = *m_scene;
     auto payload_check = [&](const CompiledProgram& p, unsigned r) {
-        if (p && p.desc->payload->tag != scene.ray_types[r].payload->tag)
+        if (p && !same_type(*p.desc->payload, *scene.ray_types[r].payload))
             throw Error(p.label + ": its payload type is " + std::string(p.desc->payload->name) +
                         " but " + ray_type_label(m_state, r) + " carries " +
                         std::string(scene.ray_types[r].payload->name) +
@@ -336,7 +336,7 @@ void SceneCompiler::check_types() const {
             for (unsigned r = 0; r < scene.ray_types.size(); ++r) {
                 for (const CompiledProgram* p : {&mat.closest_hit[r], &mat.any_hit[r]}) {
                     payload_check(*p, r);
-                    if (*p && p->desc->attributes->tag != inst.attributes->tag)
+                    if (*p && !same_type(*p->desc->attributes, *inst.attributes))
                         throw Error(p->label + ": it reads attributes " +
                                     std::string(p->desc->attributes->name) + " but " +
                                     inst.source->geometry()->describe() + " reports " +

@@ -37,7 +37,7 @@ struct CpuPolicy {
     inline const core::CompiledScene& scene() const;
     unsigned ray_type_count() const { return unsigned(scene().ray_types.size()); }
     bool payload_matches(unsigned ray_type, const void* tag) const {
-        return tag == scene().ray_types[ray_type].payload->tag;
+        return detail::same_type_tag(tag, scene().ray_types[ray_type].payload->tag);
     }
     unsigned node_count() const { return unsigned(scene().nodes.size()); }
     unsigned max_depth() const { return scene().max_depth; }

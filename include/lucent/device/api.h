@@ -9,16 +9,58 @@
 #include "lucent/device/types.h"
 
 #if !LUCENT_GPU_CODE
+#include <cstddef>
 #include <cstdio>
+#include <string_view>
+#include <type_traits>
 #endif
 
 namespace lucent {
 namespace detail {
-/// One distinct address per C++ type: identifies payload types without RTTI.
+#if !LUCENT_GPU_CODE
+/// A C++ type's readable name (GCC's and Clang's __PRETTY_FUNCTION__ spelling).
+template <class T>
+constexpr std::string_view type_name_of() {
+    std::string_view p = __PRETTY_FUNCTION__;  // "... [with T = Name; ...]" or "[T = Name]"
+    size_t begin = p.find("T = ") + 4;
+    size_t end = p.find_first_of(";]", begin);
+    return p.substr(begin, end - begin);
+}
+/// sizeof and alignof, 0 for a function type (a callable program's signature).
+template <class T>
+constexpr size_t size_of_type() {
+    if constexpr (std::is_function_v<T>) return 0;
+    else return sizeof(T);
+}
+template <class T>
+constexpr size_t align_of_type() {
+    if constexpr (std::is_function_v<T>) return 0;
+    else return alignof(T);
+}
+/// What the host knows of a type without RTTI: its name, size and alignment.
+struct TypeIdentity {
+    std::string_view name;
+    size_t size;
+    size_t align;
+    constexpr bool operator==(const TypeIdentity&) const = default;
+};
+/// One object per C++ type, whose address identifies payload types in trace(). A module
+/// compiled at run time into a shared library (Context::add_module) has its own copy of
+/// each tag, so two tags are the same type when their addresses or their identities are.
 template <class T>
 struct TypeTag {
-    static constexpr char id = 0;
+    static constexpr TypeIdentity id{type_name_of<T>(), size_of_type<T>(), align_of_type<T>()};
 };
+/// Are the TypeTag ids `a` and `b` the same type (in this binary or across binaries)?
+/// (Types in an anonymous namespace are only ever the same in one binary.)
+inline bool same_type_tag(const void* a, const void* b) {
+    if (a == b) return true;
+    if (!a || !b) return false;
+    const TypeIdentity& x = *static_cast<const TypeIdentity*>(a);
+    return x == *static_cast<const TypeIdentity*>(b) &&
+           x.name.find("(anonymous namespace)") == std::string_view::npos;
+}
+#endif
 LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
 #if LUCENT_GPU_CODE
 // On the GPU an exception cannot unwind: it is recorded, every later trace() returns at

@@ -13,7 +13,8 @@
 namespace lucent {
 
 /// Identity of a C++ type as the host checks it: readable name, size, alignment,
-/// and the address the device API uses for the same type (detail::TypeTag).
+/// and the address the device API uses for the same type (detail::TypeTag). Compare two
+/// with same_type(): a module compiled at run time has TypeInfos of its own.
 struct TypeInfo {
     std::string_view name;
     size_t size;
@@ -21,21 +22,18 @@ struct TypeInfo {
     const void* tag;
 };
 
-namespace detail {
-template <class T>
-constexpr std::string_view type_name_of() {
-    std::string_view p = __PRETTY_FUNCTION__;  // "... [with T = Name; ...]"
-    size_t begin = p.find("T = ") + 4;
-    size_t end = p.find_first_of(";]", begin);
-    return p.substr(begin, end - begin);
-}
-}  // namespace detail
-
 template <class T>
 const TypeInfo& type_info_of() {
-    static const TypeInfo info{detail::type_name_of<T>(), sizeof(T), alignof(T),
-                               &detail::TypeTag<T>::id};
+    static const TypeInfo info{detail::type_name_of<T>(), detail::size_of_type<T>(),
+                               detail::align_of_type<T>(), &detail::TypeTag<T>::id};
     return info;
+}
+
+/// Are `a` and `b` the same C++ type? The same object in one binary; across binaries (a
+/// module compiled at run time and the program that loaded it) the same name, size and
+/// alignment.
+inline bool same_type(const TypeInfo& a, const TypeInfo& b) {
+    return detail::same_type_tag(a.tag, b.tag);
 }
 
 /// What kind of value a record field holds; decides which variable values fit it.

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/cache_directory.h"
+#include "core/cache_key.h"
 #include "cuda/jit/embedded_sources.h"
 #include "lucent/error.h"
 
@@ -66,23 +68,7 @@ const NvrtcApi& nvrtc() {
     return api;
 }
 
-/// 128-bit FNV-1a as two 64-bit lanes with different offsets: a cache key, not security.
-struct Key {
-    uint64_t a = 1469598103934665603ull, b = 0x84222325cbf29ce4ull;
-    void add(const std::string& s) {
-        for (unsigned char c : s) {
-            a = (a ^ c) * 1099511628211ull;
-            b = (b ^ c) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
-        }
-        add_separator();
-    }
-    void add_separator() { a = (a ^ 0xff) * 1099511628211ull; }
-    std::string hex() const {
-        char s[33];
-        std::snprintf(s, sizeof s, "%016llx%016llx", (unsigned long long)a, (unsigned long long)b);
-        return s;
-    }
-};
+using Key = core::CacheKey;
 
 constexpr char kMagic[8] = {'L', 'U', 'C', 'B', 'I', 'N', '0', '1'};
 
@@ -148,12 +134,7 @@ std::string nvrtc_version(std::string* why) {
     return std::to_string(major) + "." + std::to_string(minor);
 }
 
-std::string kernel_cache_dir() {
-    if (const char* d = std::getenv("LUCENT_CACHE_DIR")) return std::string(d) == "off" ? "" : d;
-    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lucent";
-    if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/lucent";
-    return "";
-}
+std::string kernel_cache_dir() { return core::cache_directory(); }
 
 CompileRequest embedded_request(std::string name, std::string source,
                                 std::vector<std::string> options, int sm) {
