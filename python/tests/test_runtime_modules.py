@@ -136,3 +136,38 @@ def test_a_module_from_a_string_compiles_into_the_megakernel_for_sm_90():
         pytest.skip(f"no NVRTC here: {e}")
     ctx.add_module(DEPTH_MODULE.format(name="py_jit_depth"))
     np.testing.assert_allclose(depth_image(ctx, "py_jit_depth"), expected_depth(), rtol=1e-6)
+
+
+def first_program_image(ctx, module):
+    """The first program of docs/programming-model.md, from `module`, at 64x48."""
+    ctx.set_ray_type(0, "radiance", payload=f"{module}::Payload")
+    ctx.set_ray_generation_program(0, ctx.create_program("camera", module))
+    ctx.set_miss_program(0, ctx.create_program("background", module))
+    vertices = ctx.create_buffer("input", "float3", 3)
+    vertices.upload(np.array([[-1, -1, -2], [1, -1, -2.5], [0, 1, -1.5]], np.float32))
+    triangle = ctx.create_geometry_triangles()
+    triangle.vertices = vertices
+    material = ctx.create_material()
+    material.set_closest_hit(0, ctx.create_program("shade", module))
+    material["color"] = (1, 0.5, 0.2)
+    instance = ctx.create_geometry_instance()
+    instance.geometry = triangle
+    instance.add_material(material)
+    scene = ctx.create_geometry_group()
+    scene.add_child(instance)
+    image = ctx.create_buffer("output", "float3", (64, 48))
+    ctx["eye"], ctx["scene"], ctx["image"] = (0, 0, 0), scene, image
+    ctx.launch(0, 64, 48)
+    return image.download()
+
+
+def test_a_compiled_in_module_and_its_text_compiled_at_run_time_give_the_same_image():
+    from conftest import REPO
+    text = (REPO / "examples" / "first-program" / "first_program.h").read_text()
+    renamed = text.replace("first_program", "first_program_at_run_time")
+    compiled_in = first_program_image(lucent.Context(backend=BACKEND), "first_program")
+    ctx = lucent.Context(backend=BACKEND)
+    ctx.add_module(renamed, name="first_program_at_run_time.h")
+    at_run_time = first_program_image(ctx, "first_program_at_run_time")
+    assert np.count_nonzero(compiled_in[..., 0] > 0.2) > 100  # the triangle is there
+    np.testing.assert_array_equal(at_run_time, compiled_in)
