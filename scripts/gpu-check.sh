@@ -52,7 +52,7 @@ examples)
     # The examples built against the installed package: GPU against CPU, and the JIT of a
     # user's module cold, then from the disk cache.
     cold_cache
-    for e in first-program ambient-occlusion; do
+    for e in first-program ambient-occlusion programs-at-run-time; do
         echo "== example $e: cuda (cold JIT), cuda (cached), cpu"
         $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
         $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
@@ -80,7 +80,7 @@ PY
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs device_api nodes variables exceptions validation occlusion whitted backend igi radiosity fog pathtracer modules; do
+    for t in programs device_api nodes variables exceptions validation occlusion whitted backend igi radiosity direct fog pathtracer modules; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
@@ -288,7 +288,7 @@ python)
     echo "== linking the Python module for $(python3 --version) ($ext)"
     g++ -O2 -std=c++20 -shared -fPIC -fvisibility=hidden -DLUCENT_HAVE_CUDA=1 \
         -Ipython/src -I. -Iinclude $(python3 -m pybind11 --includes) python/src/*.cpp \
-        $P/objects/*.o -Wl,--start-group $P/lib/*.a -Wl,--end-group -Wl,--exclude-libs,ALL \
+        $P/objects/*.o -Wl,--start-group $P/lib/*.a -Wl,--end-group -Wl,-Bsymbolic-functions \
         $P/so/*.so* -ldl -lpthread -o "$pkg/_lucent$ext" 2>&1 | grep -v "warning: " | head -20
     export LD_LIBRARY_PATH=$PWD/$P/so PYTHONPATH=$work/lucent-python LUCENT_CLI=$work/lucent-cli
     export LUCENT_SCENES_DIR=/work/shared/scenes

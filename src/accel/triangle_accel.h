@@ -13,9 +13,25 @@ namespace lucent::accel {
 
 struct TriangleHit {
     float t;
-    float u, v;     // barycentrics of vertices 1 and 2
+    float u, v;     // barycentrics of vertices 1 and 2 (adjacent: read as one float2)
     uint32_t prim;  // triangle index in the input order
+    // Its vertices in the leaf the traversal tested, for hit_vertices():
+    // vertex_lane[(3 * k + axis) * lanes] is coordinate `axis` of vertex k.
+    const float* vertex_lane = nullptr;
+    uint32_t lanes = 0;
 };
+
+/// The vertices of a hit's triangle (as given to build or refit, in its index order), read
+/// from the leaf the traversal just tested: in cache, where the mesh's own arrays may not
+/// be. Inline, so they go to registers: copied out through memory they were stored in
+/// pieces and reloaded whole, a store-forwarding stall.
+inline void hit_vertices(const TriangleHit& hit, float3& p0, float3& p1, float3& p2) {
+    const float* v = hit.vertex_lane;
+    const uint32_t n = hit.lanes;
+    p0 = make_float3(v[0], v[n], v[2 * n]);
+    p1 = make_float3(v[3 * n], v[4 * n], v[5 * n]);
+    p2 = make_float3(v[6 * n], v[7 * n], v[8 * n]);
+}
 
 /// What a filter (the engine's any-hit) decides about a candidate hit.
 enum class HitDecision { kAccept, kIgnore, kAcceptAndStop };

@@ -36,6 +36,20 @@ namespace lucent::accel::LUCENT_ISA_VARIANT {
 
 namespace {
 
+/// Writes a hit's barycentrics: u = e1 / det, v = e2 / det, as one 8-byte store with SIMD.
+/// The engine reads them back as one float2, and a load that spans two stores is not
+/// forwarded from the store buffer (a stall on every closest hit). The packed division is
+/// IEEE division per lane: the same values as the scalar one.
+inline void store_barycentrics(TriangleHit& hit, float e1, float e2, float det) {
+#if LUCENT_ACCEL_SIMD
+    const __m128 uv = _mm_div_ps(_mm_setr_ps(e1, e2, 0.0f, 0.0f), _mm_set1_ps(det));
+    _mm_storel_pi(reinterpret_cast<__m64*>(&hit.u), uv);
+#else
+    hit.u = e1 / det;
+    hit.v = e2 / det;
+#endif
+}
+
 // Far planes are tested with 1/d scaled up by 1 + 2^-21 so that rounding never culls a box
 // the ray touches (Ize 2013, "Robust BVH ray traversal", scales the far distance instead).
 // With u = 2^-24, a computed near distance is at most (1 + u)^2 times the true one (1/d and
@@ -397,7 +411,8 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
     int sp = 0;
     uint32_t ref = 0;
     bool found = false;
-    uint32_t best_prim = 0;
+    uint32_t best_prim = 0, best_lanes = 0;
+    const float* best_vertex = nullptr;
     float best_e1 = 0.0f, best_e2 = 0.0f, best_det = 1.0f;
     alignas(32) float dist[kWideArity];
     BlockLanes lanes;
@@ -469,15 +484,21 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
         } else if (ref != kEmptyChild) {
             const uint32_t count = leaf_count(ref);
             const uint32_t* prims;
+            const float* vertices;  // the block's vertex[0][0]
+            uint32_t block_lanes;
             unsigned mask;
             if (count > kNarrowLeafTriangles) {
                 const TriangleBlock8& block = accel.blocks8[leaf_block(ref)];
                 mask = test_block(block, count, r, end, lanes);
                 prims = block.prim;
+                vertices = &block.vertex[0][0][0];
+                block_lanes = 8;
             } else {
                 const TriangleBlock4& block = accel.blocks4[leaf_block(ref)];
                 mask = test_block(block, count, r, end, lanes);
                 prims = block.prim;
+                vertices = &block.vertex[0][0][0];
+                block_lanes = 4;
             }
             if (mask != 0) {
                 if constexpr (kQuery == Query::kAny) {
@@ -489,6 +510,8 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         if (lanes.t[lane] < tmax) {
                             tmax = lanes.t[lane];
                             best_prim = prims[lane];
+                            best_vertex = vertices + lane;
+                            best_lanes = block_lanes;
                             best_e1 = lanes.e1[lane];
                             best_e2 = lanes.e2[lane];
                             best_det = lanes.det[lane];
@@ -504,8 +527,10 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         TriangleHit candidate;
                         candidate.t = lanes.t[lane];
                         candidate.prim = prims[lane];
-                        candidate.u = lanes.e1[lane] / lanes.det[lane];
-                        candidate.v = lanes.e2[lane] / lanes.det[lane];
+                        candidate.vertex_lane = vertices + lane;
+                        candidate.lanes = block_lanes;
+                        store_barycentrics(candidate, lanes.e1[lane], lanes.e2[lane],
+                                           lanes.det[lane]);
                         HitDecision decision = thunk(filter, candidate);
                         if (decision == HitDecision::kIgnore) continue;
                         *hit = candidate;
@@ -524,8 +549,9 @@ bool traverse(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                     if (found) {
                         hit->t = tmax;
                         hit->prim = best_prim;
-                        hit->u = best_e1 / best_det;
-                        hit->v = best_e2 / best_det;
+                        hit->vertex_lane = best_vertex;
+                        hit->lanes = best_lanes;
+                        store_barycentrics(*hit, best_e1, best_e2, best_det);
                     }
                 }
                 return found;

@@ -123,7 +123,7 @@ class CpuBackend final : public core::Backend {
   private:
     static void run_index(ThreadState& ts, const core::CompiledScene& scene,
                           const core::CompiledEntry& e, uint3 index, WorkerExceptions& out) {
-        ts.launch_index = index;
+        set_launch_index(ts, index);
         ts.depth = 0;
         ts.frame = nullptr;
         ts.context = ProgramContext::kRayGeneration;

@@ -4,6 +4,7 @@
 // index, and the traversal is the Traverser of traversal.cpp.
 #pragma once
 
+#include <cstdint>
 #include <cstring>
 
 #include "core/compiled_scene.h"
@@ -88,7 +89,13 @@ struct CpuPolicy {
         std::memcpy(dst.bytes, src.bytes, inst.attributes->size);
     }
     /// The Traverser over the compiled graph (traversal.cpp).
-    void traverse(runtime::TraceFrame<CpuPolicy>& frame, Handle root, const Ray& ray) const;
+    /// Traverses the graph below `root` with the frame's ray (`ray` is what begin_frame
+    /// copied into it). Inline and not reading `ray`, so a trace's ray never has its address
+    /// taken: it stays in registers up to the frame (no store-forwarding stall).
+    void traverse(runtime::TraceFrame<CpuPolicy>& frame, Handle root, const Ray&) const {
+        traverse_frame(frame, root);
+    }
+    void traverse_frame(runtime::TraceFrame<CpuPolicy>& frame, Handle root) const;
 
     static uint3 triangle_of(const Instance& inst, unsigned prim) {
         return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
@@ -100,7 +107,7 @@ using AttributeStorage = TraceFrame::Attributes;
 
 struct ThreadState {
     const core::CompiledScene* scene = nullptr;
-    uint3 launch_index{0, 0, 0};
+    uint3 launch_index{0, 0, 0};  // written by set_launch_index()
     uint3 launch_size{1, 1, 1};
     const uint4* device_keys = nullptr;  // per device slot (device_tea_key())
     unsigned device_slots = 1;
@@ -109,6 +116,17 @@ struct ThreadState {
     ProgramContext context = ProgramContext::kRayGeneration;  // outside any trace
     bool print_here = false;
 };
+
+/// Sets ts.launch_index as launch_index() reads it: (x, y) in one 8-byte store, z in one
+/// 4-byte store. The x86-64 ABI returns a uint3 as (x, y) in one register and z in another,
+/// so the ray-generation program's first call loads it that way; a store the compiler
+/// happened to split otherwise (x alone, then y and z together) cannot be forwarded to that
+/// load, and the stall cost a third of a one-ray-per-index launch (perf, 2026-12).
+inline void set_launch_index(ThreadState& ts, uint3 index) {
+    const uint64_t xy = uint64_t(index.x) | uint64_t(index.y) << 32;
+    std::memcpy(&ts.launch_index.x, &xy, sizeof xy);
+    ts.launch_index.z = index.z;
+}
 
 inline const core::CompiledScene& CpuPolicy::scene() const {
     return *ts->scene;

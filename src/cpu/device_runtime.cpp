@@ -27,8 +27,20 @@ void set_thread_state(ThreadState* state) {
 }  // namespace cpu
 
 namespace detail {
-void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag) {
+// Flattened: with runtime::trace inlined the ray stays in registers up to the traversal
+// (called out of line, it re-read the ray just stored here with wider loads: the same
+// store-forwarding stall as across the program's call).
+[[gnu::flatten]] void trace_fields(Handle root, float3 origin, float3 direction, float tmin,
+                                   float tmax, unsigned ray_type, void* payload,
+                                   const void* payload_tag) {
+    const Ray ray{origin, tmin, direction, tmax, ray_type};
     runtime::trace(runtime::backend(), root, ray, payload, payload_tag);
+}
+
+bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
+                     unsigned ray_type) {
+    const Ray ray{origin, tmin, direction, tmax, ray_type};
+    return cpu::occluded(cpu::thread_state(), root, ray);
 }
 
 void raise_exception(int code, unsigned detail) {
@@ -55,10 +67,6 @@ uint3 launch_size() {
 uint4 device_tea_key() {
     const cpu::ThreadState& ts = cpu::thread_state();
     return ts.device_keys[device_slot_of(ts.launch_index, ts.launch_size, ts.device_slots)];
-}
-
-bool occluded(Handle root, const Ray& ray) {
-    return cpu::occluded(cpu::thread_state(), root, ray);
 }
 
 }  // namespace lucent

@@ -193,6 +193,24 @@ LUCENT_RUNTIME_INLINE void run_intersection(const P& p, FrameOf<P>& f, unsigned 
 
 /// The attributes of a triangle hit: the attribute program's, or the built-in
 /// TriangleAttributes (barycentrics and object-space geometric normal).
+/// The attributes of built-in triangles without an attribute program (TriangleAttributes),
+/// from the triangle's vertices: the one formula every backend and path uses.
+template <class Attributes>
+LUCENT_HD inline void builtin_triangle_attributes(float2 bary, float3 p0, float3 p1, float3 p2,
+                                                  Attributes& out) {
+#if LUCENT_GPU_CODE
+    TriangleAttributes* a = reinterpret_cast<TriangleAttributes*>(out.bytes);
+    a->barycentrics = bary;
+    a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
+#else
+    // Each member straight from its registers: built in a local and copied whole, the
+    // copy's wide load would span the local's narrower stores (a store-forwarding stall).
+    const float3 n = normalize(cross(p1 - p0, p2 - p0));
+    __builtin_memcpy(out.bytes + offsetof(TriangleAttributes, barycentrics), &bary, sizeof bary);
+    __builtin_memcpy(out.bytes + offsetof(TriangleAttributes, geometric_normal), &n, sizeof n);
+#endif
+}
+
 template <class P>
 LUCENT_HD inline void triangle_attributes(const P& p, FrameOf<P>& f,
                                           const typename P::Instance& inst, unsigned prim,
@@ -207,16 +225,7 @@ LUCENT_HD inline void triangle_attributes(const P& p, FrameOf<P>& f,
     }
     float3 p0, p1, p2;
     p.triangle(inst, prim, p0, p1, p2);
-#if LUCENT_GPU_CODE
-    TriangleAttributes* a = reinterpret_cast<TriangleAttributes*>(out.bytes);
-    a->barycentrics = bary;
-    a->geometric_normal = normalize(cross(p1 - p0, p2 - p0));
-#else
-    TriangleAttributes a;
-    a.barycentrics = bary;
-    a.geometric_normal = normalize(cross(p1 - p0, p2 - p0));
-    __builtin_memcpy(out.bytes, &a, sizeof a);
-#endif
+    builtin_triangle_attributes(bary, p0, p1, p2, out);
 }
 
 /// Records a hit as the closest so far (the caller fills its attributes).

@@ -62,6 +62,16 @@ inline bool same_type_tag(const void* a, const void* b) {
 }
 #endif
 LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
+#if !LUCENT_GPU_CODE
+// The CPU backend's trace() and occluded() take the ray's fields by value, in registers. A
+// Ray the caller has just built on its stack and the callee copies with wider loads than
+// the caller's stores cannot be forwarded from the store buffer: that stall cost about a
+// tenth of a primary ray's time on Sponza (perf, 2026-12).
+void trace_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
+                  unsigned ray_type, void* payload, const void* payload_tag);
+bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
+                     unsigned ray_type);
+#endif
 #if LUCENT_GPU_CODE
 // On the GPU an exception cannot unwind: it is recorded, every later trace() returns at
 // once, and the exception program runs when the ray-generation program returns.
@@ -99,7 +109,8 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
     detail::trace_erased(root, ray, &payload,
                          reinterpret_cast<const void*>(sizeof(Payload) << 8 | alignof(Payload)));
 #else
-    detail::trace_erased(root, ray, &payload, &detail::TypeTag<Payload>::id);
+    detail::trace_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax, ray.ray_type,
+                         &payload, &detail::TypeTag<Payload>::id);
 #endif
 }
 
@@ -126,8 +137,13 @@ __device__ bool occluded(Handle, const Ray&) {
 // In the megakernel the runtime defines it, inlined into each caller: its fast path is the
 // bare BVH traversal, and a call would cost the ABI's register saves on every shadow ray.
 __device__ __forceinline__ bool occluded(Handle root, const Ray& ray);
-#else
+#elif LUCENT_GPU_CODE
 LUCENT_HD bool occluded(Handle root, const Ray& ray);
+#else
+inline bool occluded(Handle root, const Ray& ray) {
+    return detail::occluded_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
+                                   ray.ray_type);
+}
 #endif
 
 /// In an intersection program: is t inside the ray's current interval (tmin, closest hit so
