@@ -364,7 +364,7 @@ void print_text(const RaysResult& r) {
 /// `--programs --backend cuda`: the programs on the GPU, their checksums against the CPU
 /// kernels' on the same rays (TriangleAccel, one pass of each set).
 void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, const Camera& cam,
-                       unsigned threads) {
+                       unsigned threads, Json& document) {
     accel::TriangleAccel accel;
     accel.build(mesh.positions, mesh.indices, {});
     const RaySet primary = primary_rays(cam, options.width, options.height);
@@ -383,7 +383,7 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
         j["backend"] = p.backend;
         j["timing"] = p.timing;
         j["checksums_agree_with_cpu_kernels"] = differences.empty();
-        print_json(Json{{"scene", options.scene}, {"programs", j}});
+        document["programs"] = j;  // beside the kernels' figures: one document
         return;
     }
     std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
@@ -417,8 +417,11 @@ int run_bench_rays(const RaysOptions& options) {
         in.camera = cam;
         in.width = options.width, in.height = options.height;
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
+        Json document;
+        if (options.json && options.programs) in.json_out = &document;
         const int code = cuda::run_bench_rays_cuda(in);
-        if (code == 0 && options.programs) run_programs_cuda(options, mesh, cam, threads);
+        if (code == 0 && options.programs) run_programs_cuda(options, mesh, cam, threads, document);
+        if (in.json_out) print_json(document);
         return code;
 #else
         throw Error(

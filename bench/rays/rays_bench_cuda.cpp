@@ -332,7 +332,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
 
     result.cpu = trace_on_cpu(in, bench, result.binary, result.threads);
     result.differences = bench::checksum_differences(result.gpu, result.cpu.sums, "gpu", "cpu");
-    bench::report(result, in.json);
+    if (in.json && in.json_out)
+        *in.json_out = to_json(result);
+    else
+        bench::report(result, in.json);
     return 0;
 }
 

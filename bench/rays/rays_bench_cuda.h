@@ -8,6 +8,7 @@
 #include <string>
 
 #include "bench/common/bench_camera.h"
+#include "bench/common/report.h"
 #include "lucent/device/vector_math.h"
 
 namespace lucent::cuda {
@@ -21,6 +22,9 @@ struct CudaRaysInput {
     int repeat = 5;
     unsigned threads = 0;  // CPU threads of the reference trace, 0 = all
     bool json = false;
+    /// With `json`: where the document goes instead of stdout (the caller adds to it, e.g.
+    /// `--programs`' figures, and prints one document).
+    bench::Json* json_out = nullptr;
 };
 
 /// Times the trace kernels (CUDA events, median of `repeat` after a warm-up), prints one

@@ -123,15 +123,19 @@ struct ScratchDirectory {
 };
 
 void* open_library(const fs::path& file, const HostObject& host, const std::string& module,
-                   bool throw_on_failure) {
+                   const std::string& compiler, bool throw_on_failure) {
     void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (handle || !throw_on_failure) return handle;
     std::string why = ::dlerror();
-    std::string fix = host.path.empty()
+    // An engine symbol it cannot find: the executable does not export them. Anything else
+    // (a C library newer than the one loaded, a damaged file) is about the library itself.
+    std::string fix = host.path.empty() && why.find("undefined symbol") != std::string::npos
                           ? "; the program that loads it must export its symbols: "
                             "set_target_properties(<your target> PROPERTIES ENABLE_EXPORTS ON) "
                             "in CMake (the -rdynamic link flag)"
-                          : "; rebuild the module (remove " + file.string() + ")";
+                          : "; the compiler (" + compiler +
+                                ") must build for the C and C++ libraries this program runs "
+                                "with: name the right one in LUCENT_CXX";
     throw Error("cannot load program module '" + module + "' compiled at run time: " + why + fix);
 }
 
@@ -215,7 +219,7 @@ const ModuleInfo& load_runtime_module(const ModuleSource& source) {
     void* handle = nullptr;
     std::error_code ec;
     if (!cached.empty() && fs::is_regular_file(fs::symlink_status(cached, ec))) {
-        handle = open_library(cached, host, source.module, false);
+        handle = open_library(cached, host, source.module, compiler.front(), false);
         if (!handle) fs::remove(cached, ec);  // damaged: compile it again
     }
     if (!handle) {
@@ -236,7 +240,7 @@ const ModuleInfo& load_runtime_module(const ModuleSource& source) {
             fs::rename(library, cached, ec);  // atomic: another process sees all or nothing
             if (!ec) file = cached;
         }
-        handle = open_library(file, host, source.module, true);
+        handle = open_library(file, host, source.module, compiler.front(), true);
     }
     const ModuleInfo* info = find_module(source.module);
     if (!info)
