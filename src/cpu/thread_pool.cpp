@@ -60,6 +60,8 @@ void ThreadPool::run(const std::function<void(unsigned)>& job, unsigned max_work
         std::unique_lock lock(m_mutex);
         m_done.wait(lock, [this] { return m_running == 0; });
         m_job = nullptr;
+        if (!error) error = m_worker_error;  // the caller's own first, else a worker's
+        m_worker_error = nullptr;
     }
     if (error) std::rethrow_exception(error);
 }
@@ -73,9 +75,16 @@ void ThreadPool::worker_loop(unsigned worker) {
             std::lock_guard lock(m_mutex);
             job = m_job;
         }
-        (*job)(worker);
+        std::exception_ptr error;
+        try {
+            (*job)(worker);
+        } catch (...) {
+            // Thrown on a worker thread it would end the process: run() rethrows it.
+            error = std::current_exception();
+        }
         {
             std::lock_guard lock(m_mutex);
+            if (error && !m_worker_error) m_worker_error = error;
             if (--m_running == 0) m_done.notify_one();
         }
     }

@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -26,7 +27,9 @@ class ThreadPool {
     unsigned size() const { return m_size; }
     /// Runs job(worker) on workers 0 .. min(size(), max_workers)-1 and returns when all are
     /// done. Only those workers are woken (each has its own semaphore), so a pool far larger
-    /// than the work (--threads 4096 on a 32x32 image) costs nothing per launch.
+    /// than the work (--threads 4096 on a 32x32 image) costs nothing per launch. An
+    /// exception thrown by the job on any worker is rethrown here once every worker is done
+    /// (the calling thread's own first).
     void run(const std::function<void(unsigned worker)>& job, unsigned max_workers = ~0u);
 
   private:
@@ -40,6 +43,7 @@ class ThreadPool {
     std::condition_variable m_done;
     const std::function<void(unsigned)>* m_job = nullptr;
     unsigned m_running = 0;  // woken workers not finished yet (under m_mutex)
+    std::exception_ptr m_worker_error;  // the first a worker's job threw (under m_mutex)
     std::atomic<bool> m_stop{false};
 };
 
