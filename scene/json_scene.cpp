@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "lucent/error.h"
+#include "scene/input_file.h"
 #include "scene/scene.h"
 
 namespace lucent::scene {
@@ -85,6 +86,7 @@ class JsonReader {
 };
 
 json parse_file(const std::string& path) {
+    require_regular_file(path, "scene file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open the scene file (check the path)");
     std::stringstream buffer;

@@ -6,6 +6,7 @@
 #include <regex>
 
 #include "lucent/error.h"
+#include "scene/input_file.h"
 
 namespace lucent::scene {
 
@@ -60,6 +61,7 @@ void fail(const std::string& path, size_t line, const std::string& message) {
 }
 
 tinyobj::ObjReader read_obj(const std::string& path, bool with_materials) {
+    require_regular_file(path, "OBJ file");
     {
         std::ifstream probe(path);
         if (!probe) fail(path, 0, "cannot open the OBJ file (check the path)");

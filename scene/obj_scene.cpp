@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "lucent/error.h"
+#include "scene/input_file.h"
 #include "scene/obj_reader.h"
 #include "scene/scene.h"
 
@@ -50,7 +51,9 @@ float3 to_float3(const tinyobj::real_t v[3]) {
 }  // namespace
 
 Scene load_obj_scene(const std::string& path) {
+    require_regular_file(path, "OBJ file");
     const auto libs = mtllibs(path);
+    for (const auto& [file, line] : libs) require_regular_file(file, "MTL file");
     for (const auto& [file, line] : libs)
         if (!fs::exists(file))
             fail(path, line,

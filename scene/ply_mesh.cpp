@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "lucent/error.h"
+#include "scene/input_file.h"
 #include "scene/scene.h"
 
 namespace lucent::scene {
@@ -87,9 +88,34 @@ class Reader {
     Format m_format;
 };
 
+/// The header's element counts against the bytes after it: each item of an element takes at
+/// least its scalars' and list counts' bytes in a binary file, and a character and a
+/// separator per property in an ASCII one. A header that claims more than the file holds
+/// (a damaged or hostile file) is refused before anything is allocated or read, and an
+/// element without properties may have no items (they would take no bytes at all).
+void check_declared_counts(const std::string& path, const std::vector<Element>& elements,
+                           Format format, uint64_t bytes_after_header) {
+    long double needed = 0;
+    for (const Element& e : elements) {
+        if (e.count > 0 && e.properties.empty())
+            throw Error(path + ": element '" + e.name + "' declares " + std::to_string(e.count) +
+                        " items but no properties; a PLY element needs at least one property");
+        uint64_t per_item = 0;
+        for (const Property& p : e.properties)
+            per_item += format == Format::kAscii ? 2 : type_size(p.list ? p.count_type : p.type);
+        needed += static_cast<long double>(per_item) * e.count;
+    }
+    if (needed > static_cast<long double>(bytes_after_header))
+        throw Error(path + ": the header declares elements that need at least " +
+                    std::to_string(static_cast<unsigned long long>(needed)) + " bytes, but " +
+                    std::to_string(bytes_after_header) +
+                    " follow it; the file is truncated or its element counts are wrong");
+}
+
 }  // namespace
 
 Mesh load_ply_mesh(const std::string& path) {
+    require_regular_file(path, "PLY file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ":0: cannot open the PLY file (check the path)");
     auto fail_at = [&](size_t line, const std::string& m) -> void {
@@ -154,6 +180,7 @@ Mesh load_ply_mesh(const std::string& path) {
         }
     }
     if (!have_format) fail_at(line_no, "the header has no format line");
+    check_declared_counts(path, elements, format, file_size(path) - uint64_t(in.tellg()));
 
     Reader reader(path, in, format);
     Mesh mesh;

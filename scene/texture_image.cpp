@@ -7,11 +7,28 @@
 #include <memory>
 
 #include "lucent/error.h"
+#include "scene/input_file.h"
 #include "scene/exr_encoder.h"
 
 namespace lucent::scene {
 
 namespace {
+/// The most texels an image may declare: 2^27 (2 GiB as float4), e.g. 11,585 x 11,585. An
+/// image's header is read before its pixels: a small file that claims 16,000 x 16,000 would
+/// otherwise take gigabytes and minutes before anything could be said.
+constexpr uint64_t kMaxTexels = uint64_t(1) << 27;
+
+void check_declared_size(const std::string& path, const char* what) {
+    require_regular_file(path, what);
+    int width = 0, height = 0, channels = 0;
+    if (!stbi_info(path.c_str(), &width, &height, &channels)) return;  // stbi_load says why
+    if (uint64_t(width) * uint64_t(height) > kMaxTexels)
+        throw Error("the " + std::string(what) + " '" + path + "' declares " +
+                    std::to_string(width) + " x " + std::to_string(height) +
+                    " pixels, more than the " + std::to_string(kMaxTexels) +
+                    " a texture may have; resize it (or check that the file is not damaged)");
+}
+
 /// The sRGB transfer function's inverse (IEC 61966-2-1).
 float srgb_to_linear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
@@ -19,6 +36,7 @@ float srgb_to_linear(float c) {
 }  // namespace
 
 TextureImage load_texture(const std::string& path) {
+    check_declared_size(path, "texture");
     int width = 0, height = 0, channels = 0;
     std::unique_ptr<unsigned char, void (*)(void*)> data(
         stbi_load(path.c_str(), &width, &height, &channels, 4), stbi_image_free);
@@ -54,6 +72,7 @@ TextureImage load_linear_image(const std::string& path) {
     if (ext != ".hdr")
         throw Error("cannot read the environment map '" + path +
                     "': expected a linear .hdr or .exr file");
+    check_declared_size(path, "environment map");
     int width = 0, height = 0, channels = 0;
     std::unique_ptr<float, void (*)(void*)> data(
         stbi_loadf(path.c_str(), &width, &height, &channels, 4), stbi_image_free);

@@ -100,8 +100,27 @@ TEST_F(Ply, ErrorsNameTheLineOrElement) {
     std::string truncated = binary_triangle(false);
     truncated.resize(truncated.size() - 3);
     EXPECT_NE(error_of(write("e.ply", truncated)).find("ends early"), std::string::npos);
-    auto nan = write("f.ply", std::string(kQuadHeader) + "0 0 nan 0 0\n");
+    auto nan = write("f.ply", std::string(kQuadHeader) +
+                                  "0 0 nan 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n");
     EXPECT_NE(error_of(nan).find("not finite"), std::string::npos) << error_of(nan);
+}
+
+TEST_F(Ply, CountsTheFileCannotHoldAreRefusedBeforeReading) {
+    // 2^31 - 1 vertices declared in a file of a few bytes (it used to allocate and read on).
+    auto huge = write("huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 2147483647\n"
+                                  "property float x\nproperty float y\nproperty float z\n"
+                                  "end_header\n0123456789ab");
+    const std::string message = error_of(huge);
+    EXPECT_NE(message.find("huge.ply"), std::string::npos) << message;
+    EXPECT_NE(message.find("need at least 25769803764 bytes, but 12 follow"), std::string::npos)
+        << message;
+    // An element without properties whose items would take no bytes at all.
+    auto empty = write("empty.ply", "ply\nformat ascii 1.0\nelement nothing 2000000000\n"
+                                    "element vertex 0\nproperty float x\nproperty float y\n"
+                                    "property float z\nend_header\n");
+    EXPECT_NE(error_of(empty).find("element 'nothing' declares 2000000000 items but no properties"),
+              std::string::npos)
+        << error_of(empty);
 }
 
 TEST_F(Ply, LoadSceneFramesAPlyMesh) {

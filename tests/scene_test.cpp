@@ -5,8 +5,12 @@
 #include <filesystem>
 #include <fstream>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "lucent/error.h"
 #include "scene/scene.h"
+#include "scene/texture_image.h"
 
 namespace {
 
@@ -96,6 +100,45 @@ TEST_F(SceneFiles, ObjWithoutItsMaterialLibraryNamesTheLine) {
     auto path =
         write("a.obj", "# header\nmtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     EXPECT_NE(error_of(path).find("a.obj:2:"), std::string::npos) << error_of(path);
+}
+
+TEST_F(SceneFiles, FifosDevicesAndFoldersAreRefusedNotReadForEver) {
+    // A FIFO nobody writes to would block the reader for ever, /dev/zero would be read
+    // until memory runs out: each is an error naming the path and what it is.
+    for (const char* name : {"pipe.obj", "pipe.json", "pipe.ply"}) {
+        const std::string path = (dir / name).string();
+        ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0) << path;
+        const std::string e = error_of(path);
+        EXPECT_NE(e.find(path), std::string::npos) << e;
+        EXPECT_NE(e.find("is a FIFO (named pipe), not a file"), std::string::npos) << e;
+    }
+    fs::create_symlink("/dev/zero", dir / "zero.ply");
+    EXPECT_NE(error_of((dir / "zero.ply").string()).find("is a device"), std::string::npos)
+        << error_of((dir / "zero.ply").string());
+    fs::create_directory(dir / "folder.obj");
+    EXPECT_NE(error_of((dir / "folder.obj").string()).find("is a folder"), std::string::npos);
+    // An MTL that is a FIFO, named by a regular OBJ.
+    ASSERT_EQ(::mkfifo((dir / "m.mtl").c_str(), 0600), 0);
+    const std::string obj = write("lib.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    EXPECT_NE(error_of(obj).find("MTL file is a FIFO"), std::string::npos) << error_of(obj);
+}
+
+TEST_F(SceneFiles, ATextureThatClaimsAHugeSizeIsRefusedFromItsHeader) {
+    // A PNG signature and an IHDR chunk claiming 16,000 x 16,000 RGB pixels, nothing else:
+    // the size is refused before any pixel is decoded (it took 7.8 GB and 108 s).
+    const unsigned char png[] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a, 0, 0, 0, 13,
+                                 'I', 'H', 'D', 'R', 0, 0, 0x3e, 0x80, 0, 0, 0x3e, 0x80,
+                                 8, 2, 0, 0, 0, 0, 0, 0, 0};
+    const std::string path = write("huge.png", std::string(reinterpret_cast<const char*>(png),
+                                                            sizeof png));
+    try {
+        lucent::scene::load_texture(path);
+        FAIL() << "the texture was loaded";
+    } catch (const lucent::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("declares 16000 x 16000 pixels"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
 }
 
 TEST_F(SceneFiles, MissingTextureNamesTheMtlLine) {
