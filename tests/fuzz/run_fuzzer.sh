@@ -11,10 +11,11 @@ mkdir -p "$build"
 exe="$build/${name}_fuzzer"
 scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$root/scene/obj_scene.cpp"
                "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp" "$root/scene/cornell_materials.cpp"
-               "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp")
+               "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp" "$root/scene/input_file.cpp")
 defines=()
 case $name in
-  obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp")
+  obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"
+                    "$root/scene/input_file.cpp")
             corpus_name=obj ;;
   scene_obj) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".obj"')
              corpus_name=obj ;;
