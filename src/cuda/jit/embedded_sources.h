@@ -2,15 +2,13 @@
 // and the GPU runtime and traversal. Program modules bring their own (lucent/module.h).
 #pragma once
 
-#include <string_view>
 #include <vector>
+
+#include "core/device_headers.h"
 
 namespace lucent::cuda {
 
-struct EmbeddedSource {
-    std::string_view name;  // include path, e.g. "lucent/device/api.h"
-    std::string_view text;
-};
+using core::EmbeddedSource;  // one (include path, text) pair, as the CPU's headers are kept
 
 const std::vector<EmbeddedSource>& embedded_sources();
 
