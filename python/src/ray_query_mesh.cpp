@@ -54,10 +54,24 @@ MeshData load_mesh(const std::string& path) {
 
 RayQueryMesh::RayQueryMesh(const float* vertices, size_t vertex_count, const uint32_t* indices,
                            size_t triangle_count, ContextOptions options)
-    : m_ctx(std::make_unique<Context>(std::move(options))),
-      m_vertex_count(vertex_count),
-      m_triangle_count(triangle_count) {
+    : m_vertex_count(vertex_count), m_triangle_count(triangle_count) {
+    const bool engine_on_cpu = options.jit_check_sm != 0 || !options.devices.empty();
+    const unsigned threads = options.threads;
+    // The Context decides the backend ("auto": the GPU if there is one) and names it.
+    m_ctx = std::make_unique<Context>(std::move(options));
+    m_backend_name = m_ctx->backend_name();
+    if (!engine_on_cpu && m_backend_name.rfind("cpu", 0) == 0) {
+        m_ctx.reset();  // its workers would idle beside the direct queries' own
+        m_cpu = std::make_unique<CpuRayQueries>(vertices, vertex_count, indices, triangle_count,
+                                                threads);
+        return;
+    }
+    build_engine_queries(vertices, indices);
+}
+
+void RayQueryMesh::build_engine_queries(const float* vertices, const uint32_t* indices) {
     Context& ctx = *m_ctx;
+    const size_t vertex_count = m_vertex_count, triangle_count = m_triangle_count;
     ctx.add_module("lucent_python_queries");
     ctx.set_ray_type<lucent_python::QueryHit>(lucent_python::kQueryRay, "query");
     ctx.set_miss_program(lucent_python::kQueryRay, ctx.create_program("record_miss"));
@@ -107,13 +121,12 @@ RayQueryMesh::RayQueryMesh(const float* vertices, size_t vertex_count, const uin
 }
 
 std::string RayQueryMesh::backend_name() const {
-    std::lock_guard lock(m_mutex);
-    return m_ctx->backend_name();
+    return m_backend_name;
 }
 
 LaunchReport RayQueryMesh::last_launch() const {
     std::lock_guard lock(m_mutex);
-    return m_ctx->last_launch();
+    return m_cpu ? m_cpu->last_launch() : m_ctx->last_launch();
 }
 
 void RayQueryMesh::update(const float* vertices, size_t vertex_count, bool rebuild) {
@@ -121,6 +134,7 @@ void RayQueryMesh::update(const float* vertices, size_t vertex_count, bool rebui
     if (vertex_count != m_vertex_count)
         throw Error("update: " + std::to_string(vertex_count) + " vertices for a mesh of " +
                     std::to_string(m_vertex_count) + "; make a new TriangleMesh");
+    if (m_cpu) return m_cpu->update(vertices, rebuild);
     m_accel->set_refit(!rebuild);
     std::memcpy(m_vertices->map<float3>(), vertices, vertex_count * sizeof(float3));
     m_vertices->unmap();  // the acceleration structure is refitted or rebuilt at the next launch
@@ -153,6 +167,7 @@ void RayQueryMesh::load_rays(const RayArrays& rays) {
 void RayQueryMesh::intersect(const RayArrays& rays, const HitArrays& out) {
     if (rays.count == 0) return;
     std::lock_guard lock(m_mutex);
+    if (m_cpu) return m_cpu->intersect(rays, out);
     load_rays(rays);
     m_ctx->launch(kClosestEntry, unsigned(rays.count));
     std::memcpy(out.t, m_t->data<float>(), rays.count * sizeof(float));
@@ -164,6 +179,7 @@ void RayQueryMesh::intersect(const RayArrays& rays, const HitArrays& out) {
 void RayQueryMesh::occluded(const RayArrays& rays, uint8_t* out) {
     if (rays.count == 0) return;
     std::lock_guard lock(m_mutex);
+    if (m_cpu) return m_cpu->occluded(rays, out);
     load_rays(rays);
     m_ctx->launch(kAnyEntry, unsigned(rays.count));
     std::memcpy(out, m_blocked->data<unsigned char>(), rays.count);

@@ -1,7 +1,10 @@
-// The engine side of lucent.TriangleMesh, free of Python: a Context with one
+// The engine side of lucent.TriangleMesh, free of Python. On the CPU backend the queries
+// call the triangle BVH directly (cpu_ray_queries.h). On the GPU, and on the CPU when a
+// JIT check or a device list is asked for, they run through a Context: one
 // GeometryTriangles under a GeometryGroup, the ray_query_programs.h module's two entry
-// points, and the buffers the rays go in and the answers come out through. The binding
-// (mesh_binding.cpp) checks the numpy arrays and calls this without the GIL.
+// points, and the buffers the rays go in and the answers come out through. Both give the
+// same answers. The binding (mesh_binding.cpp) checks the numpy arrays and calls this
+// without the GIL.
 #pragma once
 
 #include <cstddef>
@@ -12,28 +15,10 @@
 #include <vector>
 
 #include "lucent/lucent.h"
+#include "cpu_ray_queries.h"
+#include "ray_query_arrays.h"
 
 namespace lucent::python {
-
-/// A batch of rays as flat arrays: origins and directions are count x 3 floats; tmin and
-/// tmax hold 1 value (for every ray) or `count`.
-struct RayArrays {
-    const float* origins = nullptr;
-    const float* directions = nullptr;
-    const float* tmin = nullptr;
-    size_t tmin_count = 1;
-    const float* tmax = nullptr;
-    size_t tmax_count = 1;
-    size_t count = 0;
-};
-
-/// Where intersect() writes: count values of t, prim; count x 2 of uv; count x 3 of normal.
-struct HitArrays {
-    float* t = nullptr;
-    int32_t* prim = nullptr;
-    float* uv = nullptr;
-    float* normal = nullptr;
-};
 
 /// A mesh's positions and triangles as loaded from a file.
 struct MeshData {
@@ -69,12 +54,16 @@ class RayQueryMesh {
     LaunchReport last_launch() const;
 
   private:
+    /// The Context, its graph, programs and buffers (the GPU's path).
+    void build_engine_queries(const float* vertices, const uint32_t* indices);
     /// Copies the rays into the input buffers, sizing every batch buffer to the batch.
     void load_rays(const RayArrays& rays);
 
     mutable std::mutex m_mutex;
-    std::unique_ptr<Context> m_ctx;
     size_t m_vertex_count, m_triangle_count;
+    std::string m_backend_name;
+    std::unique_ptr<CpuRayQueries> m_cpu;  // the CPU's direct queries, or
+    std::unique_ptr<Context> m_ctx;        // the engine's
     std::shared_ptr<Buffer> m_vertices;
     std::shared_ptr<Acceleration> m_accel;
     std::shared_ptr<Program> m_closest, m_any;

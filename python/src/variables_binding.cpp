@@ -151,7 +151,7 @@ py::object get_variable(const VariableScope& scope, const std::string& name) {
         case FieldKind::kMatrix4x3: {
             py::array_t<float> m({3, 4});
             std::memcpy(m.mutable_data(), v->bytes.data(), 12 * sizeof(float));
-            return std::move(m);
+            return m;  // moved: C++20 treats a returned local as an rvalue
         }
         case FieldKind::kBuffer: return py::cast(v->buffer);
         case FieldKind::kTexture: return py::cast(v->texture);

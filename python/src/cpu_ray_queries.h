@@ -1,0 +1,55 @@
+// The CPU side of lucent.TriangleMesh: the rays of a batch go straight to the triangle BVH
+// the engine builds for a GeometryGroup of triangles (accel::TriangleAccel, the same build
+// and the same watertight test), on a pool of worker threads, reading the caller's arrays
+// and writing the answers into the caller's arrays: no copies, and no programs around the
+// traversal. The answers are those of the query module (ray_query_programs.h) on the CPU
+// backend, bit for bit: the same rules for what a ray is (ray_query_rules.h) and the same
+// attribute formula (runtime::builtin_triangle_attributes).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "accel/triangle_accel.h"
+#include "cpu/thread_pool.h"
+#include "lucent/context.h"
+#include "ray_query_arrays.h"
+
+namespace lucent::python {
+
+class CpuRayQueries {
+  public:
+    /// vertices: vertex_count x 3 floats; indices: triangle_count x 3, each < vertex_count.
+    /// threads: workers counting the caller, 0 = one per core. The BVH is built at the first
+    /// query, as the engine builds it at the first launch.
+    CpuRayQueries(const float* vertices, size_t vertex_count, const uint32_t* indices,
+                  size_t triangle_count, unsigned threads);
+
+    /// New positions (same count): the BVH is refitted at the next query, or rebuilt.
+    void update(const float* vertices, bool rebuild);
+
+    void intersect(const RayArrays& rays, const HitArrays& out);
+    void occluded(const RayArrays& rays, uint8_t* out);
+
+    unsigned threads() const { return m_pool.size(); }
+    /// The last query's figures: accel_ms for a build or refit it made, launch_ms for the rays.
+    const LaunchReport& last_launch() const { return m_report; }
+
+  private:
+    enum class BvhState { kCurrent, kBuild, kRefit };
+    /// Builds or refits the BVH if the vertices changed; starts m_report.
+    void prepare();
+    /// Runs answer(i) for every ray i in [0, count), in chunks taken by the workers.
+    template <class Answer>
+    void for_each_ray(size_t count, const Answer& answer);
+
+    std::vector<float3> m_vertices;
+    std::vector<uint3> m_indices;
+    accel::TriangleAccel m_accel;
+    BvhState m_bvh = BvhState::kBuild;
+    cpu::ThreadPool m_pool;
+    LaunchReport m_report;
+};
+
+}  // namespace lucent::python
