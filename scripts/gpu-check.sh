@@ -290,7 +290,7 @@ python)
     ext=$(python3 -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
     echo "== linking the Python module for $(python3 --version) ($ext)"
     g++ -O2 -std=c++20 -shared -fPIC -fvisibility=hidden -DLUCENT_HAVE_CUDA=1 \
-        -Ipython/src -I. -Iinclude $(python3 -m pybind11 --includes) python/src/*.cpp \
+        -Ipython/src -I. -Isrc -Iinclude $(python3 -m pybind11 --includes) python/src/*.cpp \
         $P/objects/*.o -Wl,--start-group $P/lib/*.a -Wl,--end-group -Wl,-Bsymbolic-functions \
         $P/so/*.so* -ldl -lpthread -o "$pkg/_lucent$ext" 2>&1 | grep -v "warning: " | head -20
     export LD_LIBRARY_PATH=$PWD/$P/so PYTHONPATH=$work/lucent-python LUCENT_CLI=$work/lucent-cli
