@@ -17,11 +17,17 @@ class ProgressBar {
     void update(unsigned long long done, unsigned long long total);
     /// Clears the line.
     void finish();
+    /// Whether it draws at all (stderr is a terminal).
+    bool enabled() const { return m_enabled; }
 
   private:
     std::string m_label, m_unit;
     bool m_enabled;
     bool m_drawn = false;
+    // The rate is measured from the first update (not from construction, which may be long
+    // before the work starts) and again from each restart (done going back: a new launch).
+    bool m_started = false;
+    unsigned long long m_first_done = 0, m_last_done = 0;
     std::chrono::steady_clock::time_point m_start, m_last;
 };
 

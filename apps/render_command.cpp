@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_parse.h"
 #include "progress_bar.h"
 #include "samples/sample.h"
@@ -15,6 +17,7 @@ namespace {
 
 using samples::Clock;
 using samples::ms_since;
+using Json = nlohmann::ordered_json;
 
 /// Breaks `text` into lines of at most kHelpWidth columns; the first line starts at column
 /// `first`, the others are indented by `indent`.
@@ -72,6 +75,10 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.scene = args.scene;
     s.verbose = args.verbose;
     if (!args.jit_check.empty()) s.jit_check_sm = parse_sm("--jit-check", args.jit_check);
+    if (!args.eye.empty()) s.camera.eye = parse_vec3("--eye", args.eye);
+    if (!args.look.empty()) s.camera.look = parse_vec3("--look", args.look);
+    if (!args.up.empty()) s.camera.up = parse_vec3("--up", args.up);
+    if (!args.fov.empty()) s.camera.fov_degrees = parse_float("--fov", args.fov, 0, 180, true);
     s.repeat = args.repeat;
     s.spp = args.spp;
     for (const std::string& text : args.sets) {
@@ -79,6 +86,68 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
         s.sets[name] = value;  // a later --set of the same name wins, as in most CLIs
     }
     return s;
+}
+
+/// The render's progress on a terminal (stderr): the launches done of several (a
+/// progressive sample, --repeat), or else the rows done of the one launch, which the CPU
+/// backend reports in bands as they finish.
+class RenderProgress {
+  public:
+    explicit RenderProgress(bool wanted) : m_wanted(wanted) {}
+    bool shown() const { return m_wanted && m_rows.enabled(); }
+    void launches(unsigned done, unsigned total) {
+        if (!m_wanted) return;
+        m_several = m_several || total > 1;
+        m_rows.finish();
+        m_launches.update(done, total);
+    }
+    void rows(const LaunchProgress& p) {
+        if (!m_wanted || m_several) return;
+        m_rows.update(p.rows_done, p.rows);
+    }
+    void finish() {
+        m_rows.finish();
+        m_launches.finish();
+    }
+
+  private:
+    bool m_wanted;
+    bool m_several = false;
+    ProgressBar m_rows{"render", "rows"}, m_launches{"render", "launches"};
+};
+
+/// `render --json`: the settings asked for, where it ran, and the stages' times.
+Json render_json(const RenderArgs& args, const samples::RenderSettings& settings,
+                 const samples::Sample& sample, const samples::RenderResult& result,
+                 double write_ms, double total_ms) {
+    Json j;
+    j["sample"] = sample.name;
+    j["width"] = result.image.width;
+    j["height"] = result.image.height;
+    j["backend"] = result.backend;
+    if (!result.backend_notice.empty()) j["backend_notice"] = result.backend_notice;
+    j["scene"] = settings.scene.empty() ? Json(nullptr) : Json(settings.scene);
+    j["sets"] = Json::object();
+    for (const auto& [name, value] : settings.sets) j["sets"][name] = value;
+    j["spp"] = settings.spp;
+    j["repeat"] = settings.repeat;
+    j["threads"] = settings.threads;
+    Json camera = Json::object();
+    auto vec = [](float3 v) { return Json::array({v.x, v.y, v.z}); };
+    if (settings.camera.eye) camera["eye"] = vec(*settings.camera.eye);
+    if (settings.camera.look) camera["look"] = vec(*settings.camera.look);
+    if (settings.camera.up) camera["up"] = vec(*settings.camera.up);
+    if (settings.camera.fov_degrees) camera["fov"] = *settings.camera.fov_degrees;
+    j["camera"] = camera;
+    j["stages"] = Json::array();
+    for (const samples::StageTiming& stage : result.stages)
+        j["stages"].push_back({{"name", stage.name}, {"ms", stage.ms}, {"note", stage.note}});
+    j["write_ms"] = write_ms;
+    j["total_ms"] = total_ms;
+    j["exceptions"] = result.report.exception_count();
+    if (result.report.exception_count() > 0) j["exception_summary"] = result.report.summary();
+    j["out"] = args.out;
+    return j;
 }
 
 }  // namespace
@@ -120,6 +189,16 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
         ->type_name("N")
         ->check(CLI::Range(0u, 1000000u).description(""))
         ->capture_default_str();
+    cmd->add_option("--eye", args.eye, "Camera position, over the scene's")->type_name("X,Y,Z");
+    cmd->add_option("--look", args.look, "Point the camera looks at, over the scene's")
+        ->type_name("X,Y,Z");
+    cmd->add_option("--up", args.up, "Camera up direction, over the scene's")->type_name("X,Y,Z");
+    cmd->add_option("--fov", args.fov, "Vertical field of view in degrees, (0, 180), over the "
+                                       "scene's")
+        ->type_name("DEG");
+    cmd->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
+    cmd->add_flag("--json", args.json,
+                  "Print the settings and stage timings as one JSON object (no progress)");
     cmd->add_option("--jit-check", args.jit_check,
                     "Also generate the CUDA megakernel and compile it with NVRTC for this GPU "
                     "architecture (works without a GPU)")
@@ -132,7 +211,11 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "  lucent render --backend cuda         # on the GPU; a clear error without one\n"
                 "  lucent render --repeat 500           # median launch time and frames/s\n"
                 "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n"
-                "  lucent render --sample pathtracer --scene cornell-materials --spp 256\n");
+                "  lucent render --sample pathtracer --scene cornell-materials --spp 256\n"
+                "  lucent render --sample igi --eye 278,273,-500 --fov 50   # another view\n"
+                "  lucent render --json --out x.exr     # timings for scripts\n"
+                "\nThe camera flags replace the parts of the scene's camera they give; the\n"
+                "scene's own camera (or one framing the scene) gives the rest.\n");
     return cmd;
 }
 
@@ -141,29 +224,42 @@ int run_render(const RenderArgs& args) {
     check_image_path("--out", args.out);
     const samples::Sample& sample = samples::find_sample(args.sample);
     sample.read_options(settings);  // every --set checked before the render
-    if (args.verbose) {
-        std::printf("sample %s, %ux%u, backend %s, threads %u, scene %s\n", sample.name.c_str(),
-                    settings.width, settings.height, args.backend.c_str(), settings.threads,
-                    settings.scene.empty() ? "(default)" : settings.scene.c_str());
-        for (const auto& [name, value] : settings.sets)
-            std::printf("  --set %s=%s\n", name.c_str(), value.c_str());
+    const bool talk = !args.quiet && !args.json;
+    if (talk) {
+        // Before the render, which may take long: what is being rendered.
+        std::printf("%s: %ux%u, backend %s, scene %s\n", sample.name.c_str(), settings.width,
+                    settings.height, args.backend.c_str(),
+                    settings.scene.empty() ? "(the sample's own)" : settings.scene.c_str());
+        if (args.verbose) {
+            std::printf("  threads %u, spp %u, repeat %u\n", settings.threads, settings.spp,
+                        settings.repeat);
+            for (const auto& [name, value] : settings.sets)
+                std::printf("  --set %s=%s\n", name.c_str(), value.c_str());
+        }
+        std::fflush(stdout);
     }
 
-    ProgressBar bar("render", "launches");
+    RenderProgress progress(talk);
     samples::RenderSettings run = settings;
-    run.progress = [&bar](unsigned done, unsigned total) { bar.update(done, total); };
+    run.progress = [&progress](unsigned done, unsigned total) { progress.launches(done, total); };
+    if (progress.shown())
+        run.on_launch_progress = [&progress](const LaunchProgress& p) { progress.rows(p); };
     const Clock::time_point start = Clock::now();
     samples::RenderResult result = sample.render(run);
-    bar.finish();
+    progress.finish();
     const Clock::time_point written = Clock::now();
     scene::write_image(args.out, result.image);
     const double write_ms = ms_since(written);
     const double total_ms = ms_since(start);
 
+    if (args.json) {
+        std::printf("%s\n", render_json(args, settings, sample, result, write_ms, total_ms).dump(2).c_str());
+        return 0;
+    }
+    if (args.quiet) return 0;
     if (!result.backend_notice.empty()) std::printf("note: %s\n", result.backend_notice.c_str());
     std::printf("%s: %ux%u on %s\n", sample.name.c_str(), result.image.width, result.image.height,
                 result.backend.c_str());
-
     for (const samples::StageTiming& stage : result.stages)
         std::printf("  %-20s %10.3f ms%s%s\n", stage.name.c_str(), stage.ms,
                     stage.note.empty() ? "" : "  ", stage.note.c_str());

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lucent/context.h"
+#include "samples/camera_override.h"
 #include "samples/options.h"
 #include "scene/image_io.h"
 #include "scene/scene.h"
@@ -21,6 +22,7 @@ struct RenderSettings {
     std::vector<DeviceSpec> devices;          // --devices: launches spread over these
     unsigned threads = 0;                     // CPU workers, 0 = all cores
     std::string scene;                        // built-in scene name or file; empty = default
+    CameraOverride camera;                    // --eye --look --up --fov: over the scene's
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
     bool verbose = false;
     int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel

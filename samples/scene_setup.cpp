@@ -8,6 +8,12 @@
 
 namespace lucent::samples {
 
+scene::Scene load_render_scene(const RenderSettings& settings) {
+    scene::Scene scene = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    if (!settings.camera.empty()) scene.camera = settings.camera.applied_to(scene.camera);
+    return scene;
+}
+
 float scene_extent(const scene::Scene& scene) {
     float extent = 0;
     for (const auto& mesh : scene.meshes)

@@ -11,10 +11,15 @@
 #include "lucent/context.h"
 #include "samples/common/camera.h"
 #include "samples/common/lights.h"
+#include "samples/sample.h"
 #include "scene/image_io.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
+
+/// The scene of settings.scene (default: the Cornell box), with the parts of its camera that
+/// settings.camera gives replaced (SettingsError for a camera that cannot see).
+scene::Scene load_render_scene(const RenderSettings& settings);
 
 /// The largest coordinate magnitude of any vertex: offsets for secondary rays scale with
 /// it (the Cornell box is in millimetres).

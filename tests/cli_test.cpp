@@ -218,6 +218,76 @@ TEST_F(CliTest, RenderWritesAPfmByExtension) {
     EXPECT_EQ(fs::file_size(out), 12 + 1 + 16u * 8u * 3u * sizeof(float));
 }
 
+/// A file's bytes: two .pfm images of the same size are the same image when these are.
+std::string file_bytes(const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string flag_vector(float3 v) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g", double(v.x), double(v.y), double(v.z));
+    return buf;
+}
+
+TEST_F(CliTest, CameraFlagsReplaceThePartsOfTheScenesCameraTheyGive) {
+    const std::string base = "render --sample direct --size 32x24 --threads 1 --out ";
+    ASSERT_EQ(run_cli(base + "'" + path("own.pfm") + "'").exit_code, 0);
+    // The scene's own eye, given as a flag: the same camera, the same image.
+    const lucent::scene::Camera own = lucent::scene::load_scene("cornell").camera;
+    CliRun same = run_cli(base + "'" + path("same.pfm") + "' --eye " + flag_vector(own.eye));
+    ASSERT_EQ(same.exit_code, 0) << same.output;
+    EXPECT_EQ(file_bytes(path("own.pfm")), file_bytes(path("same.pfm")));
+    // Another field of view alone: the same eye and look, a narrower view.
+    CliRun narrow = run_cli(base + "'" + path("narrow.pfm") + "' --fov 10");
+    ASSERT_EQ(narrow.exit_code, 0) << narrow.output;
+    EXPECT_NE(file_bytes(path("own.pfm")), file_bytes(path("narrow.pfm")));
+    // The whitted and fog samples, which have cameras of their own, take the flags too.
+    for (const char* sample : {"whitted", "fog"}) {
+        CliRun run = run_cli(std::string("render --sample ") + sample +
+                             " --size 16x16 --fov 20 --out '" + path(sample + std::string(".pfm")) + "'");
+        EXPECT_EQ(run.exit_code, 0) << sample << ": " << run.output;
+    }
+}
+
+TEST_F(CliTest, ACameraThatCannotSeeIsRefusedByName) {
+    CliRun same_point = expect_render_usage_error("--sample direct --size 8x8 --eye 1,2,3 --look 1,2,3");
+    EXPECT_NE(same_point.output.find("eye and look are the same point (1,2,3)"), std::string::npos)
+        << same_point.output;
+    CliRun along = expect_render_usage_error("--sample igi --size 8x8 --eye 0,0,0 --look 0,5,0 --up 0,1,0");
+    EXPECT_NE(along.output.find("along the view direction"), std::string::npos) << along.output;
+    CliRun fov = expect_render_usage_error("--size 8x8 --fov 180");
+    EXPECT_NE(fov.output.find("--fov '180': expected a number in (0, 180)"), std::string::npos)
+        << fov.output;
+    expect_render_usage_error("--size 8x8 --eye 1,2");
+}
+
+TEST_F(CliTest, RenderJsonIsOneObjectWithTheStages) {
+    CliRun run = run_cli("render --sample whitted --size 16x16 --json --set lights=2 --fov 30 --out '" +
+                         path("w.exr") + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json j = nlohmann::json::parse(run.output);  // nothing else is printed
+    EXPECT_EQ(j["sample"], "whitted");
+    EXPECT_EQ(j["width"], 16);
+    EXPECT_EQ(j["sets"]["lights"], "2");
+    EXPECT_EQ(j["camera"]["fov"], 30.0);
+    EXPECT_FALSE(j["camera"].contains("eye"));
+    ASSERT_FALSE(j["stages"].empty());
+    bool launch = false;
+    for (const auto& stage : j["stages"]) launch = launch || stage["name"] == "launch";
+    EXPECT_TRUE(launch) << j.dump(2);
+    EXPECT_GT(j["total_ms"].get<double>(), 0.0);
+    EXPECT_EQ(j["out"], path("w.exr"));
+    EXPECT_TRUE(fs::exists(path("w.exr")));
+}
+
+TEST_F(CliTest, QuietRenderPrintsNothing) {
+    CliRun run = run_cli("render --size 16x16 --backend cpu -q --out '" + path("q.png") + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_EQ(run.output, "");
+    EXPECT_TRUE(fs::exists(path("q.png")));
+}
+
 }  // namespace
 
 namespace {

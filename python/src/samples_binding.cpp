@@ -23,10 +23,26 @@ std::string option_text(const py::handle& value) {
     return py::str(value).cast<std::string>();
 }
 
+/// A camera keyword (eye, look, up): None, or three numbers.
+std::optional<float3> camera_point(const py::object& value, const char* name) {
+    if (value.is_none()) return std::nullopt;
+    std::vector<double> v;
+    try {
+        v = value.cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+    }
+    if (v.size() != 3)
+        throw py::value_error(std::string("render: ") + name +
+                              " must be three numbers (x, y, z); got " +
+                              py::repr(value).cast<std::string>());
+    return make_float3(float(v[0]), float(v[1]), float(v[2]));
+}
+
 py::array_t<float> render(const std::string& name, const std::optional<std::string>& scene,
                           std::pair<unsigned, unsigned> size, const std::string& backend,
                           unsigned threads, unsigned spp, int jit_check_sm,
-                          const py::kwargs& options) {
+                          const py::object& eye, const py::object& look, const py::object& up,
+                          std::optional<float> fov, const py::kwargs& options) {
     samples::RenderSettings settings;
     settings.width = size.first;
     settings.height = size.second;
@@ -40,6 +56,10 @@ py::array_t<float> render(const std::string& name, const std::optional<std::stri
     settings.spp = spp;
     settings.jit_check_sm = jit_check_sm;
     if (scene) settings.scene = *scene;
+    settings.camera.eye = camera_point(eye, "eye");
+    settings.camera.look = camera_point(look, "look");
+    settings.camera.up = camera_point(up, "up");
+    settings.camera.fov_degrees = fov;  // checked with the rest of the camera by the sample
     for (const auto& [key, value] : options)
         settings.sets[key.cast<std::string>()] = option_text(value);
     samples::RenderResult result;
@@ -107,9 +127,13 @@ void bind_samples(py::module_& m) {
     m.def("render", &render, py::arg("sample"), py::kw_only(), py::arg("scene") = py::none(),
           py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
           py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
+          py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
+          py::arg("fov") = py::none(),
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
-          "(progressive samples; 0: the sample's default), and the sample's options as "
+          "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
+          "and vertical fov in degrees over the scene's (--eye --look --up --fov; each "
+          "None: the scene's), and the sample's options as "
           "keywords (vpls=64). Returns the linear RGB image as an (H, W, 4) float32 array, "
           "row 0 at the top, alpha 1.");
     m.def("samples", &list_samples,

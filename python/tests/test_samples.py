@@ -58,6 +58,31 @@ def test_render_a_scene_by_name(tmp_path, cli):
     np.testing.assert_array_equal(a[..., :3], read_pfm(out))
 
 
+@pytest.mark.parametrize("sample", ["igi", "whitted"])
+def test_render_with_a_camera_is_the_cli_image(tmp_path, cli, sample):
+    camera = dict(eye=(100, 400, -300), look=(278, 200, 280), up=(0, 1, 0), fov=50) if sample == "igi" \
+        else dict(fov=25, up=(0.1, 1, 0))
+    image = lucent.render(sample, size=(40, 32), backend=BACKEND, **camera)
+    out = tmp_path / "c.pfm"
+    args = [cli, "render", "--sample", sample, "--size", "40x32", "--backend", BACKEND, "--out", str(out)]
+    for name, value in camera.items():
+        args += [f"--{name}", ",".join(str(v) for v in value) if isinstance(value, tuple) else str(value)]
+    subprocess.run(args, check=True, capture_output=True)
+    np.testing.assert_array_equal(image[..., :3], read_pfm(out))
+    assert not np.array_equal(image, lucent.render(sample, size=(40, 32), backend=BACKEND))
+
+
+def test_a_bad_camera_is_a_value_error():
+    with pytest.raises(ValueError, match=r"render: eye must be three numbers \(x, y, z\); got \(1, 2\)"):
+        lucent.render("direct", size=(8, 8), eye=(1, 2))
+    with pytest.raises(ValueError, match="render: look must be three numbers"):
+        lucent.render("direct", size=(8, 8), look="abc")
+    with pytest.raises(ValueError, match=r"render: camera: eye and look are the same point \(1,2,3\)"):
+        lucent.render("direct", size=(8, 8), eye=(1, 2, 3), look=np.array([1, 2, 3]))
+    with pytest.raises(ValueError, match=r"camera: fov 0 degrees; the vertical field of view must be in \(0, 180\)"):
+        lucent.render("fog", size=(8, 8), fov=0)
+
+
 def test_samples_lists_every_sample_with_its_options():
     listed = lucent.samples()
     assert set(listed) >= {"whitted", "direct", "igi", "radiosity", "pathtracer", "fog"}

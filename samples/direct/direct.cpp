@@ -27,8 +27,7 @@ struct DirectScene {
 DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValues& options,
                   const CameraBuffer& camera) {
     const float ambient = options.number("ambient");
-    const scene::Scene input =
-        scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    const scene::Scene input = load_render_scene(settings);
     ctx.set_ray_type<direct::RadiancePayload>(direct::kRadianceRay, "radiance");
     ctx.set_ray_type<direct::ShadowPayload>(direct::kShadowRay, "shadow",
                                             /*expects_closest_hit=*/false);

@@ -255,7 +255,7 @@ struct IgiScene {
 
     IgiScene(Context& ctx, const RenderSettings& settings, const IgiOptions& options,
              const CameraBuffer& camera)
-        : input(scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene)),
+        : input(load_render_scene(settings)),
           lights(point_emitters(input, options.area_side)) {
         if (lights.empty())
             throw SettingsError("igi: scene '" + input.name +

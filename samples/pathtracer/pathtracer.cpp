@@ -77,7 +77,7 @@ struct PathScene {
 /// entry 0 reading `camera`.
 PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions& options,
                 const CameraBuffer& camera) {
-    scene::Scene input = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    scene::Scene input = load_render_scene(settings);
     const float extent = scene_extent(input);
     const float epsilon = std::max(1e-4f, 1e-4f * extent);
     add_light_geometry(input, 10 * epsilon);

@@ -46,7 +46,7 @@ struct Options {
 /// The scene of settings.scene (default: cornell); SettingsError when it has no area light
 /// (declared, or an emissive triangle).
 scene::Scene load_lit_scene(const RenderSettings& settings) {
-    scene::Scene input = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    scene::Scene input = load_render_scene(settings);
     if (area_lights(input).empty())
         throw SettingsError("radiosity: scene '" + input.name +
                             "' has no area light nor emissive triangle; the photons leave area "

@@ -31,6 +31,23 @@ sample_common::PinholeCamera camera_frame(const WhittedLayout& layout, float asp
     return {layout.eye, U * (half_height * aspect), V * half_height, W};
 }
 
+/// The sample's camera as a scene::Camera, with the parts settings.camera gives replaced.
+scene::Camera whitted_camera(const RenderSettings& settings) {
+    const WhittedLayout& layout = whitted_layout();
+    scene::Camera own;
+    own.eye = layout.eye;
+    own.look = layout.lookat;
+    own.up = layout.up;
+    own.fov_degrees = layout.vfov_degrees;
+    return settings.camera.empty() ? own : settings.camera.applied_to(own);
+}
+
+/// The pinhole of the render: the sample's own frame, or that of the camera asked for.
+sample_common::PinholeCamera whitted_pinhole(const RenderSettings& settings) {
+    if (settings.camera.empty()) return camera_frame(whitted_layout(), settings.aspect());
+    return pinhole_camera(whitted_camera(settings), settings.aspect());
+}
+
 /// The sample's --set options, checked.
 struct WhittedOptions {
     int antialiasing = 0;
@@ -288,13 +305,7 @@ class WhittedSession final : public CameraSession {
         : CameraSession(sample, settings), m_lights(options.lights) {
         set_output(build_scene(context(), options, settings.width, settings.height, camera()));
         m_camera = context().ray_generation_program(0);
-        const WhittedLayout& layout = whitted_layout();
-        scene::Camera start;
-        start.eye = layout.eye;
-        start.look = layout.lookat;
-        start.up = layout.up;
-        start.fov_degrees = layout.vfov_degrees;
-        start_at(start, camera_frame(layout, settings.aspect()));
+        start_at(whitted_camera(settings), whitted_pinhole(settings));
     }
 
   private:
@@ -339,7 +350,7 @@ class WhittedSample final : public Sample {
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        camera.set(camera_frame(whitted_layout(), settings.aspect()));
+        camera.set(whitted_pinhole(settings));
         auto output = build_scene(ctx, options, settings.width, settings.height, camera);
         out.stages.push_back({"scene setup", ms_since(setup_start)});
         timed_launch(ctx, 0, settings, out);
