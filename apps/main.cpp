@@ -8,6 +8,7 @@
 #include "bench_fog_command.h"
 #include "bench_igi_command.h"
 #include "bench_present_command.h"
+#include "cli_errors.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "lucent/version.h"
@@ -72,8 +73,11 @@ int main(int argc, char** argv) {
         try {
             app.parse(argc, argv);
         } catch (const CLI::ParseError& e) {
-            // --help exits 0; every other parse error is a usage error.
-            return app.exit(e) == 0 ? 0 : kUsageExit;
+            // --help and --version print and exit 0; every other parse error is a usage
+            // error, worded as Lucent's own.
+            if (e.get_exit_code() == 0) return app.exit(e);
+            const UsageMessage message = usage_message(app, e, argc, argv);
+            return report(message.where, "", message.text.c_str(), kUsageExit);
         }
         if (render->parsed()) {
             where = "lucent render";

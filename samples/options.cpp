@@ -2,6 +2,8 @@
 // --set values against them.
 #include "samples/options.h"
 
+#include "samples/nearest_name.h"
+
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -89,9 +91,14 @@ OptionValues::OptionValues(const std::string& sample, const std::vector<SampleOp
         for (const SampleOption& option : options) known |= option.name == name;
         if (known) continue;
         std::string names = options.empty() ? "it has no options" : "its options are ";
-        for (size_t i = 0; i < options.size(); ++i) names += (i ? ", " : "") + options[i].name;
+        std::vector<std::string> all;
+        for (size_t i = 0; i < options.size(); ++i) {
+            names += (i ? ", " : "") + options[i].name;
+            all.push_back(options[i].name);
+        }
         throw SettingsError("--set " + name + "=" + text + ": sample '" + sample +
-                            "' has no option '" + name + "'; " + names);
+                            "' has no option '" + name + "'" + did_you_mean(name, all) + "; " +
+                            names);
     }
     for (const SampleOption& option : options) {
         const auto given = sets.find(option.name);

@@ -3,6 +3,7 @@
 #include <memory>
 #include <vector>
 
+#include "samples/nearest_name.h"
 #include "samples/sample.h"
 #include "samples/settings_error.h"
 
@@ -47,11 +48,14 @@ const std::vector<const Sample*>& all_samples() {
 
 const Sample& find_sample(const std::string& name) {
     std::string names;
+    std::vector<std::string> all;
     for (const Sample* sample : all_samples()) {
         if (sample->name == name) return *sample;
         names += (names.empty() ? "" : ", ") + sample->name;
+        all.push_back(sample->name);
     }
-    throw SettingsError("--sample " + name + ": no such sample; the samples are " + names);
+    throw SettingsError("--sample " + name + ": no such sample" + did_you_mean(name, all) +
+                        "; the samples are " + names);
 }
 
 }  // namespace lucent::samples
