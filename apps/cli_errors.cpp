@@ -1,5 +1,7 @@
 #include "cli_errors.h"
 
+#include <algorithm>
+#include <cctype>
 #include <regex>
 #include <sstream>
 #include <vector>
@@ -89,6 +91,22 @@ UsageMessage usage_message(CLI::App& app, const CLI::ParseError& error, int argc
                              samples::did_you_mean(typed, names) + "; the commands are " +
                              join(names);
         return out;
+    }
+    if (dynamic_cast<const CLI::RequiredError*>(&error)) {
+        // A required argument missing beside a flag the command does not have: the unknown
+        // flag is the likelier mistake (a typo that swallowed the argument), so it is named.
+        const std::vector<std::string> flags = flag_names(command);
+        for (int i = 1; i < argc; ++i) {
+            std::string word = argv[i];
+            if (word.size() < 2 || word[0] != '-' || std::isdigit((unsigned char)word[1]) || word[1] == '.')
+                continue;  // not a flag: a word or a negative number
+            word = word.substr(0, word.find('='));
+            if (std::find(flags.begin(), flags.end(), word) != flags.end() || word == "--help" ||
+                word == "-h")
+                continue;
+            out.text = "unknown flag " + word + samples::did_you_mean(word, flags) + help;
+            return out;
+        }
     }
     if (dynamic_cast<const CLI::ExtrasError*>(&error)) {
         // "The following argument(s) was/were not expected: b a": CLI11 lists them last first.

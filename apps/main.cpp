@@ -10,6 +10,7 @@
 #include "bench_present_command.h"
 #include "cli_errors.h"
 #include "cli_parse.h"
+#include "compare_command.h"
 #include "lucent/error.h"
 #include "lucent/version.h"
 #include "noise_command.h"
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
         "  lucent view --sample pathtracer --scene cornell-materials\n"
         "  lucent bench rays --scene ../shared/scenes/sponza.obj\n"
         "  lucent tea --block 0,0 --key 0,0,0,0 --rounds 32\n"
+        "  lucent compare reference.exr render.exr --error-image flip.png\n"
         "Run `lucent render --help` for the samples and their options.\n");
 
     RenderArgs render_args;
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     BenchPresentArgs bench_present_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
+    CompareArgs compare_args;
     std::string where = "lucent";
     try {
         CLI::App* render = add_render_command(app, render_args);
@@ -70,6 +73,7 @@ int main(int argc, char** argv) {
         CLI::App* bench_present = add_bench_present_command(bench.bench, bench_present_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
+        CLI::App* compare = add_compare_command(app, compare_args);
         try {
             app.parse(argc, argv);
         } catch (const CLI::ParseError& e) {
@@ -114,6 +118,10 @@ int main(int argc, char** argv) {
         if (tea->parsed()) {
             where = "lucent tea";
             return run_tea(tea_args);
+        }
+        if (compare->parsed()) {
+            where = "lucent compare";
+            return run_compare(compare_args);
         }
         if (noise->parsed()) {
             where = "lucent noise";

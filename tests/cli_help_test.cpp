@@ -28,7 +28,8 @@ CliRun run_lucent(const std::string& args) {
 }
 
 const char* const kCommands[] = {"render",    "view",      "bench rays", "bench build", "bench tea",
-                                 "bench igi", "bench fog", "tea",        "noise"};
+                                 "bench igi", "bench fog", "tea",        "noise",
+                                 "compare"};
 
 TEST(CliHelp, EverySubcommandShowsExamplesOfItself) {
     for (const char* command : kCommands) {
@@ -94,8 +95,9 @@ TEST(CliHelp, EveryUsageErrorHasOneStyleAndMistypesAGuess) {
     };
     const Case cases[] = {
         {"rendr", "lucent: 'rendr' is not a command (did you mean 'render'?); the commands are "
-                  "render, view, bench, tea, noise"},
-        {"", "lucent: a command is needed: render, view, bench, tea, noise; run `lucent --help`"},
+                  "render, view, bench, tea, noise, compare"},
+        {"", "lucent: a command is needed: render, view, bench, tea, noise, compare; run `lucent "
+             "--help`"},
         {"bench ray", "lucent bench: 'ray' is not a command (did you mean 'rays'?); the commands "
                       "are rays, tea, build, igi, fog, present"},
         {"render --sampel igi", "lucent render: unknown flag --sampel (did you mean '--sample'?); "

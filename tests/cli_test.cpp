@@ -281,6 +281,36 @@ TEST_F(CliTest, RenderJsonIsOneObjectWithTheStages) {
     EXPECT_TRUE(fs::exists(path("w.exr")));
 }
 
+TEST_F(CliTest, CompareGivesTheFiguresAndFailsAboveAThreshold) {
+    for (const char* set : {"ambient=0.05", "ambient=0.3"})
+        ASSERT_EQ(run_cli(std::string("render --sample direct --size 32x32 -q --set ") + set +
+                          " --out '" + path(set) + ".pfm'")
+                      .exit_code,
+                  0);
+    const std::string a = path("ambient=0.05") + ".pfm", b = path("ambient=0.3") + ".pfm";
+    CliRun same = run_cli("compare '" + a + "' '" + a + "' --json");
+    ASSERT_EQ(same.exit_code, 0) << same.output;
+    const nlohmann::json s = nlohmann::json::parse(same.output);
+    EXPECT_EQ(s["rmse"], 0.0);
+    EXPECT_EQ(s["flip_max"], 0.0);
+    EXPECT_TRUE(s["psnr_db"].is_null());  // infinite
+    CliRun differ = run_cli("compare '" + a + "' '" + b + "' --error-image '" + path("flip.exr") +
+                            "' --fail-above 0.01");
+    EXPECT_EQ(differ.exit_code, 1) << differ.output;
+    EXPECT_NE(differ.output.find("is above --fail-above 0.01"), std::string::npos) << differ.output;
+    EXPECT_TRUE(fs::exists(path("flip.exr")));
+    EXPECT_EQ(run_cli("compare '" + a + "' '" + b + "' --fail-above 0.99").exit_code, 0);
+    // Images of two sizes: an error naming both, and no error image.
+    ASSERT_EQ(run_cli("render --size 8x8 -q --out '" + path("small.png") + "'").exit_code, 0);
+    CliRun sizes = run_cli("compare '" + a + "' '" + path("small.png") + "' --error-image '" +
+                           path("none.png") + "'");
+    EXPECT_EQ(sizes.exit_code, 1);
+    EXPECT_NE(sizes.output.find("the images differ in size (32x32 and 8x8)"), std::string::npos)
+        << sizes.output;
+    EXPECT_FALSE(fs::exists(path("none.png")));
+    EXPECT_EQ(run_cli("compare '" + a + "' --ppd 0").exit_code, 2);
+}
+
 TEST_F(CliTest, QuietRenderPrintsNothing) {
     CliRun run = run_cli("render --size 16x16 --backend cpu -q --out '" + path("q.png") + "'");
     ASSERT_EQ(run.exit_code, 0) << run.output;

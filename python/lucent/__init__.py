@@ -6,6 +6,8 @@
   graph, variables, programs of the modules compiled into this extension), and launches.
 - The samples: ``render("igi", scene="cornell", size=(512, 512), vpls=64)`` returns an
   (H, W, 4) float32 image; ``samples()`` lists them with their options.
+- Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
+  FLIP, as ``lucent compare``).
 
 docs/python.md in the repository is the tutorial.
 """
@@ -35,8 +37,10 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     Transform,
     TriangleMesh,
     __version__,
+    compare,
     cuda_built,
     modules,
+    read_image,
     render,
     samples,
     types,

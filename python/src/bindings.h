@@ -19,6 +19,7 @@ void bind_nodes(py::module_& m);           // nodes_binding.cpp
 void bind_programs(py::module_& m);        // programs_binding.cpp
 void bind_triangle_mesh(py::module_& m);   // mesh_binding.cpp
 void bind_samples(py::module_& m);         // samples_binding.cpp
+void bind_images(py::module_& m);          // images_binding.cpp
 
 /// "auto", "cpu" or "cuda"; a ValueError naming `what` otherwise.
 BackendKind backend_kind(const std::string& name, const char* what);

@@ -49,4 +49,5 @@ PYBIND11_MODULE(_lucent, m) {
     bind_context(m);
     bind_triangle_mesh(m);
     bind_samples(m);
+    bind_images(m);
 }
