@@ -102,6 +102,34 @@ TEST_F(SceneFiles, ObjWithoutItsMaterialLibraryNamesTheLine) {
     EXPECT_NE(error_of(path).find("a.obj:2:"), std::string::npos) << error_of(path);
 }
 
+TEST_F(SceneFiles, NumbersThatAreNotNumbersAreRefusedWithTheirLine) {
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    struct Case {
+        const char* name;
+        std::string text;
+        const char* message;
+    };
+    const Case cases[] = {
+        // An index past 32 bits once wrapped around to vertex 3.
+        {"wrap.obj", tri + "f 1 2 4294967299\n", "wrap.obj:4: face index '4294967299'"},
+        {"letters.obj", tri + "f 1 2 x\n", "letters.obj:4: face index 'x'"},
+        {"normal.obj", tri + "vn nan 0 1\nf 1//1 2//1 3//1\n", "normal.obj:4: normal has a value"},
+        {"uv.obj", tri + "vt inf 0\nf 1/1 2/1 3/1\n", "uv.obj:4: texture coordinate has a value"},
+        {"vertex.obj", "v 0 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "vertex.obj:1: vertex 1 has a value"},
+    };
+    for (const Case& c : cases)
+        EXPECT_NE(error_of(write(c.name, c.text)).find(c.message), std::string::npos)
+            << c.name << ": " << error_of(write(c.name, c.text));
+    write("nan.mtl", "newmtl m\nKd 0.5 0.5 0.5\nKe nan 0 0\n");
+    const std::string mtl = error_of(write("kd.obj", "mtllib nan.mtl\n" + tri + "usemtl m\nf 1 2 3\n"));
+    EXPECT_NE(mtl.find("nan.mtl:3: Ke has a value that is not a finite number: 'Ke nan 0 0'"),
+              std::string::npos) << mtl;
+    // What is valid stays valid: relative indices, v//vn, v/vt without normals, comments.
+    const std::string fine = error_of(write(
+        "fine.obj", tri + "vt 0.5 0.5\nvn 0 0 1\n# f 1 2 x\nf 1/1/1 2//1 -1/1\nf -3 -2 -1\n"));
+    EXPECT_EQ(fine, "");
+}
+
 TEST_F(SceneFiles, FifosDevicesAndFoldersAreRefusedNotReadForEver) {
     // A FIFO nobody writes to would block the reader for ever, /dev/zero would be read
     // until memory runs out: each is an error naming the path and what it is.
