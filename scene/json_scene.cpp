@@ -7,6 +7,8 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <vector>
 #include <sstream>
 
 #include "lucent/error.h"
@@ -85,6 +87,58 @@ class JsonReader {
     std::string m_path;
 };
 
+/// JSON allows a key twice in one object and nlohmann-json keeps the last value, so a scene
+/// written so loses the first without a word; it is refused instead, by its location. The
+/// parser's callback follows the objects and arrays being read to name it.
+class DuplicateKeyCheck {
+  public:
+    explicit DuplicateKeyCheck(std::string path) : m_path(std::move(path)) {}
+
+    bool operator()(int, json::parse_event_t event, json& parsed) {
+        switch (event) {
+            case json::parse_event_t::object_start:
+                m_stack.push_back(Frame{true});
+                break;
+            case json::parse_event_t::array_start:
+                m_stack.push_back(Frame{false});
+                break;
+            case json::parse_event_t::key: {
+                Frame& f = m_stack.back();
+                f.key = parsed.get<std::string>();
+                if (!f.keys.insert(f.key).second)
+                    throw Error(m_path + ": " + pointer() + ": the key '" + f.key +
+                                "' appears twice in one object; keep one (JSON keeps only the "
+                                "last, the first would be lost)");
+                break;
+            }
+            case json::parse_event_t::object_end:
+            case json::parse_event_t::array_end:
+                m_stack.pop_back();
+                [[fallthrough]];
+            case json::parse_event_t::value:
+                if (!m_stack.empty() && !m_stack.back().object) ++m_stack.back().index;
+                break;
+        }
+        return true;
+    }
+
+  private:
+    struct Frame {
+        bool object;
+        std::set<std::string> keys{};
+        std::string key{};
+        size_t index = 0;
+    };
+    /// The JSON pointer of the innermost key being read.
+    std::string pointer() const {
+        std::string out;
+        for (const Frame& f : m_stack) out += "/" + (f.object ? f.key : std::to_string(f.index));
+        return out;
+    }
+    std::string m_path;
+    std::vector<Frame> m_stack;
+};
+
 json parse_file(const std::string& path) {
     require_regular_file(path, "scene file");
     std::ifstream in(path, std::ios::binary);
@@ -93,7 +147,7 @@ json parse_file(const std::string& path) {
     buffer << in.rdbuf();
     const std::string text = buffer.str();
     try {
-        return json::parse(text);
+        return json::parse(text, DuplicateKeyCheck(path));
     } catch (const json::parse_error& e) {
         size_t line = 1, column = 1;
         for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i, ++column)

@@ -4,6 +4,7 @@
 // line, or the element of the body, at fault.
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -16,6 +17,14 @@
 namespace lucent::scene {
 
 namespace {
+
+/// A number read from a PLY for a message: "1.9", "nan", "1e+300" (never converted to an
+/// integer type, which NaN and huge values would make undefined).
+std::string number_text(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    return buf;
+}
 
 enum class Format { kAscii, kBinaryLittle, kBinaryBig };
 
@@ -227,18 +236,21 @@ Mesh load_ply_mesh(const std::string& path) {
                     continue;
                 }
                 double count = reader.value(p.count_type, where);
-                if (!(count >= 0 && count <= 1024))
-                    reader.fail(where + ": a list of " + std::to_string(count) +
-                                " items (at most 1024)");
+                if (!(count >= 0 && count <= 1024 && count == std::floor(count)))
+                    reader.fail(where + ": a list of " + number_text(count) +
+                                " items (a whole number, at most 1024)");
                 list.resize(size_t(count));
                 for (double& item_value : list) item_value = reader.value(p.type, where);
                 if (faces && p.name.rfind("vertex_ind", 0) == 0) {
-                    for (size_t k = 0; k < list.size(); ++k)
+                    for (size_t k = 0; k < list.size(); ++k) {
+                        if (list[k] != std::floor(list[k]))  // NaN too: never equal
+                            reader.fail(where + ": vertex index " + number_text(list[k]) +
+                                        " is not a whole number");
                         if (!(list[k] >= 0 && list[k] < double(mesh.positions.size())))
-                            reader.fail(where + ": vertex index " +
-                                        std::to_string((long long)list[k]) +
+                            reader.fail(where + ": vertex index " + number_text(list[k]) +
                                         " out of range (there are " +
                                         std::to_string(mesh.positions.size()) + " vertices)");
+                    }
                     for (size_t k = 1; k + 1 < list.size(); ++k)
                         mesh.indices.push_back(
                             uint3{unsigned(list[0]), unsigned(list[k]), unsigned(list[k + 1])});

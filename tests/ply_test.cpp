@@ -105,6 +105,26 @@ TEST_F(Ply, ErrorsNameTheLineOrElement) {
     EXPECT_NE(error_of(nan).find("not finite"), std::string::npos) << error_of(nan);
 }
 
+TEST_F(Ply, IndicesAndCountsThatAreNotWholeNumbersAreRefused) {
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list float float vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n";
+    // A float index once truncated to a vertex (1.9 as 1); NaN and 1e300 were converted to
+    // an integer for the message (undefined behaviour).
+    for (const char* face : {"3 0 1 1.9\n", "3 0 1 nan\n", "3 0 1 1e300\n", "2.5 0 1 2\n"}) {
+        const std::string error = error_of(write("g.ply", header + face));
+        EXPECT_NE(error.find("element 'face' 0"), std::string::npos) << face << error;
+        EXPECT_TRUE(error.find("not a whole number") != std::string::npos ||
+                    error.find("out of range") != std::string::npos ||
+                    error.find("a whole number, at most 1024") != std::string::npos)
+            << face << error;
+    }
+    EXPECT_NE(error_of(write("h.ply", header + "3 0 1 1e300\n")).find("vertex index 1e+300 out of range"),
+              std::string::npos);
+    EXPECT_EQ(error_of(write("i.ply", header + "3 0 1 2\n")), "");  // float-typed but whole
+}
+
 TEST_F(Ply, CountsTheFileCannotHoldAreRefusedBeforeReading) {
     // 2^31 - 1 vertices declared in a file of a few bytes (it used to allocate and read on).
     auto huge = write("huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 2147483647\n"

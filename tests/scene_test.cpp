@@ -193,6 +193,20 @@ TEST_F(SceneFiles, ObjNormalsUvsAndMaterialsArrive) {
     ASSERT_FALSE(mesh.uvs.empty());
 }
 
+TEST_F(SceneFiles, JsonKeysGivenTwiceAreRefusedByLocation) {
+    const std::string mesh = R"({"positions": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]]})";
+    const std::string twice_top = error_of(write("t.json", R"({"meshes": [)" + mesh + R"(], "meshes": []})"));
+    EXPECT_NE(twice_top.find("t.json: /meshes: the key 'meshes' appears twice in one object"),
+              std::string::npos) << twice_top;
+    const std::string nested = error_of(write(
+        "n.json", R"({"meshes": [)" + mesh + "," +
+                      R"({"positions": [[0,0,0]], "positions": [[1,1,1]], "triangles": [[0,0,0]]})" + "]}"));
+    EXPECT_NE(nested.find("n.json: /meshes/1/positions: the key 'positions' appears twice"),
+              std::string::npos) << nested;
+    // The same key in two objects is no duplicate.
+    EXPECT_EQ(error_of(write("ok.json", R"({"meshes": [)" + mesh + "," + mesh + "]}")), "");
+}
+
 TEST_F(SceneFiles, JsonSceneWithInlineMeshLightsAndCamera) {
     auto path = write("s.json", R"({
       "camera": {"eye": [0, 1, 5], "look": [0, 1, 0], "fov": 40},
