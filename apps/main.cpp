@@ -16,6 +16,7 @@
 #include "noise_command.h"
 #include "render_command.h"
 #include "samples/settings_error.h"
+#include "scene/temp_file_cleanup.h"
 #include "tea_command.h"
 #include "view_command.h"
 
@@ -34,6 +35,8 @@ int report(const std::string& where, const char* kind, const char* what, int cod
 
 int main(int argc, char** argv) {
     using namespace lucent::cli;
+    // A render killed while it writes its image leaves no temporary file behind.
+    lucent::scene::remove_temp_files_on_signals();
     CLI::App app{"Lucent: an open, programmable ray-tracing engine", "lucent"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("lucent ") + lucent::version() +

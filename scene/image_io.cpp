@@ -3,6 +3,8 @@
 // file beside the target, rename over it.
 #include "scene/image_io.h"
 
+#include "scene/temp_file_cleanup.h"
+
 #include "scene/exr_encoder.h"
 
 #include <fcntl.h>
@@ -96,10 +98,12 @@ class TempFile {
         m_path = (dir / name).string();
         m_fd = ::mkstemp(m_path.data());
         if (m_fd < 0) fail("cannot create a file in '" + dir.string() + "'");
+        m_guard = std::make_unique<TempFileGuard>(m_path);  // removed if a signal ends us
     }
     ~TempFile() {
         if (m_fd >= 0) ::close(m_fd);
         if (!m_committed) ::unlink(m_path.c_str());
+        m_guard.reset();
     }
     TempFile(const TempFile&) = delete;
     TempFile& operator=(const TempFile&) = delete;
@@ -124,6 +128,7 @@ class TempFile {
         if (::close(fd) != 0) fail("write failed");
         if (::rename(m_path.c_str(), m_target.c_str()) != 0) fail("cannot replace the file");
         m_committed = true;
+        m_guard.reset();  // the path is the target's now: a signal must not remove it
     }
 
   private:
@@ -133,6 +138,7 @@ class TempFile {
     std::string m_target, m_path;
     int m_fd = -1;
     bool m_committed = false;
+    std::unique_ptr<TempFileGuard> m_guard;
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
-// Image comparison (scene/image_compare.h, scene/flip.h, scene/image_read.h): the figures on
-// images whose answers are known in closed form, FLIP's colour pipeline against published
-// CIE L*a*b* values, its spatial behaviour, and bad input refused by name.
+// Images in and out: comparison (scene/image_compare.h, scene/flip.h) on images whose
+// answers are known in closed form, FLIP's colour pipeline against published CIE L*a*b*
+// values, its spatial behaviour; reading (scene/image_read.h) with bad input refused by
+// name; and temporaries removed when a signal ends the writer (scene/temp_file_cleanup.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,11 @@
 #include "scene/flip.h"
 #include "scene/image_compare.h"
 #include "scene/image_read.h"
+#include "scene/temp_file_cleanup.h"
+
+#include <csignal>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace {
 
@@ -187,6 +193,37 @@ TEST_F(ImageRead, MalformedFilesNameTheFileAndTheFault) {
     std::filesystem::create_directories(path("folder.png"));
     EXPECT_THROW(lucent::scene::read_image(path("folder.png")), lucent::Error);
     EXPECT_THROW(lucent::scene::read_image(path("missing.exr")), lucent::Error);
+}
+
+}  // namespace
+
+namespace {
+
+// A process ended by a signal while a registered temporary exists leaves no file behind
+// (scene/temp_file_cleanup.h), and still ends by that signal.
+TEST(TempFileCleanup, ASignalRemovesTheRegisteredTemporaryAndStillEndsTheProcess) {
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("lucent_temp_cleanup_" + std::to_string(::getpid()))).string();
+    const std::string kept = path + ".kept";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        lucent::scene::remove_temp_files_on_signals();
+        std::ofstream(path) << "partial image";
+        std::ofstream(kept) << "an image written before";
+        {
+            lucent::scene::TempFileGuard released(kept);  // unregistered again: kept
+        }
+        lucent::scene::TempFileGuard guard(path);
+        ::raise(SIGTERM);
+        ::_exit(0);  // not reached
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    EXPECT_FALSE(std::filesystem::exists(path));
+    EXPECT_TRUE(std::filesystem::exists(kept));
+    std::filesystem::remove(kept);
 }
 
 }  // namespace
