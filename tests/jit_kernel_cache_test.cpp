@@ -5,6 +5,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/stat.h>
 
 #if LUCENT_HAVE_CUDA
 #include "cuda/jit/nvrtc_compiler.h"
@@ -30,9 +36,11 @@ class KernelCache : public ::testing::Test {
         fs::remove_all(dir);
         ::unsetenv("LUCENT_CACHE_DIR");
     }
+    /// The kernels' folder under the cache.
+    fs::path kernels() const { return dir / "kernels"; }
     fs::path only_entry() const {
         std::vector<fs::path> files;
-        for (auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
+        for (auto& e : fs::directory_iterator(kernels())) files.push_back(e.path());
         EXPECT_EQ(files.size(), 1u);
         return files.empty() ? fs::path() : files[0];
     }
@@ -89,7 +97,74 @@ TEST_F(KernelCache, CompileErrorNamesTheFileAndKeepsNothing) {
         EXPECT_NE(std::string(e.what()).find("cache_test.cu"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("undeclared_name"), std::string::npos) << e.what();
     }
-    EXPECT_TRUE(!fs::exists(dir) || fs::is_empty(dir));
+    EXPECT_TRUE(!fs::exists(kernels()) || fs::is_empty(kernels()));
+}
+
+TEST_F(KernelCache, TheFolderIsPrivateAndOneOthersCanWriteIsNotUsed) {
+    lucent::cuda::compile_cubin(request);
+    EXPECT_EQ(fs::status(kernels()).permissions() & fs::perms::all, fs::perms::owner_all);
+    fs::permissions(kernels(), fs::perms::all);  // 0777: anyone could plant an entry
+    testing::internal::CaptureStderr();
+    EXPECT_FALSE(lucent::cuda::compile_cubin(request).from_cache);
+    EXPECT_FALSE(lucent::cuda::compile_cubin(request).from_cache);
+    const std::string warning = testing::internal::GetCapturedStderr();
+    EXPECT_NE(warning.find("others can write to it (mode 777; chmod 700 it)"), std::string::npos)
+        << warning;
+    EXPECT_EQ(warning.find("lucent:"), warning.rfind("lucent:")) << "warned once: " << warning;
+}
+
+TEST_F(KernelCache, ALinkPlantedAtTheEntryIsNeitherFollowedNorLoaded) {
+    const auto cold = lucent::cuda::compile_cubin(request);
+    const fs::path entry = only_entry();
+    // A valid entry elsewhere, linked in: not loaded (O_NOFOLLOW).
+    const fs::path elsewhere = dir / "elsewhere.cubin";
+    fs::rename(entry, elsewhere);
+    fs::create_symlink(elsewhere, entry);
+    EXPECT_FALSE(lucent::cuda::compile_cubin(request).from_cache);
+    // The rewrite replaced the link with an entry and left its target alone.
+    EXPECT_FALSE(fs::is_symlink(entry));
+    EXPECT_TRUE(lucent::cuda::compile_cubin(request).from_cache);
+    // A link to a victim file, planted where the entry goes: the victim is never written.
+    const fs::path victim = dir / "victim.txt";
+    std::ofstream(victim) << "precious";
+    fs::remove(entry);
+    fs::create_symlink(victim, entry);
+    EXPECT_EQ(lucent::cuda::compile_cubin(request).cubin, cold.cubin);
+    std::ifstream in(victim);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text, "precious");
+}
+
+TEST_F(KernelCache, AFifoOrAHeaderThatLiesIsNeverWaitedOnOrAllocated) {
+    lucent::cuda::compile_cubin(request);
+    const fs::path entry = only_entry();
+    std::string bytes;
+    {
+        std::ifstream in(entry, std::ios::binary);
+        bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    }
+    // A header claiming a 1 GiB payload over a short file: refused before allocating.
+    const uint64_t huge = uint64_t(1) << 30;
+    std::memcpy(bytes.data() + 40, &huge, 8);
+    std::ofstream(entry, std::ios::binary | std::ios::trunc) << bytes;
+    EXPECT_FALSE(lucent::cuda::compile_cubin(request).from_cache);
+    // A FIFO in the entry's place: not opened for a blocking read, replaced by the entry.
+    fs::remove(entry);
+    ASSERT_EQ(::mkfifo(entry.c_str(), 0600), 0);
+    EXPECT_FALSE(lucent::cuda::compile_cubin(request).from_cache);
+    EXPECT_TRUE(fs::is_regular_file(entry));
+    EXPECT_TRUE(lucent::cuda::compile_cubin(request).from_cache);
+}
+
+TEST_F(KernelCache, ConcurrentColdCompilesLeaveOneValidEntryAndNoTemporaries) {
+    std::vector<std::thread> threads;
+    std::vector<std::string> cubins(4);
+    for (int k = 0; k < 4; ++k)
+        threads.emplace_back([&, k] { cubins[k] = lucent::cuda::compile_cubin(request).cubin; });
+    for (auto& t : threads) t.join();
+    for (const std::string& c : cubins) EXPECT_EQ(c, cubins[0]);
+    only_entry();  // exactly one file: no temporary left
+    EXPECT_TRUE(lucent::cuda::compile_cubin(request).from_cache);
 }
 #else
 TEST(KernelCache, NeedsTheCudaToolkit) {

@@ -1,9 +1,12 @@
 #include "cuda/jit/nvrtc_compiler.h"
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <nvrtc.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -80,45 +83,70 @@ uint64_t checksum(const std::string& data) {
 
 /// A cache entry: magic, the full key, payload size, payload checksum, payload. Anything
 /// that does not match exactly is treated as absent (and overwritten).
+constexpr size_t kHeaderBytes = 8 + 32 + 8 + 8;
+constexpr uint64_t kMaxPayload = uint64_t(1) << 30;
+
+/// Reads exactly `n` bytes (false at the end or on an error).
+bool read_exactly(int fd, char* out, size_t n) {
+    while (n > 0) {
+        const ssize_t got = ::read(fd, out, n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) return false;
+        out += got;
+        n -= size_t(got);
+    }
+    return true;
+}
+
+/// The entry is opened without following a link and without blocking (a FIFO planted in
+/// its place would hang the read), must be a regular file, and must be as long as its
+/// header says before anything is allocated for it.
 bool read_entry(const std::filesystem::path& file, const std::string& key, std::string& cubin) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return false;
-    char magic[8];
-    char stored_key[32];
-    uint64_t size = 0, sum = 0;
-    if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) return false;
-    if (!in.read(stored_key, 32) || std::string(stored_key, 32) != key) return false;
-    if (!in.read(reinterpret_cast<char*>(&size), 8) || !in.read(reinterpret_cast<char*>(&sum), 8))
+    const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct FdCloser {
+        int fd;
+        ~FdCloser() { ::close(fd); }
+    } closer{fd};
+    struct stat st{};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || uint64_t(st.st_size) < kHeaderBytes)
         return false;
-    if (size > (1ull << 30)) return false;
+    char header[kHeaderBytes];
+    if (!read_exactly(fd, header, kHeaderBytes) || std::memcmp(header, kMagic, 8) != 0 ||
+        std::string(header + 8, 32) != key)
+        return false;
+    uint64_t size = 0, sum = 0;
+    std::memcpy(&size, header + 40, 8);
+    std::memcpy(&sum, header + 48, 8);
+    if (size > kMaxPayload || uint64_t(st.st_size) != kHeaderBytes + size) return false;
     cubin.resize(size);
-    if (!in.read(cubin.data(), std::streamsize(size))) return false;
+    if (!read_exactly(fd, cubin.data(), size)) return false;
     return checksum(cubin) == sum;
 }
 
+/// Written to a temporary of an unpredictable name created with O_EXCL (mkstemp) in the
+/// cache's own folder, then renamed over the entry: a link planted at either name is never
+/// followed, and readers never see half an entry.
 void write_entry(const std::filesystem::path& file, const std::string& key,
                  const std::string& cubin) {
-    std::error_code ec;
-    std::filesystem::create_directories(file.parent_path(), ec);
-    auto tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) return;  // an unwritable cache only costs speed
-        uint64_t size = cubin.size(), sum = checksum(cubin);
-        out.write(kMagic, 8);
-        out.write(key.data(), 32);
-        out.write(reinterpret_cast<const char*>(&size), 8);
-        out.write(reinterpret_cast<const char*>(&sum), 8);
-        out.write(cubin.data(), std::streamsize(cubin.size()));
-        if (!out) {
-            out.close();
-            std::filesystem::remove(tmp, ec);
-            return;
-        }
+    std::string tmp = file.string() + ".XXXXXX";
+    const int fd = ::mkstemp(tmp.data());
+    if (fd < 0) return;  // an unwritable cache only costs speed
+    std::string bytes(kMagic, 8);
+    bytes += key;
+    const uint64_t size = cubin.size(), sum = checksum(cubin);
+    bytes.append(reinterpret_cast<const char*>(&size), 8);
+    bytes.append(reinterpret_cast<const char*>(&sum), 8);
+    bytes += cubin;
+    bool ok = true;
+    for (size_t done = 0; ok && done < bytes.size();) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        ok = n > 0;
+        if (ok) done += size_t(n);
     }
-    std::filesystem::rename(tmp, file, ec);  // atomic: readers never see half an entry
-    if (ec) std::filesystem::remove(tmp, ec);
+    ok = ::close(fd) == 0 && ok;
+    if (!ok || ::rename(tmp.c_str(), file.c_str()) != 0) ::unlink(tmp.c_str());
 }
 
 }  // namespace
@@ -134,7 +162,9 @@ std::string nvrtc_version(std::string* why) {
     return std::to_string(major) + "." + std::to_string(minor);
 }
 
-std::string kernel_cache_dir() { return core::cache_directory(); }
+std::string kernel_cache_dir() {
+    return core::private_cache_subdirectory("kernels");
+}
 
 CompileRequest embedded_request(std::string name, std::string source,
                                 std::vector<std::string> options, int sm) {

@@ -40,7 +40,9 @@ CompileResult compile_cubin(const CompileRequest& request);
 /// NVRTC's version as "13.0", or an empty string (with `why`) when it cannot be loaded.
 std::string nvrtc_version(std::string* why = nullptr);
 
-/// The cache directory in use (empty when disabled).
+/// The kernel cache's folder, `<cache>/kernels` (core/cache_directory.h: created 0700, and
+/// refused with a warning when another user owns it or others can write to it); empty when
+/// the cache is off or refused.
 std::string kernel_cache_dir();
 
 }  // namespace lucent::cuda
