@@ -15,12 +15,13 @@
 #include "lucent/error.h"
 #include "scene/exr_encoder.h"
 #include "scene/input_file.h"
+#include "scene/texture_image.h"
 
 namespace lucent::scene {
 
 namespace {
 
-constexpr uint64_t kMaxPixels = uint64_t(1) << 27;  // as textures (texture_image.cpp)
+constexpr uint64_t kMaxPixels = kMaxImagePixels;
 
 std::string lower_extension(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -83,10 +84,6 @@ Image read_pfm(const std::string& path) {
                 channels == 3 ? make_float3(p[0], p[1], p[2]) : make_float3(p[0]);
         }
     return image;
-}
-
-float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 /// stb_image's formats: 8-bit ones decoded from sRGB, Radiance .hdr as stored.

@@ -13,10 +13,7 @@
 namespace lucent::scene {
 
 namespace {
-/// The most texels an image may declare: 2^27 (2 GiB as float4), e.g. 11,585 x 11,585. An
-/// image's header is read before its pixels: a small file that claims 16,000 x 16,000 would
-/// otherwise take gigabytes and minutes before anything could be said.
-constexpr uint64_t kMaxTexels = uint64_t(1) << 27;
+constexpr uint64_t kMaxTexels = kMaxImagePixels;
 
 void check_declared_size(const std::string& path, const char* what) {
     require_regular_file(path, what);
@@ -28,12 +25,11 @@ void check_declared_size(const std::string& path, const char* what) {
                     " pixels, more than the " + std::to_string(kMaxTexels) +
                     " a texture may have; resize it (or check that the file is not damaged)");
 }
+}  // namespace
 
-/// The sRGB transfer function's inverse (IEC 61966-2-1).
 float srgb_to_linear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
-}  // namespace
 
 TextureImage load_texture(const std::string& path) {
     check_declared_size(path, "texture");

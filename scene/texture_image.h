@@ -3,6 +3,7 @@
 // alpha is linear already.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,15 @@ struct TextureImage {
     unsigned width = 0, height = 0;
     std::vector<float4> texels;
 };
+
+/// The most pixels an image file may declare (textures, environment maps, images read for
+/// comparison): 2^27 (2 GiB as float4), e.g. 11,585 x 11,585. A header is read before its
+/// pixels: a small file that claims 16,000 x 16,000 would otherwise take gigabytes and
+/// minutes before anything could be said.
+inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 27;
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+float srgb_to_linear(float c);
 
 /// Throws lucent::Error naming the file and stb_image's reason.
 TextureImage load_texture(const std::string& path);
