@@ -304,6 +304,56 @@ TEST(TriangleAccel, ClosestAndAnyHitEqualBruteForce) {
     }
 }
 
+/// The interval (t0, t1) in which the ray is inside `box` (t0 > t1: it misses).
+void box_interval(const Aabb& box, const TestRay& r, float& t0, float& t1) {
+    const float o[3] = {r.o.x, r.o.y, r.o.z}, d[3] = {r.d.x, r.d.y, r.d.z};
+    const float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+    t0 = -kInfinity, t1 = kInfinity;
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0.0f) {
+            if (o[k] < lo[k] || o[k] > hi[k]) t0 = kInfinity;
+            continue;
+        }
+        const float a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
+        t0 = std::max(t0, std::min(a, b));
+        t1 = std::min(t1, std::max(a, b));
+    }
+}
+
+TEST(TriangleAccel, LeafBoxOcclusionEqualsBruteForceOverItsLeafBoxes) {
+    // Occlusion::kLeafBoxes: blocked exactly when some leaf box lies wholly within the ray's
+    // interval. Rays whose answer hangs on rounding (a box ending within 1e-4 of tmin or
+    // tmax, or grazed) are skipped; the rest must agree.
+    for (uint32_t seed : {21u, 22u, 23u}) {
+        Mesh m = random_soup(seed, 1500);
+        TriangleAccel accel;
+        accel.build(m.positions, m.indices);
+        const std::vector<Aabb> leaves = accel.leaf_boxes();
+        ASSERT_FALSE(leaves.empty());
+        int blocked = 0, open = 0;
+        for (const TestRay& r : random_rays(seed * 5, 800)) {
+            bool clear_inside = false, ambiguous = false;
+            const float margin = 1e-4f * std::max(1.0f, r.tmax - r.tmin);
+            for (const Aabb& box : leaves) {
+                float t0, t1;
+                box_interval(box, r, t0, t1);
+                if (!(t0 <= t1 + margin)) continue;  // missed (with room)
+                const bool inside = t0 > r.tmin + margin && t1 < r.tmax - margin;
+                const bool near_edge = std::fabs(t0 - r.tmin) <= margin ||
+                                       std::fabs(t1 - r.tmax) <= margin || t1 - t0 <= margin;
+                if (inside && t0 < t1 - margin) clear_inside = true;
+                else if (near_edge || inside) ambiguous = true;
+            }
+            if (!clear_inside && ambiguous) continue;
+            EXPECT_EQ(accel.occluded_leaf_boxes(r.o, r.d, r.tmin, r.tmax), clear_inside)
+                << "seed " << seed;
+            ++(clear_inside ? blocked : open);
+        }
+        EXPECT_GT(blocked, 50) << "the rays test both answers";
+        EXPECT_GT(open, 50) << "the rays test both answers";
+    }
+}
+
 TEST(TriangleAccel, FarFromTheOriginEqualsBruteForce) {
     // The slab test computes plane/d - o/d, whose rounding grows with |o|: a soup (with its
     // axis-aligned triangles and rays) moved far out must still lose no hit.

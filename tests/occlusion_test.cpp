@@ -66,6 +66,34 @@ TEST_F(OcclusionTest, CustomPrimitivesUnderGroupsAndTransformsOcclude) {
     EXPECT_EQ(r, (std::vector<unsigned>{1, 0, 0}));
 }
 
+TEST_F(OcclusionTest, LeafBoxesBlockRaysThatPassWhollyThroughThem) {
+    // One tilted triangle, (0,0,4) (2,0,6) (0,2,6): the plane z = 4 + x + y over x + y <= 2,
+    // and its leaf's box [0,2] x [0,2] x [4,6]. Rays along +z, at (x, y), up to tmax.
+    const std::vector<float3> tilted = {make_float3(0, 0, 4), make_float3(2, 0, 6),
+                                        make_float3(0, 2, 6)};
+    auto triangle =
+        make_instance(ctx, make_triangles(ctx, tilted),
+                      make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1));
+    auto group = make_geometry_group(ctx, {triangle});
+    // The same triangle under a Group and an identity Transform: the traversal's frame path.
+    auto transform = ctx.create_transform();
+    transform->set_matrix(translation(0, 0, 0));
+    transform->set_child(group);
+    auto nested = ctx.create_group();
+    nested->add_child(transform);
+    const float3 beside = make_float3(1.9f, 1.9f, 0), through = make_float3(0.5f, 0.5f, 0);
+    for (const auto& top : {std::shared_ptr<Node>(group), std::shared_ptr<Node>(nested)}) {
+        const auto r = query(top, {{beside, kForward, 10.0f, 0},   // misses the triangle
+                                   {beside, kForward, 10.0f, 1},   // but crosses its box
+                                   {beside, kForward, 5.0f, 1},    // and ends in the box
+                                   {through, kForward, 10.0f, 0},  // hits the triangle
+                                   {through, kForward, 10.0f, 1},  // and crosses the box
+                                   {through, kForward, 4.8f, 1},   // ends in the box
+                                   {make_float3(3, 3, 0), kForward, 10.0f, 1}});  // beside both
+        EXPECT_EQ(r, (std::vector<unsigned>{0, 1, 0, 1, 1, 0, 0}));
+    }
+}
+
 TEST_F(OcclusionTest, AnyHitProgramsAreNotRun) {
     // An any-hit that ignores everything: trace() passes through to the miss program, the
     // occlusion query still sees the square (every primitive counts as opaque).

@@ -1,5 +1,6 @@
 // Host setup of the IGI sample: the scene as triangles with per-triangle materials, its
-// lights as point emitters, a second graph of per-triangle boxes for imperfect visibility,
+// lights as point emitters, for the paper's form of imperfect visibility a second graph of
+// per-triangle boxes,
 // and the passes of the IGI paper's Fig. 3 as entry points launched in order each frame. `lucent view`
 // runs the same frame, the camera in a buffer.
 #include <algorithm>
@@ -101,7 +102,7 @@ struct IgiOptions {
           normal_threshold(v.number("normal_threshold")),
           sigma(v.number("sigma")),
           max_depth(v.integer("max_depth")),
-          imperfect(v.on("imperfect_visibility")),
+          imperfect(v.integer("imperfect_visibility")),
           area_side(v.integer("area_samples")) {
         config.paths = unsigned(v.integer("vpls"));
         config.bounces = unsigned(v.integer("bounces"));
@@ -150,10 +151,11 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
         ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
 }
 
-/// The scene's triangles ("top_object", traced by radiance and particle rays) and, for
-/// imperfect visibility (IGI paper §4.1), a second graph of one box per triangle as custom
-/// primitives ("vpl_shadow_object", traced only by VPL shadow rays).
-void add_graphs(Context& ctx, const scene::Scene& input) {
+/// The scene's triangles ("top_object", traced by radiance and particle rays) and, for the
+/// paper's form of imperfect visibility (IGI paper §4.1, imperfect_visibility=2), a second
+/// graph of one box per triangle as custom primitives ("vpl_shadow_object", traced only by
+/// VPL shadow rays; an empty group otherwise).
+void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
     DiffuseTextures texture_for(ctx);
@@ -180,6 +182,7 @@ void add_graphs(Context& ctx, const scene::Scene& input) {
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
     box_material->set_name("box");
     auto add_boxes = [&](const scene::Mesh& mesh, const MeshBuffers&) {
+        if (!box_graph) return;
         auto box_geometry = ctx.create_geometry();
         box_geometry->set_primitive_count(unsigned(mesh.indices.size()));
         box_geometry->set_bounding_box_program(box_bounds);
@@ -264,7 +267,7 @@ struct IgiScene {
                                 "material Ke in its MTL, or add a light to a JSON scene)");
         set_up_context(ctx, options, scene_extent(input));
         add_lights(ctx, lights, options.config);
-        add_graphs(ctx, input);
+        add_graphs(ctx, input, options.imperfect == igi::kBoxGraphVisibility);
         images = create_igi_images(ctx, options.config);
         add_passes(ctx, options.config, images, camera);
     }
@@ -313,9 +316,11 @@ class IgiSample final : public Sample {
                       "Eq. (1)'s bounding distance, as a fraction of the scene's size"),
                   SampleOption::integer("max_depth", 4, 1, 16,
                                         "deepest specular reflection tree"),
-                  SampleOption::toggle("imperfect_visibility", false,
-                                       "1: VPL shadow rays against the triangles' bounding boxes "
-                                       "(IGI paper §4.1), 0: exact"),
+                  SampleOption::integer(
+                      "imperfect_visibility", 0, 0, 2,
+                      "VPL shadow rays (IGI paper §4.1) against 0: the triangles; 1: the boxes "
+                      "of the scene BVH's leaves; 2: the paper's second graph of one box per "
+                      "triangle"),
                   SampleOption::integer(
                       "downsample", 1, 1, 16,
                       "N: indirect light at 1/N of the resolution, joint bilateral upsampling"),

@@ -165,7 +165,7 @@ struct IndirectParams {
     float min_d;  // Eq. (1)'s bounding distance
     float scene_epsilon;
     lucent::Handle top_object;
-    unsigned imperfect_visibility;  // VPL shadow rays against the boxes graph (IGI paper §4.1)
+    unsigned imperfect_visibility;  // kExactVisibility, kLeafBoxVisibility or kBoxGraphVisibility
     lucent::Handle vpl_shadow_object;
 };
 
@@ -265,14 +265,26 @@ LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
 
 /// Nothing opaque between `from` and just short of `to`: an occlusion query, no programs.
 LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float epsilon, float3 from,
-                              float3 to) {
-    return !lucent::occluded(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f));
+                              float3 to, lucent::Occlusion test = lucent::Occlusion::kExact) {
+    return !lucent::occluded(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f),
+                             test);
 }
 
-/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (IGI paper §4.1), against
-/// the crude second graph of the triangles' bounding boxes (a different root and ray type).
+/// The imperfect_visibility option: how VPL shadow rays test the scene (IGI paper §4.1).
+enum : unsigned {
+    kExactVisibility = 0,  // the triangles
+    kLeafBoxVisibility = 1,  // the boxes of the scene BVH's leaves (Occlusion::kLeafBoxes)
+    kBoxGraphVisibility = 2,  // the paper's form: a second graph of one box per triangle
+};
+
+/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (IGI paper §4.1),
+/// against boxes: the scene's own BVH leaf boxes, or the paper's second graph of the
+/// triangles' bounding boxes (a different root and ray type).
 LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 to) {
-    if (p.imperfect_visibility)
+    if (p.imperfect_visibility == kLeafBoxVisibility)
+        return visible(p.top_object, kShadowRay, p.scene_epsilon, from, to,
+                       lucent::Occlusion::kLeafBoxes);
+    if (p.imperfect_visibility == kBoxGraphVisibility)
         return visible(p.vpl_shadow_object, kVplShadowRay, p.scene_epsilon, from, to);
     return visible(p.top_object, kShadowRay, p.scene_epsilon, from, to);
 }

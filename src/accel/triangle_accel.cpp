@@ -190,6 +190,20 @@ Aabb TriangleAccel::bounds() const {
     return m_impl->binary.bounds();
 }
 
+std::vector<Aabb> TriangleAccel::leaf_boxes() const {
+    std::vector<Aabb> boxes;
+    if (!m_impl) return boxes;
+    for (const WideNode& node : m_impl->nodes)
+        for (int c = 0; c < kWideArity; ++c) {
+            const uint32_t ref = node.child[c];
+            if (ref == kEmptyChild || !is_leaf(ref)) continue;
+            boxes.push_back(Aabb{
+                make_float3(node.planes[0][0][c], node.planes[1][0][c], node.planes[2][0][c]),
+                make_float3(node.planes[0][1][c], node.planes[1][1][c], node.planes[2][1][c])});
+        }
+    return boxes;
+}
+
 double TriangleAccel::sah_cost() const {
     return m_impl ? m_impl->sah_cost : 0.0;
 }

@@ -57,6 +57,14 @@ class TriangleAccel {
     bool intersect(float3 origin, float3 direction, float tmin, float tmax, TriangleHit& hit) const;
     /// True when any triangle is hit with t in (tmin, tmax).
     bool occluded(float3 origin, float3 direction, float tmin, float tmax) const;
+    /// Conservative occlusion by the tree's leaf boxes (the IGI paper's imperfect
+    /// visibility, §4.1, with a leaf's box for the triangles' boxes): true when the ray
+    /// passes wholly through a leaf's box within (tmin, tmax), entering after tmin and
+    /// leaving before tmax. A leaf box that holds either end does not count, or a surface
+    /// would shadow itself. Triangles are never tested: inner nodes only.
+    bool occluded_leaf_boxes(float3 origin, float3 direction, float tmin, float tmax) const;
+    /// The boxes of the tree's leaves (for tests of occluded_leaf_boxes).
+    std::vector<Aabb> leaf_boxes() const;
 
     /// Closest hit where every candidate nearer than the current closest is first offered
     /// to filter(const TriangleHit&) -> HitDecision. Candidates may come out of order.

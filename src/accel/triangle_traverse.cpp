@@ -208,6 +208,58 @@ inline unsigned test_node(const WideNode& node, const RayState& r, const RayEnd&
 #endif
 }
 
+/// The slab test of the eight children as test_node, and in `inside` those whose boxes the
+/// ray passes wholly through: entered after tmin and left before tmax (the leaf-box
+/// occlusion query's test).
+inline unsigned test_node_inside(const WideNode& node, const RayState& r, const RayEnd& end,
+                                 unsigned& inside) {
+    const float* p = &node.planes[0][0][0];
+#if LUCENT_ACCEL_SIMD
+    __m256 tn[3], tf[3];
+    for (int k = 0; k < 3; ++k) {
+        tn[k] = _mm256_fmsub_ps(_mm256_load_ps(p + r.near_plane[k]), r.rdir_near8[k],
+                                r.org_rdir_near8[k]);
+        tf[k] =
+            _mm256_fmsub_ps(_mm256_load_ps(p + r.far_plane[k]), r.rdir_far8[k], r.org_rdir_far8[k]);
+    }
+    const __m256 raw_near = _mm256_max_ps(_mm256_max_ps(tn[0], tn[1]), tn[2]);
+    const __m256 raw_far = _mm256_min_ps(_mm256_min_ps(tf[0], tf[1]), tf[2]);
+    const __m256 t_near = _mm256_max_ps(raw_near, r.tmin8);
+    const __m256 t_far = _mm256_min_ps(raw_far, end.far8);
+    const unsigned hit = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ));
+    const __m256 within = _mm256_and_ps(_mm256_cmp_ps(raw_near, r.tmin8, _CMP_GT_OQ),
+                                        _mm256_cmp_ps(raw_far, end.t8, _CMP_LT_OQ));
+    inside = hit & (unsigned)_mm256_movemask_ps(within);
+    return hit;
+#else
+    unsigned hit = 0;
+    inside = 0;
+    for (int i = 0; i < kWideArity; ++i) {
+        float raw_near = -kInfinity, raw_far = kInfinity;
+        for (int k = 0; k < 3; ++k) {
+            raw_near = lc_max(raw_near, std::fma(p[r.near_plane[k] + i], r.rdir_near[k],
+                                                 -r.org_rdir_near[k]));
+            raw_far = lc_min(raw_far,
+                             std::fma(p[r.far_plane[k] + i], r.rdir_far[k], -r.org_rdir_far[k]));
+        }
+        if (lc_max(raw_near, r.tmin) > lc_min(raw_far, end.t * kFarScale)) continue;
+        hit |= 1u << i;
+        if (raw_near > r.tmin && raw_far < end.t) inside |= 1u << i;
+    }
+    return hit;
+#endif
+}
+
+/// The children of `node` in `mask` that are leaves.
+inline unsigned leaf_children(const WideNode& node, unsigned mask) {
+    unsigned leaves = 0;
+    for (; mask != 0; mask &= mask - 1) {
+        const unsigned c = (unsigned)std::countr_zero(mask);
+        if (is_leaf(node.child[c])) leaves |= 1u << c;
+    }
+    return leaves;
+}
+
 #if LUCENT_ACCEL_SIMD
 /// The operations of the watertight block test on four lanes (SSE) or eight (AVX), so one
 /// template serves both block widths.
@@ -397,6 +449,33 @@ inline void push_children(const WideNode& node, unsigned mask, uint32_t* stack_r
 #endif
 }
 
+/// The leaf-box occlusion query (TriangleAccel::occluded_leaf_boxes): inner nodes only. A
+/// leaf the ray passes wholly through answers it; a leaf it enters otherwise holds an end
+/// of the ray and is skipped, so no triangle is ever loaded.
+bool traverse_leaf_boxes(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
+                         float tmin, float tmax) {
+    const RayState r(origin, direction, tmin);
+    const RayEnd end(tmax);
+    uint32_t stack_ref[kStackSize + kWideArity];  // push_children may write 8 past the top
+    float stack_dist[kStackSize];
+    alignas(32) float dist[kWideArity] = {};
+    int sp = 0;
+    uint32_t ref = 0;  // the root: always a node (a one-leaf tree has one)
+    for (;;) {
+        const WideNode& node = accel.nodes[ref];
+        unsigned inside = 0;
+        unsigned mask = test_node_inside(node, r, end, inside);
+        if (mask != 0) {
+            const unsigned leaves = leaf_children(node, mask);
+            if (inside & leaves) return true;
+            mask &= ~leaves;
+            if (mask != 0) push_children(node, mask, stack_ref, stack_dist, dist, sp);
+        }
+        if (sp == 0) return false;
+        ref = stack_ref[--sp];
+    }
+}
+
 enum class Query { kClosest, kAny, kFiltered };
 
 /// The one traversal loop, specialized per query. Closest and filtered queries visit the
@@ -575,6 +654,11 @@ bool occluded(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
     return traverse<Query::kAny>(accel, origin, direction, tmin, tmax, nullptr, nullptr, nullptr);
 }
 
+bool occluded_leaf_boxes(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
+                         float tmin, float tmax) {
+    return traverse_leaf_boxes(accel, origin, direction, tmin, tmax);
+}
+
 bool intersect_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                         float tmin, float tmax, TriangleHit& hit, FilterThunk thunk, void* filter) {
     return traverse<Query::kFiltered>(accel, origin, direction, tmin, tmax, &hit, thunk, filter);
@@ -583,6 +667,7 @@ bool intersect_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 
 extern const TraverseVariant kTraverse = {
     intersect,
     occluded,
+    occluded_leaf_boxes,
     intersect_filtered,
 #if !LUCENT_ACCEL_SIMD
     "scalar",

@@ -17,6 +17,8 @@ struct TraverseVariant {
                       float tmax, TriangleHit& hit);
     bool (*occluded)(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
                      float tmax);
+    bool (*occluded_leaf_boxes)(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
+                                float tmin, float tmax);
     bool (*intersect_filtered)(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                                float tmin, float tmax, TriangleHit& hit, FilterThunk thunk,
                                void* filter);

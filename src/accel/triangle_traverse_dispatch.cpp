@@ -35,13 +35,17 @@ bool resolve_occluded(const TriangleAccel::Impl& accel, float3 origin, float3 di
                       float tmax) {
     return resolve().occluded(accel, origin, direction, tmin, tmax);
 }
+bool resolve_occluded_leaf_boxes(const TriangleAccel::Impl& accel, float3 origin,
+                                 float3 direction, float tmin, float tmax) {
+    return resolve().occluded_leaf_boxes(accel, origin, direction, tmin, tmax);
+}
 bool resolve_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 direction, float tmin,
                       float tmax, TriangleHit& hit, FilterThunk thunk, void* filter) {
     return resolve().intersect_filtered(accel, origin, direction, tmin, tmax, hit, thunk, filter);
 }
 
-constexpr TraverseVariant kResolve = {resolve_intersect, resolve_occluded, resolve_filtered,
-                                      "unresolved"};
+constexpr TraverseVariant kResolve = {resolve_intersect, resolve_occluded,
+                                      resolve_occluded_leaf_boxes, resolve_filtered, "unresolved"};
 
 const TraverseVariant& active() {
     return *g_active.load(std::memory_order_relaxed);
@@ -56,6 +60,11 @@ bool TriangleAccel::intersect(float3 origin, float3 direction, float tmin, float
 
 bool TriangleAccel::occluded(float3 origin, float3 direction, float tmin, float tmax) const {
     return active().occluded(*m_impl, origin, direction, tmin, tmax);
+}
+
+bool TriangleAccel::occluded_leaf_boxes(float3 origin, float3 direction, float tmin,
+                                        float tmax) const {
+    return active().occluded_leaf_boxes(*m_impl, origin, direction, tmin, tmax);
 }
 
 bool TriangleAccel::intersect_filtered_impl(float3 origin, float3 direction, float tmin, float tmax,

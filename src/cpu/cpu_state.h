@@ -137,7 +137,7 @@ ThreadState& thread_state();
 void set_thread_state(ThreadState* state);
 
 /// occluded() of the device API.
-bool occluded(ThreadState& ts, Handle root, const Ray& ray);
+bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test);
 
 }  // namespace lucent::cpu
 

@@ -38,9 +38,9 @@ namespace detail {
 }
 
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type) {
+                     unsigned ray_type, unsigned occlusion) {
     const Ray ray{origin, tmin, direction, tmax, ray_type};
-    return cpu::occluded(cpu::thread_state(), root, ray);
+    return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion));
 }
 
 void raise_exception(int code, unsigned detail) {

@@ -75,8 +75,11 @@ class Traverser {
         if (ga.triangles_only) {
             accel::TriangleHit hit;
             if (m_frame.occlusion) {
-                if (ga.triangles.occluded(origin, direction, tmin, m_frame.closest))
-                    m_frame.has_hit = m_frame.terminated = true;
+                const bool blocked =
+                    m_frame.leaf_boxes
+                        ? ga.triangles.occluded_leaf_boxes(origin, direction, tmin, m_frame.closest)
+                        : ga.triangles.occluded(origin, direction, tmin, m_frame.closest);
+                if (blocked) m_frame.has_hit = m_frame.terminated = true;
                 return;
             }
             if (!n.any_hit_for_ray_type[m_frame.ray_type]) {
@@ -179,7 +182,7 @@ void CpuPolicy::traverse_frame(TraceFrame& frame, Handle root) const {
     Traverser(*ts, frame).node(root.index, frame.world_ray.origin, frame.world_ray.direction);
 }
 
-bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
+bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test) {
     const CompiledScene& scene = *ts.scene;
     if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
         throw Error(
@@ -190,11 +193,14 @@ bool occluded(ThreadState& ts, Handle root, const Ray& ray) {
     // A GeometryGroup of triangles (the common shadow root): the BVH's any-hit traversal.
     const CompiledNode& root_node = scene.nodes[root.index];
     if (root_node.kind == NodeKind::kGeometryGroup && root_node.geometry &&
-        root_node.geometry->triangles_only)
-        return root_node.geometry->triangles.occluded(ray.origin, ray.direction, ray.tmin,
-                                                      ray.tmax);
+        root_node.geometry->triangles_only) {
+        const accel::TriangleAccel& triangles = root_node.geometry->triangles;
+        return test == Occlusion::kLeafBoxes
+                   ? triangles.occluded_leaf_boxes(ray.origin, ray.direction, ray.tmin, ray.tmax)
+                   : triangles.occluded(ray.origin, ray.direction, ray.tmin, ray.tmax);
+    }
     // Anything else needs a frame: intersection programs and selectors run in it.
-    return runtime::occluded_in_frame(policy, root, ray);
+    return runtime::occluded_in_frame(policy, root, ray, test == Occlusion::kLeafBoxes);
 }
 
 }  // namespace lucent::cpu

@@ -55,7 +55,8 @@ struct TraceFrame : FrameTransforms<Policy::kTransforms> {
     float closest;  // upper end of the ray interval: shrinks with each committed hit
     ProgramContext context;
     bool has_hit, terminated, candidate_open;
-    bool occlusion;  // occluded(): the first intersection ends it, no programs run
+    bool occlusion;   // occluded(): the first intersection ends it, no programs run
+    bool leaf_boxes;  // occluded(..., Occlusion::kLeafBoxes): triangles by their leaf boxes
     AnyHitOutcome any_hit;
     // the committed (closest so far) hit
     float hit_t;

@@ -397,6 +397,7 @@ LUCENT_RUNTIME_INLINE void begin_frame(FrameOf<P>& f, const Ray& ray, void* payl
     f.has_hit = false;
     f.terminated = false;
     f.occlusion = occlusion;
+    f.leaf_boxes = false;
     f.candidate_open = false;
     f.context = ProgramContext::kIntersection;
 }
@@ -471,9 +472,11 @@ LUCENT_RUNTIME_INLINE bool occlusion_allowed(const P& p, Handle root, const Ray&
 }
 
 /// occluded() through an occlusion frame (intersection programs and selectors run in it,
-/// any-hit, closest hit and miss do not): any graph, after occlusion_allowed.
+/// any-hit, closest hit and miss do not): any graph, after occlusion_allowed. With
+/// `leaf_boxes`, triangle groups answer by their BVH's leaf boxes (Occlusion::kLeafBoxes).
 template <class P>
-LUCENT_RUNTIME_INLINE bool occluded_in_frame(const P& p, Handle root, const Ray& ray) {
+LUCENT_RUNTIME_INLINE bool occluded_in_frame(const P& p, Handle root, const Ray& ray,
+                                             bool leaf_boxes) {
     typename P::Thread& s = p.thread();
     if (s.depth >= p.max_depth()) {
         p.raise(kExceptionStackOverflow, s.depth + 1);
@@ -481,6 +484,7 @@ LUCENT_RUNTIME_INLINE bool occluded_in_frame(const P& p, Handle root, const Ray&
     }
     FrameOf<P> f;
     begin_frame<P>(f, ray, nullptr, /*occlusion=*/true);
+    f.leaf_boxes = leaf_boxes;
     FrameOf<P>* outer = s.frame;
     s.frame = &f;
     ++s.depth;

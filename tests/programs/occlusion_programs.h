@@ -14,6 +14,7 @@ LUCENT_MODULE(test_occlusion, lucent::kUsesOccluded)
 struct OcclusionQuery {
     float3 origin, direction;
     float tmax;
+    unsigned leaf_boxes;  // 1: occluded(..., Occlusion::kLeafBoxes)
 };
 
 struct OcclusionRecord {
@@ -28,7 +29,8 @@ LUCENT_RAY_GENERATION(occlusion_cast, OcclusionRecord) {
     const unsigned i = launch_index().x;
     const OcclusionQuery q = rec.queries[i];
     const Ray ray = make_ray(q.origin, q.direction, 0, 1e-4f, q.tmax);
-    rec.occluded[i] = occluded(rec.top, ray) ? 1u : 0u;
+    const Occlusion test = q.leaf_boxes ? Occlusion::kLeafBoxes : Occlusion::kExact;
+    rec.occluded[i] = occluded(rec.top, ray, test) ? 1u : 0u;
     TestPayload p = make_test_payload();
     trace(rec.top, ray, p);
     rec.traced[i] = p;

@@ -70,7 +70,7 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 void trace_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
                   unsigned ray_type, void* payload, const void* payload_tag);
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type);
+                     unsigned ray_type, unsigned occlusion);
 #endif
 #if LUCENT_GPU_CODE
 // On the GPU an exception cannot unwind: it is recorded, every later trace() returns at
@@ -114,11 +114,27 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 #endif
 }
 
+/// What occluded() counts as blocking a ray.
+enum class Occlusion : unsigned {
+    /// The primitives themselves: built-in triangles by the watertight test, custom
+    /// primitives by their intersection programs.
+    kExact = 0,
+    /// Built-in triangles by the boxes of their BVH's leaves, conservatively: a leaf blocks
+    /// the ray when the ray passes wholly through its box within (tmin, tmax); a leaf box
+    /// that holds either end of the ray does not, or every surface would shadow itself. The
+    /// imperfect visibility of Marques and Santos (IGI paper §4.1), with the triangles' boxes
+    /// taken a leaf (up to eight triangles) at a time from the BVH the scene already has:
+    /// no second graph, and no triangle is ever loaded. Custom primitives are tested exactly.
+    kLeafBoxes = 1,
+};
+
 /// A shadow query: true when anything in the graph below `root` intersects `ray` within
 /// (tmin, tmax). No program runs but intersection programs: every primitive counts as
 /// opaque (any-hit programs are skipped), there is no closest hit and no miss, and traversal
 /// stops at the first intersection found (OptiX's terminate-on-first-hit with any-hit
 /// disabled). `ray.ray_type` must be a valid ray type; selectors' visit programs see it.
+/// `test` says what blocks the ray: the primitives (kExact) or, for approximate
+/// visibility, the BVH's leaf boxes (kLeafBoxes).
 /// Use it where a shadow any-hit would only say "blocked"; shadows that attenuate (glass)
 /// need trace() with an any-hit program. Much cheaper than trace(): on a GeometryGroup of
 /// triangles it is the bare any-hit traversal of the BVH.
@@ -127,7 +143,7 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
 // No module of this megakernel declares kUsesOccluded, so the traversal has no occlusion
 // path: a call is a compile error that says what to declare.
 template <class Undeclared = void>
-__device__ bool occluded(Handle, const Ray&) {
+__device__ bool occluded(Handle, const Ray&, Occlusion = Occlusion::kExact) {
     static_assert(detail::dependent_false<Undeclared>,
                   "occluded() is called by a module that does not declare it: write "
                   "LUCENT_MODULE(name, lucent::kUsesOccluded)");
@@ -136,13 +152,14 @@ __device__ bool occluded(Handle, const Ray&) {
 #elif defined(__CUDACC_RTC__)
 // In the megakernel the runtime defines it, inlined into each caller: its fast path is the
 // bare BVH traversal, and a call would cost the ABI's register saves on every shadow ray.
-__device__ __forceinline__ bool occluded(Handle root, const Ray& ray);
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray,
+                                         Occlusion test = Occlusion::kExact);
 #elif LUCENT_GPU_CODE
-LUCENT_HD bool occluded(Handle root, const Ray& ray);
+LUCENT_HD bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact);
 #else
-inline bool occluded(Handle root, const Ray& ray) {
+inline bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact) {
     return detail::occluded_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
-                                   ray.ray_type);
+                                   ray.ray_type, unsigned(test));
 }
 #endif
 

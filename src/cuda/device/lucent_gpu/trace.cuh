@@ -58,8 +58,11 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     if (ga.triangles_only) {
 #if LUCENT_GPU_OCCLUSION
         if (f.occlusion) {
-            if (gpu_bvh_occluded(ga.triangles, origin, direction, tmin, f.closest))
-                f.has_hit = f.terminated = true;
+            const bool blocked =
+                f.leaf_boxes
+                    ? gpu_bvh_occluded_leaf_boxes(ga.triangles, origin, direction, tmin, f.closest)
+                    : gpu_bvh_occluded(ga.triangles, origin, direction, tmin, f.closest);
+            if (blocked) f.has_hit = f.terminated = true;
             return;
         }
 #endif
@@ -224,11 +227,11 @@ __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payloa
 #if LUCENT_GPU_OCCLUSION
 /// occluded() of the device API for the roots its inline fast path leaves (see occluded()
 /// below): any graph, traversed in an occlusion frame; and the checks that raise exceptions.
-__device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray) {
+__device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray, bool leaf_boxes) {
     const GpuPolicy p{};
     if (p.exception_pending()) return false;
     if (!runtime::occlusion_allowed(p, root, ray)) return false;
-    return runtime::occluded_in_frame(p, root, ray);
+    return runtime::occluded_in_frame(p, root, ray, leaf_boxes);
 }
 #endif  // LUCENT_GPU_OCCLUSION
 
@@ -255,19 +258,24 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 }  // namespace detail
 
 #if LUCENT_GPU_OCCLUSION
-__device__ __forceinline__ bool occluded(Handle root, const Ray& ray) {
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test) {
+    const bool leaf_boxes = test == Occlusion::kLeafBoxes;
 #if LUCENT_GPU_TRIANGLE_GROUPS
     // The common shadow root, a GeometryGroup of triangles: the BVH's any-hit traversal right
     // here (occluded_ray checks the same and raises the exceptions for bad input).
     if (root.index < gpu::params.node_count && ray.ray_type < gpu::params.ray_type_count &&
         !gpu::self().exception_code) {
         const gpu::GpuNode& node = gpu::params.nodes[root.index];
-        if (node.kind == gpu::kGpuGeometryGroup && gpu::params.accels[node.accel].triangles_only)
-            return gpu::gpu_bvh_occluded(gpu::params.accels[node.accel].triangles, ray.origin,
-                                         ray.direction, ray.tmin, ray.tmax);
+        if (node.kind == gpu::kGpuGeometryGroup && gpu::params.accels[node.accel].triangles_only) {
+            const gpu::GpuTriangleBvhView& bvh = gpu::params.accels[node.accel].triangles;
+            return leaf_boxes ? gpu::gpu_bvh_occluded_leaf_boxes(bvh, ray.origin, ray.direction,
+                                                                 ray.tmin, ray.tmax)
+                              : gpu::gpu_bvh_occluded(bvh, ray.origin, ray.direction, ray.tmin,
+                                                      ray.tmax);
+        }
     }
 #endif
-    return gpu::occluded_ray(root, ray);
+    return gpu::occluded_ray(root, ray, leaf_boxes);
 }
 #endif
 

@@ -341,6 +341,51 @@ LUCENT_HD inline bool gpu_bvh_occluded(const GpuTriangleBvhView& bvh, float3 ori
     return tr.hit();
 }
 
+/// Conservative occlusion by the leaf boxes (Occlusion::kLeafBoxes, TriangleAccel's
+/// occluded_leaf_boxes): true when the ray passes wholly through a leaf's box within
+/// (tmin, tmax). Inner nodes only: a leaf child is either the answer or skipped, so no
+/// triangle is loaded. Plain stack order, without the speculative leaf postponing, which
+/// has no leaves to postpone here.
+LUCENT_HD inline bool gpu_bvh_occluded_leaf_boxes(const GpuTriangleBvhView& bvh, float3 origin,
+                                                  float3 dir, float tmin, float tmax) {
+    GpuBvhStack stack_memory;
+    GpuBvhTraversal tr;
+    tr.start(origin, dir, tmin, tmax, stack_memory);
+    int* const stack = stack_memory.entries;
+    const float4* __restrict__ nodes = bvh.nodes;
+    int node = 0, sp = 0;
+    while (node != kGpuEntrypointSentinel) {
+        const float4 n0 = gpu_load(nodes + node + 0);
+        const float4 n1 = gpu_load(nodes + node + 1);
+        const float4 nz = gpu_load(nodes + node + 2);
+        const float4 nc = gpu_load(nodes + node + 3);
+        float c0_near, c0_far, c1_near, c1_far;
+        GpuBvhTraversal::slab(n0.x, n0.y, n0.z, n0.w, nz.x, nz.y, tr, c0_near, c0_far);
+        GpuBvhTraversal::slab(n1.x, n1.y, n1.z, n1.w, nz.z, nz.w, tr, c1_near, c1_far);
+        int child0 = gpu_float_as_int(nc.x);
+        int child1 = gpu_float_as_int(nc.y);
+        bool hit0 = c0_near <= c0_far;
+        bool hit1 = c1_near <= c1_far;
+        // A leaf entered after tmin and left before tmax blocks the ray (slab() clamps near
+        // to tmin and far to tmax * kGpuFarScale, so strict comparisons mean "within").
+        if (hit0 && child0 < 0) {
+            if (c0_near > tmin && c0_far < tmax) return true;
+            hit0 = false;
+        }
+        if (hit1 && child1 < 0) {
+            if (c1_near > tmin && c1_far < tmax) return true;
+            hit1 = false;
+        }
+        if (!hit0 && !hit1) {
+            node = stack[sp--];
+        } else {
+            node = hit0 ? child0 : child1;
+            if (hit0 && hit1) stack[++sp] = child1;
+        }
+    }
+    return false;
+}
+
 /// Closest hit where each candidate nearer than the closest accepted one is first offered
 /// to filter(const GpuHit&) -> int: kGpuIgnore (0), kGpuAccept (1) or kGpuAcceptAndStop
 /// (2). Candidates come in traversal order, not sorted. `hit` gets the closest accepted.
