@@ -192,9 +192,12 @@ fog)
     $R $B/bin/lucent bench fog --backend cuda --frames 100 --json > "$out/bench_fog.json"
     ;;
 tea)
-    echo "== bench tea on the GPU"
+    echo "== bench tea on the GPU: the engine's launches read back (Table 2), then stream-ordered"
     $R $B/bin/lucent bench tea --backend cuda
+    $R $B/bin/lucent bench tea --backend cuda --json > "$out/bench_tea.json"
     $R $B/bin/lucent bench tea --backend cuda --rounds 16
+    echo "== bench tea --megabytes 5000 must be refused (the stream rows' limit)"
+    $R $B/bin/lucent bench tea --backend cuda --megabytes 5000; echo "exit $?"
     ;;
 sanitizer)
     echo "== compute-sanitizer memcheck: whitted, bench rays"

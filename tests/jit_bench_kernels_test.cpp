@@ -54,6 +54,21 @@ TEST(jit, bench_kernels) {
     }
 }
 
+TEST(jit, bench_tea_kernels) {
+    // `bench tea --backend cuda`'s stream-ordered kernels compile without warnings, and the
+    // TEA kernel's formula is the engine's programs' (checked on the GPU by the checksums).
+    std::string why;
+    if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
+    setenv("LUCENT_CACHE_DIR", "off", 1);
+    const cuda::CompileResult result = cuda::compile_cubin(cuda::bench_kernel_request(
+        "lucent_bench_tea.cu", "#include \"lucent_bench/tea_kernels.cuh\"\n",
+        {"--std=c++17", "--ptxas-options=-v"}, 90));
+    EXPECT_FALSE(result.cubin.empty());
+    EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;
+    for (const char* kernel : {"lucent_bench_tea", "lucent_bench_xor_fold"})
+        EXPECT_NE(result.log.find(kernel), std::string::npos) << kernel;
+}
+
 TEST(jit, gpu_bvh_builder_kernels) {
     // The GPU builder's module (H-PLOC, radix sort, refit) compiles to sm_90 code, without
     // warnings, so `lucent bench build --backend cuda` can never silently stop compiling.

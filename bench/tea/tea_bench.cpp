@@ -1,13 +1,17 @@
 // Sebald's Table 2: TEA output in 1 MB launches, each read back, with the fixed key, the
-// generated key and a plain copy taking turns.
+// generated key and a plain copy taking turns; on the GPU, also the same output
+// stream-ordered against the hardware's copy rates (tea_bench_cuda.h).
 #include "bench/tea/tea_bench.h"
 
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "bench/common/report.h"
+#include "bench/tea/tea_bench_cuda.h"
+#include "lucent/error.h"
 #include "samples/tea/tea_programs.h"
 
 namespace lucent::bench {
@@ -51,17 +55,40 @@ std::array<VariantResult, 3> run_variants(Context& ctx, const std::shared_ptr<Bu
     return r;
 }
 
-/// What `lucent bench tea` measured: fixed key, generated key, copy.
+/// What `lucent bench tea` measured: fixed key, generated key, copy; on the GPU also the
+/// stream-ordered rows.
 struct TeaResult {
     const TeaBenchOptions* options = nullptr;
     std::string backend, notice;
     std::array<VariantResult, 3> variants;
+    std::optional<cuda::TeaStreamResult> stream;
 };
 
 std::string hex8(unsigned value) {
     char buf[9];
     std::snprintf(buf, sizeof buf, "%08x", value);
     return buf;
+}
+
+Json row_json(const cuda::TeaStreamRow& row) {
+    Json j{{"mb_per_s", rounded(row.mb_per_s, 1)},
+           {"min_mb_per_s", rounded(row.min_mb_per_s, 1)},
+           {"max_mb_per_s", rounded(row.max_mb_per_s, 1)}};
+    if (row.checksum) j["checksum"] = hex8(row.checksum);
+    return j;
+}
+
+Json stream_json(const cuda::TeaStreamResult& s) {
+    return Json{{"device", s.device},
+                {"repeat", s.repeat},
+                {"device_memory",
+                 {{"fixed_key", row_json(s.device_fixed)},
+                  {"generated_key", row_json(s.device_generated)},
+                  {"device_to_device_copy", row_json(s.device_copy)}}},
+                {"read_back",
+                 {{"fixed_key", row_json(s.readback_fixed)},
+                  {"generated_key", row_json(s.readback_generated)},
+                  {"pinned_device_to_host_copy", row_json(s.readback_copy)}}}};
 }
 
 Json to_json(const TeaResult& r) {
@@ -75,7 +102,8 @@ Json to_json(const TeaResult& r) {
                 {"generated_key_mb_per_s", rounded(mb / device.seconds, 1)},
                 {"copy_mb_per_s", rounded(mb / copy.seconds, 1)},
                 {"fixed_checksum", hex8(fixed.checksum)},
-                {"generated_checksum", hex8(device.checksum)}};
+                {"generated_checksum", hex8(device.checksum)},
+                {"stream_ordered", r.stream ? stream_json(*r.stream) : Json(nullptr)}};
 }
 
 void print_text(const TeaResult& r) {
@@ -95,6 +123,42 @@ void print_text(const TeaResult& r) {
         options.device, options.seed);
     std::printf("copy           %9.1f MB/s  the same launches copying a 1 MB device buffer\n",
                 mb / copy.seconds);
+    if (!r.stream) return;
+    const cuda::TeaStreamResult& s = *r.stream;
+    auto line = [](const char* name, const cuda::TeaStreamRow& row, const cuda::TeaStreamRow& base) {
+        std::printf("  %-30s %10.1f MB/s  (%.1f-%.1f)", name, row.mb_per_s, row.min_mb_per_s,
+                    row.max_mb_per_s);
+        if (&row != &base) std::printf("  %5.1f%% of the copy", 100.0 * row.mb_per_s / base.mb_per_s);
+        std::printf("\n");
+    };
+    std::printf("stream-ordered on %s: %u launches of 1 MB queued without a host round trip, "
+                "CUDA events, median of %d (min-max)\n",
+                s.device.c_str(), options.megabytes, s.repeat);
+    std::printf(" into device memory\n");
+    line("fixed key", s.device_fixed, s.device_copy);
+    line("generated key", s.device_generated, s.device_copy);
+    line("device-to-device copy, 1 MB", s.device_copy, s.device_copy);
+    std::printf(" read back into pinned host memory, overlapping the next launches\n");
+    line("fixed key", s.readback_fixed, s.readback_copy);
+    line("generated key", s.readback_generated, s.readback_copy);
+    line("pinned device-to-host copy, 1 MB", s.readback_copy, s.readback_copy);
+}
+
+/// Every stream-ordered row must have made the engine's numbers: the same XOR over the
+/// same blocks and keys.
+void check_stream_checksums(const TeaResult& r) {
+    const cuda::TeaStreamResult& s = *r.stream;
+    const unsigned fixed = r.variants[0].checksum, generated = r.variants[1].checksum;
+    const std::pair<const cuda::TeaStreamRow*, unsigned> checks[] = {
+        {&s.device_fixed, fixed},
+        {&s.device_generated, generated},
+        {&s.readback_fixed, fixed},
+        {&s.readback_generated, generated}};
+    for (const auto& [row, expected] : checks)
+        if (row->checksum != expected)
+            throw Error("bench tea: the stream-ordered output's checksum " + hex8(row->checksum) +
+                        " differs from the engine launches' " + hex8(expected) +
+                        "; the GPU made other numbers than the engine's programs");
 }
 
 }  // namespace
@@ -128,10 +192,30 @@ int run_tea_bench(const TeaBenchOptions& options) {
     result.options = &options;
     result.backend = ctx.backend_name();
     result.notice = ctx.backend_notice();
+    const bool on_gpu = result.backend.rfind("cuda", 0) == 0;
+    if (on_gpu && options.megabytes > cuda::kTeaStreamMaxMegabytes)  // before any work
+        throw Error("bench tea --backend cuda: --megabytes " + std::to_string(options.megabytes) +
+                    ": the stream-ordered rows hold the whole output in device and pinned host "
+                    "memory, at most " + std::to_string(cuda::kTeaStreamMaxMegabytes) +
+                    " MB; give --megabytes " + std::to_string(cuda::kTeaStreamMaxMegabytes) +
+                    " or less");
     result.variants =
         run_variants(ctx, out, first_block, options.megabytes, [&options, total](unsigned done) {
             if (options.progress) options.progress(done, total);
         });
+#ifdef LUCENT_HAVE_CUDA
+    if (on_gpu) {
+        cuda::TeaStreamInput stream;
+        stream.megabytes = options.megabytes;
+        stream.rounds = options.rounds;
+        stream.fixed_key = zafar_tea_key();
+        stream.generated_key = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
+        result.stream = cuda::run_tea_stream_cuda(stream);
+        check_stream_checksums(result);
+    }
+#else
+    (void)on_gpu;
+#endif
     report(result, options.json);
     return 0;
 }
