@@ -27,7 +27,7 @@ scene::Image gray_image(unsigned width, unsigned height) {
 scene::Image white_noise(unsigned width, unsigned height, unsigned rounds, uint4 key) {
     scene::Image image = gray_image(width, height);
     for (unsigned i = 0; i < image.pixels.size(); ++i)
-        image.pixels[i] = make_float3(tea_unit_float(tea(make_uint2(i, 0), key, rounds).x));
+        image.pixels[i] = make_float3(tea_noise_unit(tea(make_uint2(i, 0), key, rounds)));
     return image;
 }
 

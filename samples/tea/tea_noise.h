@@ -7,7 +7,8 @@
 
 namespace lucent::samples {
 
-/// Each pixel an independent uniform value: TEA of (pixel index, 0) with `rounds` rounds.
+/// Each pixel an independent uniform value: TEA of (pixel index, 0) with `rounds` rounds,
+/// read by tea_noise_unit (lucent/device/noise.h).
 scene::Image white_noise(unsigned width, unsigned height, unsigned rounds, uint4 key);
 
 /// One octave of 2D gradient noise (Perlin 2002, quintic fade) on a lattice of `cell`

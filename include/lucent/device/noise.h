@@ -7,10 +7,20 @@
 
 namespace lucent {
 
+/// A uniform float in [0, 1) from a TEA block whose input was a small counter (a pixel index,
+/// a lattice point): the low 24 bits of v1, the word TEA's last half-round writes. A change
+/// in the counter's low bits climbs the word through TEA's << 4 and its carries, so after
+/// few rounds the top bits are the last to be mixed: at 4 rounds the top bits of v0 (what
+/// tea_unit_float reads) still streak along the counter, horizontally neighbouring pixels
+/// correlated by 0.44, where these bits are not (docs/tea-rounds.md).
+LUCENT_HD inline float tea_noise_unit(uint2 block) {
+    return float(block.y & 0xFFFFFFu) * (1.0f / 16777216.0f);
+}
+
 /// The unit gradient TEA draws at lattice point (ix, iy).
 LUCENT_HD inline float2 tea_lattice_gradient(int ix, int iy, uint4 key, unsigned rounds) {
     const float angle =
-        6.2831853f * tea_unit_float(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds).x);
+        6.2831853f * tea_noise_unit(tea(make_uint2(unsigned(ix), unsigned(iy)), key, rounds));
     return make_float2(cosf(angle), sinf(angle));
 }
 
