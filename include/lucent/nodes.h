@@ -56,9 +56,15 @@ class Node : public ContextObject {
         : ContextObject(std::move(owner), std::move(name)), m_kind(kind) {}
     NodeKind kind() const { return m_kind; }
     std::string describe() const override;
+    /// The node's 8-bit visibility mask (default 0xff): a ray whose visibility mask shares no
+    /// bit with it skips the node and everything below it (trace()'s `visibility_mask`,
+    /// OptiX's OptixInstance::visibilityMask). A mask above 0xff is an error.
+    void set_visibility_mask(unsigned mask);
+    unsigned visibility_mask() const { return m_visibility_mask; }
 
   private:
     NodeKind m_kind;
+    unsigned m_visibility_mask = kVisibilityMaskAll;
 };
 
 /// Child list shared by Group and Selector.
@@ -116,10 +122,15 @@ class Transform : public Node {
     void set_matrix(const float m[12], bool transpose = false);
     void set_matrix(const Matrix4x3& m) { set_matrix(m.m); }
     const Matrix4x3& matrix() const { return m_matrix; }
+    /// A user id that hit programs below read with instance_id() (default 0; OptiX's
+    /// OptixInstance::instanceId). Of nested Transforms, the innermost's is read.
+    void set_instance_id(unsigned id);
+    unsigned instance_id() const { return m_instance_id; }
 
   private:
     std::shared_ptr<Node> m_child;
     Matrix4x3 m_matrix;
+    unsigned m_instance_id = 0;
 };
 
 class Material;
@@ -131,9 +142,17 @@ class GeometryBase : public ContextObject, public VariableScope {
     virtual bool is_triangles() const = 0;
     virtual unsigned primitive_count() const = 0;
     std::string scope_name() const override { return describe(); }
+    /// GeometryFlags, or'ed (default kGeometryFlagNone); kGeometryFlagDisableAnyHit makes the
+    /// geometry opaque: its any-hit programs never run unless a ray has
+    /// kRayFlagEnforceAnyHit. An unknown flag is an error.
+    void set_flags(unsigned flags);
+    unsigned flags() const { return m_flags; }
 
   protected:
     void variables_changed() override { changed(); }
+
+  private:
+    unsigned m_flags = kGeometryFlagNone;
 };
 
 /// Custom primitives: a bounding-box and an intersection program shared by all of them.
@@ -210,6 +229,13 @@ class GeometryInstance : public ContextObject, public VariableScope {
     void set_material(unsigned index, std::shared_ptr<Material> material);
     unsigned material_count() const { return unsigned(m_materials.size()); }
     const std::shared_ptr<Material>& material(unsigned index) const;
+    /// The instance's 8-bit visibility mask (default 0xff): rays whose mask shares no bit
+    /// with it skip its primitives. A mask above 0xff is an error.
+    void set_visibility_mask(unsigned mask);
+    unsigned visibility_mask() const { return m_visibility_mask; }
+    /// A user id that hit programs read with geometry_instance_id() (default 0).
+    void set_instance_id(unsigned id);
+    unsigned instance_id() const { return m_instance_id; }
 
   protected:
     void variables_changed() override { changed(); }
@@ -217,6 +243,8 @@ class GeometryInstance : public ContextObject, public VariableScope {
   private:
     std::shared_ptr<GeometryBase> m_geometry;
     std::vector<std::shared_ptr<Material>> m_materials;
+    unsigned m_visibility_mask = kVisibilityMaskAll;
+    unsigned m_instance_id = 0;
 };
 
 /// Leaves of the graph: geometry instances under one acceleration structure.

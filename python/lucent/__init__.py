@@ -14,6 +14,18 @@ docs/python.md in the repository is the tutorial.
 
 from ._lucent import (  # noqa: F401  (the extension is the whole API)
     ALL_EXCEPTIONS,
+    GEOMETRY_FLAG_DISABLE_ANYHIT,
+    GEOMETRY_FLAG_NONE,
+    RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+    RAY_FLAG_CULL_DISABLED_ANYHIT,
+    RAY_FLAG_CULL_ENFORCED_ANYHIT,
+    RAY_FLAG_CULL_FRONT_FACING_TRIANGLES,
+    RAY_FLAG_DISABLE_ANYHIT,
+    RAY_FLAG_DISABLE_CLOSESTHIT,
+    RAY_FLAG_ENFORCE_ANYHIT,
+    RAY_FLAG_NONE,
+    RAY_FLAG_TERMINATE_ON_FIRST_HIT,
+    VISIBILITY_MASK_ALL,
     Acceleration,
     Buffer,
     Context,

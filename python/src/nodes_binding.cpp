@@ -73,9 +73,26 @@ void bind_nodes(py::module_& m) {
         })
         .def("__repr__", [](const TextureSampler& t) { return repr(t); });
 
+    // The device API's constants, for records and for Python code that builds flags.
+    m.attr("GEOMETRY_FLAG_NONE") = unsigned(kGeometryFlagNone);
+    m.attr("GEOMETRY_FLAG_DISABLE_ANYHIT") = unsigned(kGeometryFlagDisableAnyHit);
+    m.attr("VISIBILITY_MASK_ALL") = kVisibilityMaskAll;
+    m.attr("RAY_FLAG_NONE") = unsigned(kRayFlagNone);
+    m.attr("RAY_FLAG_DISABLE_ANYHIT") = unsigned(kRayFlagDisableAnyHit);
+    m.attr("RAY_FLAG_ENFORCE_ANYHIT") = unsigned(kRayFlagEnforceAnyHit);
+    m.attr("RAY_FLAG_TERMINATE_ON_FIRST_HIT") = unsigned(kRayFlagTerminateOnFirstHit);
+    m.attr("RAY_FLAG_DISABLE_CLOSESTHIT") = unsigned(kRayFlagDisableClosestHit);
+    m.attr("RAY_FLAG_CULL_BACK_FACING_TRIANGLES") = unsigned(kRayFlagCullBackFacingTriangles);
+    m.attr("RAY_FLAG_CULL_FRONT_FACING_TRIANGLES") = unsigned(kRayFlagCullFrontFacingTriangles);
+    m.attr("RAY_FLAG_CULL_DISABLED_ANYHIT") = unsigned(kRayFlagCullDisabledAnyHit);
+    m.attr("RAY_FLAG_CULL_ENFORCED_ANYHIT") = unsigned(kRayFlagCullEnforcedAnyHit);
+
     py::class_<Node, std::shared_ptr<Node>>(m, "Node", "A node of the scene graph.")
         .def_property("name", [](const Node& n) { return n.name(); }, &Node::set_name)
         .def_property_readonly("kind", [](const Node& n) { return std::string(node_kind_name(n.kind())); })
+        .def_property("visibility_mask", &Node::visibility_mask, &Node::set_visibility_mask,
+                      "8-bit mask (default 0xff): rays whose visibility mask shares no bit with "
+                      "it skip the node and everything below it")
         .def("__repr__", [](const Node& n) { return repr(n); });
 
     py::class_<NodeWithChildren, Node, std::shared_ptr<NodeWithChildren>>(m, "NodeWithChildren")
@@ -116,10 +133,15 @@ void bind_nodes(py::module_& m) {
                     "matrix", {3, 4}, "", unused);
                 t.set_matrix(m.data());
             },
-            "Row-major (3, 4) float32 (a (4, 4) matrix gives its top three rows)");
+            "Row-major (3, 4) float32 (a (4, 4) matrix gives its top three rows)")
+        .def_property("instance_id", &Transform::instance_id, &Transform::set_instance_id,
+                      "User id that hit programs below read with instance_id() (default 0)");
 
     py::class_<GeometryBase, std::shared_ptr<GeometryBase>> geometry_base(m, "GeometryBase");
     geometry_base.def_property_readonly("primitive_count", &GeometryBase::primitive_count)
+        .def_property("flags", &GeometryBase::flags, &GeometryBase::set_flags,
+                      "GEOMETRY_FLAG_* or'ed: GEOMETRY_FLAG_DISABLE_ANYHIT makes the geometry "
+                      "opaque (its any-hit programs never run unless a ray enforces them)")
         .def("__repr__", [](const GeometryBase& g) { return repr(g); });
     add_variable_access(geometry_base);
 
@@ -160,6 +182,13 @@ void bind_nodes(py::module_& m) {
         .def("set_material", &GeometryInstance::set_material)
         .def_property_readonly("material_count", &GeometryInstance::material_count)
         .def("material", &GeometryInstance::material)
+        .def_property("visibility_mask", &GeometryInstance::visibility_mask,
+                      &GeometryInstance::set_visibility_mask,
+                      "8-bit mask (default 0xff): rays whose mask shares no bit with it skip "
+                      "the instance's primitives")
+        .def_property("instance_id", &GeometryInstance::instance_id,
+                      &GeometryInstance::set_instance_id,
+                      "User id that hit programs read with geometry_instance_id() (default 0)")
         .def("__repr__", [](const GeometryInstance& x) { return repr(x); });
     add_variable_access(instance);
 

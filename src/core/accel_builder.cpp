@@ -99,9 +99,10 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     }
     structure.add(accel.builder());
     // Spatial splits may put a triangle in several leaves, and an any-hit program would then
-    // be offered it more than once per ray: only groups without any-hit programs get them.
+    // be offered it more than once per ray: only groups without any-hit programs get them
+    // (opaque geometry's count: kRayFlagEnforceAnyHit runs them).
     bool any_hit = false;
-    for (bool a : node.any_hit_for_ray_type) any_hit = any_hit || a;
+    for (bool a : node.any_hit_enforced_for_ray_type) any_hit = any_hit || a;
     structure.add(any_hit);
     const bool same_structure = ga.structure_signature == structure.h;
     const bool same_content = ga.content_signature == content.h;

@@ -61,6 +61,9 @@ struct CompiledInstance {
     CompiledProgram intersection, bounding_box, attribute;
     std::vector<CompiledMaterial> materials;
     const TypeInfo* attributes = nullptr;  // the attribute type this geometry produces
+    bool opaque = false;                   // kGeometryFlagDisableAnyHit
+    unsigned visibility_mask = kVisibilityMaskAll;
+    unsigned user_id = 0;  // GeometryInstance::set_instance_id
     // Built-in triangles (host pointers into the Buffers).
     const float3* vertices = nullptr;
     const uint3* indices = nullptr;  // null: triangle i is vertices 3i..3i+2
@@ -93,7 +96,13 @@ struct CompiledNode {
     Matrix4x3 to_world{}, to_object{};        // Transform
     CompiledProgram visit;                    // Selector
     Aabb bounds{};
-    std::vector<bool> any_hit_for_ray_type;  // GeometryGroup: some material has any-hit
+    unsigned visibility_mask = kVisibilityMaskAll;
+    unsigned instance_id = 0;  // Transform: its user id (instance_id())
+    // GeometryGroup: some material of a non-opaque instance has an any-hit for the ray type;
+    // and of any instance, for rays with kRayFlagEnforceAnyHit.
+    std::vector<bool> any_hit_for_ray_type;
+    std::vector<bool> any_hit_enforced_for_ray_type;
+    bool instances_masked = false;  // GeometryGroup: an instance's mask is not 0xff
 };
 
 struct CompiledEntry {

@@ -209,6 +209,7 @@ void Context::set_exception_enabled(int code, bool enabled) {
                      kExceptionInvalidHandle,
                      kExceptionInvalidRayType,
                      kExceptionMaterialIndexOutOfRange,
+                     kExceptionInvalidRayFlags,
                      kUserExceptionBase};
         }
         codes.erase(std::remove(codes.begin(), codes.end(), code), codes.end());
@@ -492,6 +493,8 @@ std::string exception_name(int code) {
             return "invalid ray type";
         case kExceptionMaterialIndexOutOfRange:
             return "material index out of range";
+        case kExceptionInvalidRayFlags:
+            return "invalid ray flags or visibility mask";
     }
     std::ostringstream s;
     if (code >= kUserExceptionBase)

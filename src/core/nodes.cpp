@@ -2,6 +2,7 @@
 #include "lucent/nodes.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace lucent {
 
@@ -20,6 +21,11 @@ const char* node_kind_name(NodeKind kind) {
 }
 
 namespace {
+std::string hex(unsigned value) {
+    char text[16];
+    std::snprintf(text, sizeof text, "%x", value);
+    return text;
+}
 template <class T>
 void require(const std::shared_ptr<T>& p, const ContextObject& owner, const char* what) {
     if (!p)
@@ -31,6 +37,11 @@ void require_same_context(const std::shared_ptr<T>& p, const ContextObject& owne
     if (p && p->owner() != owner.owner())
         throw Error(owner.describe() + ": " + p->describe() +
                     " belongs to another Context; create it with this node's Context");
+}
+void require_visibility_mask(const ContextObject& owner, unsigned mask) {
+    if (mask > kVisibilityMaskAll)
+        throw Error(owner.describe() + ": visibility mask 0x" + hex(mask) +
+                    " has more than 8 bits; pass a mask in 0x00..0xff");
 }
 std::string index_error(const ContextObject& owner, const char* what, unsigned index,
                         size_t count) {
@@ -58,6 +69,11 @@ void Acceleration::mark_dirty() {
 
 std::string Node::describe() const {
     return std::string(node_kind_name(m_kind)) + " '" + name() + "'";
+}
+void Node::set_visibility_mask(unsigned mask) {
+    require_visibility_mask(*this, mask);
+    m_visibility_mask = mask;
+    changed();
 }
 
 unsigned NodeWithChildren::add_child(std::shared_ptr<Node> child) {
@@ -124,6 +140,20 @@ void Transform::set_matrix(const float m[12], bool transpose) {
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 4; ++c) m_matrix.m[r * 4 + c] = m[c * 3 + r];
     }
+    changed();
+}
+
+void Transform::set_instance_id(unsigned id) {
+    m_instance_id = id;
+    changed();
+}
+
+void GeometryBase::set_flags(unsigned flags) {
+    if (flags & ~unsigned(kGeometryFlagDisableAnyHit))
+        throw Error(describe() + ": geometry flags 0x" + hex(flags) +
+                    " include an unknown flag; the flags are kGeometryFlagNone and "
+                    "kGeometryFlagDisableAnyHit");
+    m_flags = flags;
     changed();
 }
 
@@ -250,6 +280,16 @@ const std::shared_ptr<Material>& GeometryInstance::material(unsigned index) cons
     if (index >= m_materials.size())
         throw Error(index_error(*this, "material", index, m_materials.size()));
     return m_materials[index];
+}
+
+void GeometryInstance::set_visibility_mask(unsigned mask) {
+    require_visibility_mask(*this, mask);
+    m_visibility_mask = mask;
+    changed();
+}
+void GeometryInstance::set_instance_id(unsigned id) {
+    m_instance_id = id;
+    changed();
 }
 
 unsigned GeometryGroup::add_child(std::shared_ptr<GeometryInstance> instance) {

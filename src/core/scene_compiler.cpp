@@ -7,7 +7,6 @@
 namespace lucent::core {
 
 namespace {
-constexpr size_t kMaxAttributeBytes = 256;  // the engine's attribute scratch space
 
 std::string ray_type_label(const ContextState& s, unsigned r) {
     return "ray type " + std::to_string(r) + " ('" + s.ray_types[r].name + "')";
@@ -114,6 +113,7 @@ unsigned SceneCompiler::instance_index(const GeometryInstance& instance) {
 
 void SceneCompiler::compile_node(unsigned index) {
     const Node& node = *m_scene->nodes[index].source;
+    m_scene->nodes[index].visibility_mask = node.visibility_mask();
     ScopeChain context_scope;
     context_scope.then(m_state.context);
     switch (node.kind()) {
@@ -155,6 +155,7 @@ void SceneCompiler::compile_node(unsigned index) {
             c.children = {child};
             c.to_world = t.matrix();
             c.to_object = inverse;
+            c.instance_id = t.instance_id();
             break;
         }
         case NodeKind::kGeometryGroup: {
@@ -165,10 +166,17 @@ void SceneCompiler::compile_node(unsigned index) {
             c.instances = std::move(instances);
             c.brute_force = g.acceleration()->builder() == Builder::kNone;
             c.any_hit_for_ray_type.assign(m_state.ray_types.size(), false);
-            for (unsigned i : c.instances)
-                for (auto& m : m_scene->instances[i].materials)
+            c.any_hit_enforced_for_ray_type.assign(m_state.ray_types.size(), false);
+            for (unsigned i : c.instances) {
+                const CompiledInstance& inst = m_scene->instances[i];
+                c.instances_masked |= inst.visibility_mask != kVisibilityMaskAll;
+                for (auto& m : inst.materials)
                     for (unsigned r = 0; r < m.any_hit.size(); ++r)
-                        if (m.any_hit[r]) c.any_hit_for_ray_type[r] = true;
+                        if (m.any_hit[r]) {
+                            c.any_hit_enforced_for_ray_type[r] = true;
+                            if (!inst.opaque) c.any_hit_for_ray_type[r] = true;
+                        }
+            }
             break;
         }
     }
@@ -184,6 +192,9 @@ void SceneCompiler::compile_instance(unsigned index) {
     out.source = &gi;
     out.triangles = geometry.is_triangles();
     out.primitive_count = geometry.primitive_count();
+    out.opaque = geometry.flags() & kGeometryFlagDisableAnyHit;
+    out.visibility_mask = gi.visibility_mask();
+    out.user_id = gi.instance_id();
 
     ScopeChain geometry_scope;
     geometry_scope.then(&gi).then(&geometry).then(m_state.context);

@@ -25,7 +25,7 @@ struct CpuPolicy {
     using PayloadTag = const void*;  // the payload type's detail::TypeTag
     static constexpr bool kTransforms = true;
     static constexpr bool kOcclusion = true;
-    static constexpr unsigned kAttributeBytes = 256;
+    static constexpr unsigned kAttributeBytes = kMaxAttributeBytes;
 
     ThreadState* ts;
 
@@ -66,6 +66,9 @@ struct CpuPolicy {
     }
     Program miss(unsigned ray_type) const { return &scene().miss[ray_type]; }
     Program attribute(const Instance& inst) const { return &inst.attribute; }
+    bool opaque(const Instance& inst) const { return inst.opaque; }
+    unsigned visibility_mask(const Instance& inst) const { return inst.visibility_mask; }
+    unsigned user_id(const Instance& inst) const { return inst.user_id; }
     bool bound(Program program) const { return bool(*program); }
 
     void call_any_hit(Program any, void* payload, const void* attr) const {
@@ -137,7 +140,8 @@ ThreadState& thread_state();
 void set_thread_state(ThreadState* state);
 
 /// occluded() of the device API.
-bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test);
+bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test, unsigned ray_flags,
+              unsigned ray_mask);
 
 }  // namespace lucent::cpu
 

@@ -32,15 +32,19 @@ namespace detail {
 // store-forwarding stall as across the program's call).
 [[gnu::flatten]] void trace_fields(Handle root, float3 origin, float3 direction, float tmin,
                                    float tmax, unsigned ray_type, void* payload,
-                                   const void* payload_tag) {
+                                   const void* payload_tag, unsigned ray_flags,
+                                   unsigned visibility_mask) {
     const Ray ray{origin, tmin, direction, tmax, ray_type};
-    runtime::trace(runtime::backend(), root, ray, payload, payload_tag);
+    runtime::trace(runtime::backend(), root, ray, payload, payload_tag, ray_flags,
+                   visibility_mask);
 }
 
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type, unsigned occlusion) {
+                     unsigned ray_type, unsigned occlusion, unsigned ray_flags,
+                     unsigned visibility_mask) {
     const Ray ray{origin, tmin, direction, tmax, ray_type};
-    return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion));
+    return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion), ray_flags,
+                         visibility_mask);
 }
 
 void raise_exception(int code, unsigned detail) {

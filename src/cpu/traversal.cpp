@@ -25,6 +25,7 @@ class Traverser {
 
     void node(unsigned index, float3 origin, float3 direction) {
         const CompiledNode& n = m_scene.nodes[index];
+        if (!runtime::visible(m_frame, n.visibility_mask)) return;
         switch (n.kind) {
             case NodeKind::kGeometryGroup:
                 geometry_group(n, origin, direction);
@@ -57,7 +58,7 @@ class Traverser {
 
     void transform(const CompiledNode& n, float3 origin, float3 direction) {
         const runtime::SavedTransform saved =
-            runtime::enter_transform(m_frame, n.to_world, n.to_object);
+            runtime::enter_transform(m_frame, n.to_world, n.to_object, n.instance_id);
         node(n.children[0], transform_point(n.to_object, origin),
              transform_vector(n.to_object, direction));
         runtime::leave_transform(m_frame, saved);
@@ -75,18 +76,21 @@ class Traverser {
         if (ga.triangles_only) {
             accel::TriangleHit hit;
             if (m_frame.occlusion) {
-                const bool blocked =
-                    m_frame.leaf_boxes
-                        ? ga.triangles.occluded_leaf_boxes(origin, direction, tmin, m_frame.closest)
-                        : ga.triangles.occluded(origin, direction, tmin, m_frame.closest);
-                if (blocked) m_frame.has_hit = m_frame.terminated = true;
-                return;
-            }
-            if (!n.any_hit_for_ray_type[m_frame.ray_type]) {
+                if (!occlusion_needs_candidates(n)) {
+                    const bool blocked =
+                        m_frame.leaf_boxes
+                            ? ga.triangles.occluded_leaf_boxes(origin, direction, tmin,
+                                                               m_frame.closest)
+                            : ga.triangles.occluded(origin, direction, tmin, m_frame.closest);
+                    if (blocked) m_frame.has_hit = m_frame.terminated = true;
+                    return;
+                }
+            } else if (!trace_needs_candidates(n)) {
                 if (ga.triangles.intersect(origin, direction, tmin, m_frame.closest, hit))
                     commit_closest_triangle(n, hit);
                 return;
             }
+            // Each candidate through the trace state machine: any-hit, masks, culls.
             ga.triangles.intersect_filtered(
                 origin, direction, tmin, m_frame.closest, hit, [&](const accel::TriangleHit& c) {
                     if (!(c.t < m_frame.closest)) return accel::HitDecision::kIgnore;
@@ -130,6 +134,21 @@ class Traverser {
     }
 
     // ---- triangles -------------------------------------------------------------------
+    /// Must a trace see each triangle of this group (any-hit programs to run, instances
+    /// masked, culls or kRayFlagTerminateOnFirstHit), or does the closest one answer it?
+    bool trace_needs_candidates(const CompiledNode& n) const {
+        const unsigned flags = m_frame.ray_flags;
+        if ((flags & runtime::kRayFlagsPerCandidate) || n.instances_masked) return true;
+        if (flags & kRayFlagDisableAnyHit) return false;
+        return flags & kRayFlagEnforceAnyHit ? n.any_hit_enforced_for_ray_type[m_frame.ray_type]
+                                             : n.any_hit_for_ray_type[m_frame.ray_type];
+    }
+    /// Must occluded() see each triangle (a facing cull, masked instances)? Leaf boxes then
+    /// give way to the exact test: a leaf box mixes instances and loads no triangle.
+    bool occlusion_needs_candidates(const CompiledNode& n) const {
+        return (m_frame.ray_flags & kRayFlagsFacingCull) || n.instances_masked;
+    }
+
     /// Global triangle of a triangles-only group → (instance index, local index).
     void locate_triangle(const CompiledNode& n, unsigned global, unsigned& instance,
                          unsigned& local) const {
@@ -182,25 +201,30 @@ void CpuPolicy::traverse_frame(TraceFrame& frame, Handle root) const {
     Traverser(*ts, frame).node(root.index, frame.world_ray.origin, frame.world_ray.direction);
 }
 
-bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test) {
+bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test, unsigned ray_flags,
+              unsigned ray_mask) {
     const CompiledScene& scene = *ts.scene;
     if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
         throw Error(
             "occluded() is called, but no module of this scene declares it; declare "
             "it in the module that calls it: LUCENT_MODULE(name, lucent::kUsesOccluded)");
     const CpuPolicy policy{&ts};
-    runtime::occlusion_allowed(policy, root, ray);  // raises (throws) on bad input
+    const bool leaf_boxes = test == Occlusion::kLeafBoxes;
+    // Raises (throws) on bad input.
+    runtime::occlusion_allowed(policy, root, ray, leaf_boxes, ray_flags, ray_mask);
     // A GeometryGroup of triangles (the common shadow root): the BVH's any-hit traversal.
     const CompiledNode& root_node = scene.nodes[root.index];
     if (root_node.kind == NodeKind::kGeometryGroup && root_node.geometry &&
-        root_node.geometry->triangles_only) {
+        root_node.geometry->triangles_only && !(ray_flags & kRayFlagsFacingCull) &&
+        !root_node.instances_masked) {
+        if (!(root_node.visibility_mask & ray_mask)) return false;
         const accel::TriangleAccel& triangles = root_node.geometry->triangles;
-        return test == Occlusion::kLeafBoxes
+        return leaf_boxes
                    ? triangles.occluded_leaf_boxes(ray.origin, ray.direction, ray.tmin, ray.tmax)
                    : triangles.occluded(ray.origin, ray.direction, ray.tmin, ray.tmax);
     }
-    // Anything else needs a frame: intersection programs and selectors run in it.
-    return runtime::occluded_in_frame(policy, root, ray, test == Occlusion::kLeafBoxes);
+    // Anything else needs a frame: intersection programs, selectors, masks and culls.
+    return runtime::occluded_in_frame(policy, root, ray, leaf_boxes, ray_flags, ray_mask);
 }
 
 }  // namespace lucent::cpu

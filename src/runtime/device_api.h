@@ -16,6 +16,12 @@ LUCENT_HD float t_hit() {
 LUCENT_HD unsigned primitive_index() {
     return runtime::primitive_index(runtime::backend());
 }
+LUCENT_HD unsigned instance_id() {
+    return runtime::instance_id(runtime::backend());
+}
+LUCENT_HD unsigned geometry_instance_id() {
+    return runtime::geometry_instance_id(runtime::backend());
+}
 LUCENT_HD bool potential_intersection(float t) {
     return runtime::potential_intersection(runtime::backend(), t);
 }

@@ -38,6 +38,7 @@ template <bool Transforms>
 struct FrameTransforms {
     Ray object_ray;  // in the space of the node being traversed
     bool transformed, hit_transformed;
+    unsigned instance_id, hit_instance_id;  // of the innermost Transform (instance_id())
     Matrix4x3 to_world, to_object, hit_to_world, hit_to_object;
 };
 template <>
@@ -52,6 +53,8 @@ struct TraceFrame : FrameTransforms<Policy::kTransforms> {
     Ray world_ray;  // as passed to trace()
     void* payload;
     unsigned ray_type;
+    unsigned ray_flags;  // RayFlags of trace() or occluded()
+    unsigned ray_mask;   // the ray's visibility mask
     float closest;  // upper end of the ray interval: shrinks with each committed hit
     ProgramContext context;
     bool has_hit, terminated, candidate_open;

@@ -17,6 +17,8 @@
 //   instance(i), material_count(inst), triangle_material(inst, prim), triangle(inst, prim,
 //   p0, p1, p2), any_hit(inst, material, ray_type), closest_hit(...), miss(ray_type),
 //   attribute(inst), bound(program)            the scene, and which programs are bound
+//   opaque(inst), visibility_mask(inst),
+//   user_id(inst)                              a geometry instance's flags, mask and id
 //   call_any_hit, call_closest_hit, call_miss, call_attribute, call_intersection,
 //   call_visit                                 program dispatch
 //   copy_attributes(dst, src, inst), traverse(frame, root, ray)
@@ -78,6 +80,38 @@ LUCENT_RUNTIME_INLINE float t_hit(const P& p) {
     }
 }
 
+/// instance_id(): the innermost Transform's user id, of the committed hit in closest hit and
+/// of the traversal position in the programs that run during traversal; 0 elsewhere.
+template <class P>
+LUCENT_RUNTIME_INLINE unsigned instance_id(const P& p) {
+    if constexpr (P::kTransforms) {
+        const FrameOf<P>* f = p.thread().frame;
+        if (!f || f->context == ProgramContext::kMiss) return 0;
+        return f->context == ProgramContext::kClosestHit ? f->hit_instance_id : f->instance_id;
+    } else {
+        (void)p;
+        return 0;
+    }
+}
+
+/// geometry_instance_id(): the user id of the committed hit's GeometryInstance in closest
+/// hit, of the one being intersected in intersection, any-hit and attribute programs.
+template <class P>
+LUCENT_RUNTIME_INLINE unsigned geometry_instance_id(const P& p) {
+    const FrameOf<P>* f = p.thread().frame;
+    if (!f) return 0;
+    switch (f->context) {
+        case ProgramContext::kClosestHit:
+            return p.user_id(p.instance(f->hit_instance));
+        case ProgramContext::kIntersection:
+        case ProgramContext::kAnyHit:
+        case ProgramContext::kAttribute:
+            return p.user_id(p.instance(f->instance));
+        default:
+            return 0;
+    }
+}
+
 /// primitive_index(): the committed hit's in closest hit, the traversal position's elsewhere.
 template <class P>
 LUCENT_RUNTIME_INLINE unsigned primitive_index(const P& p) {
@@ -130,25 +164,98 @@ LUCENT_HD inline Matrix4x3 compose(const Matrix4x3& a, const Matrix4x3& b) {
 /// The traversal position's transform before a Transform node was entered.
 struct SavedTransform {
     bool transformed;
+    unsigned instance_id;
     Matrix4x3 to_world, to_object;
 };
 
-/// Enters a Transform node. Rays enter the child's space; the direction is not
-/// renormalised, so t is the same in every space and hits compare across transforms.
+/// Enters a Transform node (user id `instance_id`). Rays enter the child's space; the
+/// direction is not renormalised, so t is the same in every space and hits compare across
+/// transforms.
 template <class Frame>
 LUCENT_RUNTIME_INLINE SavedTransform enter_transform(Frame& f, const Matrix4x3& to_world,
-                                                     const Matrix4x3& to_object) {
-    const SavedTransform saved{f.transformed, f.to_world, f.to_object};
+                                                     const Matrix4x3& to_object,
+                                                     unsigned instance_id) {
+    const SavedTransform saved{f.transformed, f.instance_id, f.to_world, f.to_object};
     f.to_world = saved.transformed ? compose(saved.to_world, to_world) : to_world;
     f.to_object = saved.transformed ? compose(to_object, saved.to_object) : to_object;
     f.transformed = true;
+    f.instance_id = instance_id;
     return saved;
 }
 template <class Frame>
 LUCENT_RUNTIME_INLINE void leave_transform(Frame& f, const SavedTransform& saved) {
     f.transformed = saved.transformed;
+    f.instance_id = saved.instance_id;
     f.to_world = saved.to_world;
     f.to_object = saved.to_object;
+}
+
+// ---- ray flags and visibility masks (OptiX 7's OptixRayFlags and visibilityMask) ---------------
+
+/// Does a node or instance with visibility mask `mask` take part in this trace?
+template <class Frame>
+LUCENT_HD inline bool visible(const Frame& f, unsigned mask) {
+    return (mask & f.ray_mask) != 0;
+}
+
+/// Is a primitive of `inst` opaque for this ray (its any-hit programs do not run)? The ray's
+/// kRayFlagDisableAnyHit and kRayFlagEnforceAnyHit override the geometry's flag.
+template <class P>
+LUCENT_HD inline bool opaque_for_ray(const P& p, const FrameOf<P>& f,
+                                     const typename P::Instance& inst) {
+    if (f.ray_flags & kRayFlagDisableAnyHit) return true;
+    if (f.ray_flags & kRayFlagEnforceAnyHit) return false;
+    return p.opaque(inst);
+}
+
+/// kRayFlagCullDisabledAnyHit skips opaque primitives, kRayFlagCullEnforcedAnyHit the others.
+template <class Frame>
+LUCENT_HD inline bool culled_by_opacity(const Frame& f, bool opaque) {
+    return f.ray_flags & (opaque ? kRayFlagCullDisabledAnyHit : kRayFlagCullEnforcedAnyHit);
+}
+
+/// The facing culls, for a triangle candidate: front-facing when the ray, in the triangle's
+/// object space, runs against cross(p1 - p0, p2 - p0) (counter-clockwise from its origin).
+template <class P>
+LUCENT_HD inline bool culled_by_facing(const P& p, const FrameOf<P>& f,
+                                       const typename P::Instance& inst, unsigned prim) {
+    float3 p0, p1, p2;
+    p.triangle(inst, prim, p0, p1, p2);
+    float3 direction;
+    if constexpr (P::kTransforms)
+        direction = f.object_ray.direction;
+    else
+        direction = f.world_ray.direction;
+    const bool front = dot(cross(p1 - p0, p2 - p0), direction) < 0.0f;
+    return f.ray_flags &
+           (front ? kRayFlagCullFrontFacingTriangles : kRayFlagCullBackFacingTriangles);
+}
+
+/// Culls that need each candidate: a trace with one of them cannot take a fast path that
+/// only returns the closest hit.
+constexpr unsigned kRayFlagsPerCandidate = kRayFlagsFacingCull | kRayFlagCullDisabledAnyHit |
+                                           kRayFlagCullEnforcedAnyHit |
+                                           kRayFlagTerminateOnFirstHit;
+
+/// Flags that do not contradict each other, and an 8-bit mask.
+LUCENT_HD inline bool ray_flags_valid(unsigned flags, unsigned mask) {
+    const unsigned choice = flags & kRayFlagsAnyHitChoice, facing = flags & kRayFlagsFacingCull;
+    return !(flags & ~kRayFlagsAll) && mask <= kVisibilityMaskAll &&
+           (choice & (choice - 1)) == 0 && (facing & (facing - 1)) == 0;
+}
+
+/// What occluded() accepts: no any-hit flag but kRayFlagDisableAnyHit (it runs no any-hit),
+/// and no facing cull with leaf boxes (they load no triangle).
+LUCENT_HD inline bool occlusion_flags_valid(unsigned flags, unsigned mask, bool leaf_boxes) {
+    const unsigned any_hit_flags =
+        kRayFlagEnforceAnyHit | kRayFlagCullDisabledAnyHit | kRayFlagCullEnforcedAnyHit;
+    return ray_flags_valid(flags, mask) && !(flags & any_hit_flags) &&
+           !(leaf_boxes && (flags & kRayFlagsFacingCull));
+}
+
+/// The detail of kExceptionInvalidRayFlags.
+LUCENT_HD inline unsigned ray_flags_detail(unsigned flags, unsigned mask) {
+    return mask << 16 | (flags & 0xffffu);
 }
 
 /// The ray the programs of a node see: the world ray's interval, in the node's space.
@@ -183,6 +290,7 @@ LUCENT_RUNTIME_INLINE unsigned run_visit(const P& p, FrameOf<P>& f, typename P::
 template <class P>
 LUCENT_RUNTIME_INLINE void run_intersection(const P& p, FrameOf<P>& f, unsigned instance_index,
                                             const typename P::Instance& inst, unsigned prim) {
+    if (!visible(f, p.visibility_mask(inst))) return;
     f.instance = instance_index;
     f.prim = prim;
     const ProgramContext saved = f.context;
@@ -241,6 +349,7 @@ LUCENT_HD inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, fl
     f.hit_pending = false;
     if constexpr (P::kTransforms) {
         f.hit_transformed = f.transformed;
+        f.hit_instance_id = f.instance_id;
         if (f.transformed) {
             f.hit_to_world = f.to_world;
             f.hit_to_object = f.to_object;
@@ -272,20 +381,27 @@ LUCENT_HD inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program
     return true;
 }
 
-/// A triangle hit nearer than the closest so far: any-hit, then commit. True if accepted.
+/// A triangle hit nearer than the closest so far: the instance's mask and the ray's culls,
+/// any-hit (unless opaque), then commit. True if accepted.
 template <class P>
 LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned instance_index,
                                          unsigned prim, float t, float2 bary) {
+    const typename P::Instance& inst = p.instance(instance_index);
+    if (!visible(f, p.visibility_mask(inst))) return false;
+    if (f.ray_flags & kRayFlagsPerCandidate) {
+        if ((f.ray_flags & kRayFlagsFacingCull) && culled_by_facing(p, f, inst, prim))
+            return false;
+        if (culled_by_opacity(f, opaque_for_ray(p, f, inst))) return false;
+    }
     if constexpr (P::kOcclusion) {
         if (f.occlusion) {  // occluded(): any intersection answers the query
             f.has_hit = f.terminated = true;
             return true;
         }
     }
-    const typename P::Instance& inst = p.instance(instance_index);
     const unsigned material = p.triangle_material(inst, prim);
     const typename P::Program any = p.any_hit(inst, material, f.ray_type);
-    if (p.bound(any)) {
+    if (p.bound(any) && !opaque_for_ray(p, f, inst)) {
         f.instance = instance_index;
         f.prim = prim;
         triangle_attributes(p, f, inst, prim, bary, f.scratch);
@@ -293,9 +409,10 @@ LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned ins
         if (!run_any_hit(p, f, any)) return false;
         commit<P>(f, instance_index, prim, t, material);
         p.copy_attributes(f.hit_attr, f.scratch, inst);
-        return true;
+    } else {
+        commit_triangle<P>(f, instance_index, prim, t, material, bary);
     }
-    commit_triangle<P>(f, instance_index, prim, t, material, bary);
+    if (f.ray_flags & kRayFlagTerminateOnFirstHit) f.terminated = true;
     return true;
 }
 
@@ -333,6 +450,8 @@ LUCENT_RUNTIME_INLINE bool report_intersection(const P& p, unsigned material) {
         p.raise(kExceptionMaterialIndexOutOfRange, material);
         return false;
     }
+    const bool opaque = opaque_for_ray(p, *f, inst);
+    if (culled_by_opacity(*f, opaque)) return false;
     if constexpr (P::kOcclusion) {
         if (f->occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
             f->has_hit = f->terminated = true;
@@ -340,9 +459,10 @@ LUCENT_RUNTIME_INLINE bool report_intersection(const P& p, unsigned material) {
         }
     }
     const typename P::Program any = p.any_hit(inst, material, f->ray_type);
-    if (p.bound(any) && !run_any_hit(p, *f, any)) return false;
+    if (!opaque && p.bound(any) && !run_any_hit(p, *f, any)) return false;
     commit<P>(*f, f->instance, f->prim, f->candidate_t, material);
     p.copy_attributes(f->hit_attr, f->scratch, inst);
+    if (f->ray_flags & kRayFlagTerminateOnFirstHit) f->terminated = true;
     return true;
 }
 
@@ -358,11 +478,16 @@ LUCENT_RUNTIME_INLINE void end_any_hit(const P& p, AnyHitOutcome outcome) {
 
 // ---- trace() and occluded() ------------------------------------------------------------------
 
-/// The checks before a trace, each raising its exception: ray type, payload type, root
-/// handle, depth.
+/// The checks before a trace, each raising its exception: ray type, payload type, ray
+/// flags and mask, root handle, depth.
 template <class P>
 LUCENT_RUNTIME_INLINE bool trace_allowed(const P& p, Handle root, const Ray& ray,
-                                         typename P::PayloadTag payload_tag) {
+                                         typename P::PayloadTag payload_tag, unsigned ray_flags,
+                                         unsigned ray_mask) {
+    if (!ray_flags_valid(ray_flags, ray_mask)) {
+        p.raise(kExceptionInvalidRayFlags, ray_flags_detail(ray_flags, ray_mask));
+        return false;
+    }
     if (ray.ray_type >= p.ray_type_count()) {
         p.raise(kExceptionInvalidRayType, ray.ray_type);
         return false;
@@ -385,14 +510,17 @@ LUCENT_RUNTIME_INLINE bool trace_allowed(const P& p, Handle root, const Ray& ray
 /// A trace frame for `ray`, before traversal.
 template <class P>
 LUCENT_RUNTIME_INLINE void begin_frame(FrameOf<P>& f, const Ray& ray, void* payload,
-                                       bool occlusion) {
+                                       bool occlusion, unsigned ray_flags, unsigned ray_mask) {
     f.world_ray = ray;
     if constexpr (P::kTransforms) {
         f.object_ray = ray;
         f.transformed = false;
+        f.instance_id = 0;
     }
     f.payload = payload;
     f.ray_type = ray.ray_type;
+    f.ray_flags = ray_flags;
+    f.ray_mask = ray_mask;
     f.closest = ray.tmax;
     f.has_hit = false;
     f.terminated = false;
@@ -425,7 +553,7 @@ LUCENT_RUNTIME_INLINE void shade(const P& p, FrameOf<P>& f, const Ray& ray) {
         }
         if constexpr (P::kTransforms) f.object_ray = ray;
         const typename P::Program closest = p.closest_hit(inst, f.hit_material, f.ray_type);
-        if (p.bound(closest)) {
+        if (p.bound(closest) && !(f.ray_flags & kRayFlagDisableClosestHit)) {
             f.context = ProgramContext::kClosestHit;
             p.call_closest_hit(closest, f.payload, f.hit_attr.bytes);
         }
@@ -442,12 +570,13 @@ LUCENT_RUNTIME_INLINE void shade(const P& p, FrameOf<P>& f, const Ray& ray) {
 /// GPU a recorded exception ends the launch index's work: later traces return at once.
 template <class P>
 LUCENT_RUNTIME_INLINE void trace(const P& p, Handle root, const Ray& ray, void* payload,
-                                 typename P::PayloadTag payload_tag) {
+                                 typename P::PayloadTag payload_tag, unsigned ray_flags,
+                                 unsigned ray_mask) {
     typename P::Thread& s = p.thread();
     if (p.exception_pending()) return;
-    if (!trace_allowed(p, root, ray, payload_tag)) return;
+    if (!trace_allowed(p, root, ray, payload_tag, ray_flags, ray_mask)) return;
     FrameOf<P> f;
-    begin_frame<P>(f, ray, payload, /*occlusion=*/false);
+    begin_frame<P>(f, ray, payload, /*occlusion=*/false, ray_flags, ray_mask);
     FrameOf<P>* outer = s.frame;
     s.frame = &f;
     ++s.depth;
@@ -457,9 +586,16 @@ LUCENT_RUNTIME_INLINE void trace(const P& p, Handle root, const Ray& ray, void* 
     s.frame = outer;
 }
 
-/// The checks of occluded() that come before any fast path: ray type and root handle.
+/// The checks of occluded() that come before any fast path: ray flags and mask, ray type
+/// and root handle.
 template <class P>
-LUCENT_RUNTIME_INLINE bool occlusion_allowed(const P& p, Handle root, const Ray& ray) {
+LUCENT_RUNTIME_INLINE bool occlusion_allowed(const P& p, Handle root, const Ray& ray,
+                                             bool leaf_boxes, unsigned ray_flags,
+                                             unsigned ray_mask) {
+    if (!occlusion_flags_valid(ray_flags, ray_mask, leaf_boxes)) {
+        p.raise(kExceptionInvalidRayFlags, ray_flags_detail(ray_flags, ray_mask));
+        return false;
+    }
     if (ray.ray_type >= p.ray_type_count()) {
         p.raise(kExceptionInvalidRayType, ray.ray_type);
         return false;
@@ -476,14 +612,15 @@ LUCENT_RUNTIME_INLINE bool occlusion_allowed(const P& p, Handle root, const Ray&
 /// `leaf_boxes`, triangle groups answer by their BVH's leaf boxes (Occlusion::kLeafBoxes).
 template <class P>
 LUCENT_RUNTIME_INLINE bool occluded_in_frame(const P& p, Handle root, const Ray& ray,
-                                             bool leaf_boxes) {
+                                             bool leaf_boxes, unsigned ray_flags,
+                                             unsigned ray_mask) {
     typename P::Thread& s = p.thread();
     if (s.depth >= p.max_depth()) {
         p.raise(kExceptionStackOverflow, s.depth + 1);
         return false;
     }
     FrameOf<P> f;
-    begin_frame<P>(f, ray, nullptr, /*occlusion=*/true);
+    begin_frame<P>(f, ray, nullptr, /*occlusion=*/true, ray_flags, ray_mask);
     f.leaf_boxes = leaf_boxes;
     FrameOf<P>* outer = s.frame;
     s.frame = &f;

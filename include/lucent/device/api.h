@@ -61,16 +61,19 @@ inline bool same_type_tag(const void* a, const void* b) {
            x.name.find("(anonymous namespace)") == std::string_view::npos;
 }
 #endif
-LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag);
+LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* payload_tag,
+                           unsigned ray_flags, unsigned visibility_mask);
 #if !LUCENT_GPU_CODE
 // The CPU backend's trace() and occluded() take the ray's fields by value, in registers. A
 // Ray the caller has just built on its stack and the callee copies with wider loads than
 // the caller's stores cannot be forwarded from the store buffer: that stall cost about a
 // tenth of a primary ray's time on Sponza (perf, 2026-12).
 void trace_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                  unsigned ray_type, void* payload, const void* payload_tag);
+                  unsigned ray_type, void* payload, const void* payload_tag, unsigned ray_flags,
+                  unsigned visibility_mask);
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type, unsigned occlusion);
+                     unsigned ray_type, unsigned occlusion, unsigned ray_flags,
+                     unsigned visibility_mask);
 #endif
 #if LUCENT_GPU_CODE
 // On the GPU an exception cannot unwind: it is recorded, every later trace() returns at
@@ -102,16 +105,28 @@ LUCENT_HD float t_hit();
 LUCENT_HD unsigned primitive_index();
 
 /// Trace a ray against the graph below `root`; the payload type must match the ray type's.
+/// `ray_flags` (RayFlags, or'ed) control any-hit, closest hit, termination and culling for
+/// this ray; the ray visits only the nodes and geometry instances whose visibility mask
+/// shares a bit with `visibility_mask` (0 visits nothing). Contradicting flags (two of
+/// kRayFlagsAnyHitChoice, both facing culls) or a mask above 0xff raise
+/// kExceptionInvalidRayFlags.
 template <class Payload>
-LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
+LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload, unsigned ray_flags,
+                     unsigned visibility_mask = kVisibilityMaskAll) {
 #if LUCENT_GPU_CODE
     // No type identity without RTTI on the GPU: size and alignment catch most mismatches.
     detail::trace_erased(root, ray, &payload,
-                         reinterpret_cast<const void*>(sizeof(Payload) << 8 | alignof(Payload)));
+                         reinterpret_cast<const void*>(sizeof(Payload) << 8 | alignof(Payload)),
+                         ray_flags, visibility_mask);
 #else
     detail::trace_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax, ray.ray_type,
-                         &payload, &detail::TypeTag<Payload>::id);
+                         &payload, &detail::TypeTag<Payload>::id, ray_flags, visibility_mask);
 #endif
+}
+/// trace() with no ray flags, visiting everything.
+template <class Payload>
+LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
+    trace(root, ray, payload, kRayFlagNone, kVisibilityMaskAll);
 }
 
 /// What occluded() counts as blocking a ray.
@@ -138,12 +153,19 @@ enum class Occlusion : unsigned {
 /// Use it where a shadow any-hit would only say "blocked"; shadows that attenuate (glass)
 /// need trace() with an any-hit program. Much cheaper than trace(): on a GeometryGroup of
 /// triangles it is the bare any-hit traversal of the BVH.
+/// `ray_flags` may cull facing triangles (kRayFlagCullBackFacingTriangles,
+/// kRayFlagCullFrontFacingTriangles; not with kLeafBoxes, which loads no triangle) and may
+/// name what occluded() does anyway (kRayFlagDisableAnyHit, kRayFlagTerminateOnFirstHit,
+/// kRayFlagDisableClosestHit); the other any-hit flags raise kExceptionInvalidRayFlags.
+/// `visibility_mask` is trace()'s. With kLeafBoxes, the masks of geometry instances inside
+/// a GeometryGroup make it test that group exactly (a leaf box mixes instances).
 /// A module that calls it declares so: LUCENT_MODULE(name, lucent::kUsesOccluded).
 #if defined(__CUDACC_RTC__) && defined(LUCENT_GPU_OCCLUSION) && !LUCENT_GPU_OCCLUSION
 // No module of this megakernel declares kUsesOccluded, so the traversal has no occlusion
 // path: a call is a compile error that says what to declare.
 template <class Undeclared = void>
-__device__ bool occluded(Handle, const Ray&, Occlusion = Occlusion::kExact) {
+__device__ bool occluded(Handle, const Ray&, Occlusion = Occlusion::kExact,
+                         unsigned = kRayFlagNone, unsigned = kVisibilityMaskAll) {
     static_assert(detail::dependent_false<Undeclared>,
                   "occluded() is called by a module that does not declare it: write "
                   "LUCENT_MODULE(name, lucent::kUsesOccluded)");
@@ -153,13 +175,19 @@ __device__ bool occluded(Handle, const Ray&, Occlusion = Occlusion::kExact) {
 // In the megakernel the runtime defines it, inlined into each caller: its fast path is the
 // bare BVH traversal, and a call would cost the ABI's register saves on every shadow ray.
 __device__ __forceinline__ bool occluded(Handle root, const Ray& ray,
-                                         Occlusion test = Occlusion::kExact);
+                                         Occlusion test = Occlusion::kExact,
+                                         unsigned ray_flags = kRayFlagNone,
+                                         unsigned visibility_mask = kVisibilityMaskAll);
 #elif LUCENT_GPU_CODE
-LUCENT_HD bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact);
+LUCENT_HD bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact,
+                        unsigned ray_flags = kRayFlagNone,
+                        unsigned visibility_mask = kVisibilityMaskAll);
 #else
-inline bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact) {
+inline bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kExact,
+                     unsigned ray_flags = kRayFlagNone,
+                     unsigned visibility_mask = kVisibilityMaskAll) {
     return detail::occluded_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
-                                   ray.ray_type, unsigned(test));
+                                   ray.ray_type, unsigned(test), ray_flags, visibility_mask);
 }
 #endif
 
@@ -240,6 +268,15 @@ namespace detail {
 LUCENT_HD bool current_transform(const Matrix4x3*& to_world, const Matrix4x3*& to_object);
 }  // namespace detail
 
+/// The user id (Transform::set_instance_id) of the innermost Transform above the committed
+/// hit in closest hit, above the traversal position in intersection, any-hit and attribute
+/// programs (OptiX's optixGetInstanceId); 0 when there is no Transform, and elsewhere.
+LUCENT_HD unsigned instance_id();
+/// The user id of the hit's GeometryInstance (GeometryInstance::set_instance_id) in closest
+/// hit, of the one being intersected in intersection, any-hit and attribute programs; 0
+/// elsewhere.
+LUCENT_HD unsigned geometry_instance_id();
+
 /// Object/world transforms of the current hit or traversal position.
 LUCENT_HD inline float3 object_to_world_point(float3 p) {
     const Matrix4x3 *w, *o;
@@ -264,6 +301,16 @@ LUCENT_HD inline float3 world_to_object_vector(float3 v) {
 LUCENT_HD inline float3 world_to_object_normal(float3 n) {
     const Matrix4x3 *w, *o;
     return detail::current_transform(w, o) ? transform_normal_by_inverse(*w, n) : n;
+}
+/// The whole matrices (the identity when not below a Transform): OptiX's
+/// optixGetObjectToWorldTransformMatrix and optixGetWorldToObjectTransformMatrix.
+LUCENT_HD inline Matrix4x3 object_to_world_matrix() {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? *w : identity_matrix();
+}
+LUCENT_HD inline Matrix4x3 world_to_object_matrix() {
+    const Matrix4x3 *w, *o;
+    return detail::current_transform(w, o) ? *o : identity_matrix();
 }
 
 /// Raise a user exception: code must be >= kUserExceptionBase. Ends this launch index

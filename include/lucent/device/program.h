@@ -14,6 +14,15 @@
 #include "lucent/device/module.h"
 #include "lucent/device/reflect.h"
 
+// Attributes live in the engine's fixed scratch space, on both backends (OptiX counts 8
+// 32-bit attribute registers; Lucent allows kMaxAttributeBytes). Payloads have no limit of
+// their own: trace() passes the caller's payload object by address.
+#define LUCENT_CHECK_ATTRIBUTES_(name, Attributes)                                          \
+    static_assert(sizeof(Attributes) <= ::lucent::kMaxAttributeBytes,                       \
+                  "the attribute type of program '" #name "' is larger than "               \
+                  "lucent::kMaxAttributeBytes (256 bytes): keep attributes small and put "  \
+                  "large per-hit data in the payload or a buffer")
+
 #if !LUCENT_GPU_CODE
 #include <string_view>
 
@@ -176,6 +185,7 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
                      [[maybe_unused]] ::lucent::AnyHitScope lucent_any_hit_scope)
 
 #define LUCENT_INTERSECTION(name, Record, Attributes)                                        \
+    LUCENT_CHECK_ATTRIBUTES_(name, Attributes);                                              \
     inline void name(const Record& rec, unsigned prim, Attributes& attr);                    \
     LUCENT_DECLARE_PROGRAM_(                                                                 \
         name, ::lucent::detail::make_desc<Record>(                                           \
@@ -213,6 +223,7 @@ struct CallableSignature<R (*)(const Rec&, Args...)> {
 /// Attribute program of built-in triangles: turns barycentrics into user attributes,
 /// run once for the closest hit (and for each any-hit candidate).
 #define LUCENT_ATTRIBUTE(name, Record, Attributes)                                               \
+    LUCENT_CHECK_ATTRIBUTES_(name, Attributes);                                                  \
     inline void name(const Record& rec, unsigned prim, float2 barycentrics, Attributes& attr);   \
     LUCENT_DECLARE_PROGRAM_(                                                                     \
         name, ::lucent::detail::make_desc<Record>(                                               \
@@ -261,11 +272,13 @@ constexpr auto callable_thunk(R (*)(const Record&, Args...)) -> R (*)(const void
     __device__ void name(const Record& rec, Payload& prd, const Attributes& attr, \
                          [[maybe_unused]] ::lucent::AnyHitScope lucent_any_hit_scope = {})
 #define LUCENT_INTERSECTION(name, Record, Attributes) \
+    LUCENT_CHECK_ATTRIBUTES_(name, Attributes);       \
     __device__ void name(const Record& rec, unsigned prim, Attributes& attr)
 #define LUCENT_BOUNDING_BOX(name, Record) \
     __device__ void name(const Record& rec, unsigned prim, ::lucent::Aabb& box)
 #define LUCENT_VISIT(name, Record) __device__ unsigned name(const Record& rec)
 #define LUCENT_ATTRIBUTE(name, Record, Attributes) \
+    LUCENT_CHECK_ATTRIBUTES_(name, Attributes);    \
     __device__ void name(const Record& rec, unsigned prim, float2 barycentrics, Attributes& attr)
 #define LUCENT_UNPAREN_(...) __VA_ARGS__
 #define LUCENT_CALLABLE(name, Record, Result, Params) \

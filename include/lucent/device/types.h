@@ -45,6 +45,11 @@ struct Matrix4x3 {
     float m[12];
 };
 
+LUCENT_HD inline Matrix4x3 identity_matrix() {
+    Matrix4x3 m{};
+    m.m[0] = m.m[5] = m.m[10] = 1.0f;
+    return m;
+}
 LUCENT_HD inline float3 transform_point(const Matrix4x3& a, float3 p) {
     return make_float3(a.m[0] * p.x + a.m[1] * p.y + a.m[2] * p.z + a.m[3],
                        a.m[4] * p.x + a.m[5] * p.y + a.m[6] * p.z + a.m[7],
@@ -70,8 +75,61 @@ enum ExceptionCode : int {
     kExceptionInvalidHandle = 4,
     kExceptionInvalidRayType = 5,
     kExceptionMaterialIndexOutOfRange = 6,
+    /// trace() or occluded() with ray flags that contradict each other, flags occluded()
+    /// cannot honour, or a visibility mask above 0xff (detail: mask << 16 | flags).
+    kExceptionInvalidRayFlags = 7,
     kUserExceptionBase = 0x400,
 };
+
+/// Per-ray control of trace() and occluded(): OptiX 7's OptixRayFlags, the same meanings and
+/// bits. "Opaque" is a primitive whose any-hit program does not run: its geometry has
+/// kGeometryFlagDisableAnyHit (GeometryBase::set_flags), unless the ray's flags override it.
+enum RayFlags : unsigned {
+    kRayFlagNone = 0,
+    /// Every primitive is opaque for this ray: no any-hit program runs.
+    kRayFlagDisableAnyHit = 1u << 0,
+    /// No primitive is opaque for this ray: any-hit programs run even on opaque geometry.
+    kRayFlagEnforceAnyHit = 1u << 1,
+    /// The first hit accepted (by any-hit, or opaque) ends traversal; closest hit then runs
+    /// on it, which need not be the nearest.
+    kRayFlagTerminateOnFirstHit = 1u << 2,
+    /// No closest-hit program runs (miss programs still do).
+    kRayFlagDisableClosestHit = 1u << 3,
+    /// Built-in triangles seen from behind are skipped. A triangle is front-facing when its
+    /// vertices appear counter-clockwise from the ray origin, in object space: the ray
+    /// direction opposes cross(p1 - p0, p2 - p0).
+    kRayFlagCullBackFacingTriangles = 1u << 4,
+    /// Built-in triangles seen from the front are skipped.
+    kRayFlagCullFrontFacingTriangles = 1u << 5,
+    /// Opaque primitives are skipped.
+    kRayFlagCullDisabledAnyHit = 1u << 6,
+    /// Non-opaque primitives are skipped.
+    kRayFlagCullEnforcedAnyHit = 1u << 7,
+};
+/// Every valid RayFlags bit.
+constexpr unsigned kRayFlagsAll = 0xffu;
+/// The four flags that choose how any-hit is treated: at most one per ray (as in OptiX).
+constexpr unsigned kRayFlagsAnyHitChoice = kRayFlagDisableAnyHit | kRayFlagEnforceAnyHit |
+                                           kRayFlagCullDisabledAnyHit | kRayFlagCullEnforcedAnyHit;
+/// The two facing culls: at most one per ray.
+constexpr unsigned kRayFlagsFacingCull =
+    kRayFlagCullBackFacingTriangles | kRayFlagCullFrontFacingTriangles;
+
+/// Visibility masks: 8 bits on rays and on nodes and geometry instances; a ray skips a node
+/// or an instance whose mask shares no bit with its own (OptiX's visibilityMask).
+constexpr unsigned kVisibilityMaskAll = 0xffu;
+
+/// Flags of a geometry (GeometryBase::set_flags): OptiX's OptixGeometryFlags.
+enum GeometryFlags : unsigned {
+    kGeometryFlagNone = 0,
+    /// The geometry is opaque: its any-hit programs never run (unless a ray has
+    /// kRayFlagEnforceAnyHit), and a ray's traversal of it takes the fast closest-hit path.
+    kGeometryFlagDisableAnyHit = 1u << 0,
+};
+
+/// The largest attribute type an intersection or attribute program may write: the engine's
+/// attribute scratch space, on both backends. Checked where a program is declared.
+constexpr unsigned kMaxAttributeBytes = 256;
 
 /// What the exception program receives.
 struct ExceptionInfo {

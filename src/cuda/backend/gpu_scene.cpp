@@ -186,6 +186,9 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
         gpu::GpuInstance g{};
         g.triangles = inst.triangles;
         g.prim_count = inst.primitive_count;
+        g.opaque = inst.opaque;
+        g.visibility_mask = inst.visibility_mask;
+        g.user_id = inst.user_id;
         g.intersection = add_program(inst.intersection);
         g.attribute = add_program(inst.attribute);
         if (const GeometryTriangles* tris = triangles_of(inst)) {
@@ -215,6 +218,8 @@ void GpuScene::flatten_nodes(const core::CompiledScene& scene, FlatScene& flat) 
         g.visit = add_program(n.visit);
         g.to_world = n.to_world;
         g.to_object = n.to_object;
+        g.visibility_mask = n.visibility_mask;
+        g.instance_id = n.instance_id;
         g.accel = ~0u;
         if (n.kind == NodeKind::kGroup && !n.brute_force) {
             g.accel = unsigned(flat.bvhs.size());
@@ -235,8 +240,11 @@ gpu::GpuGeometryAccel GpuScene::flatten_geometry_accel(const core::CompiledScene
     gpu::GpuGeometryAccel a{};
     a.triangles_only = ga.triangles_only;
     a.brute_force = n.brute_force;
-    for (unsigned r = 0; r < n.any_hit_for_ray_type.size(); ++r)
+    for (unsigned r = 0; r < n.any_hit_for_ray_type.size(); ++r) {
         if (n.any_hit_for_ray_type[r]) a.any_hit_mask |= 1u << r;
+        if (n.any_hit_enforced_for_ray_type[r]) a.any_hit_enforced_mask |= 1u << r;
+    }
+    a.instances_masked = n.instances_masked;
     a.instance_offset = unsigned(flat.accel_instances.size());
     a.instance_count = unsigned(n.instances.size());
     flat.accel_instances.insert(flat.accel_instances.end(), n.instances.begin(),

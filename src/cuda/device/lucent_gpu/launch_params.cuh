@@ -26,6 +26,8 @@ struct GpuNode {
     unsigned first;  // children[first .. first + count) for Group, Selector, Transform
     unsigned count;
     unsigned accel;  // Group: bvhs index (~0u: brute force); GeometryGroup: accels index
+    unsigned visibility_mask;
+    unsigned instance_id;  // Transform: its user id (instance_id())
     ProgramRef visit;
     Matrix4x3 to_world, to_object;
 };
@@ -55,7 +57,9 @@ struct GpuPrimRef {
 struct GpuGeometryAccel {
     unsigned triangles_only;
     unsigned brute_force;
-    unsigned any_hit_mask;     // bit r: some material has an any-hit for ray type r
+    unsigned any_hit_mask;     // bit r: some non-opaque instance has an any-hit for ray type r
+    unsigned any_hit_enforced_mask;  // bit r: some instance has one (kRayFlagEnforceAnyHit)
+    unsigned instances_masked;       // some instance's visibility mask is not 0xff
     unsigned instance_offset;  // accel_instances[instance_offset + k]: CompiledInstance index
     unsigned instance_count;
     unsigned prim_first_offset;  // accel_prim_first[...]: first global primitive per instance
@@ -67,6 +71,9 @@ struct GpuGeometryAccel {
 struct GpuInstance {
     unsigned triangles;
     unsigned prim_count;
+    unsigned opaque;  // kGeometryFlagDisableAnyHit
+    unsigned visibility_mask;
+    unsigned user_id;  // GeometryInstance::set_instance_id
     ProgramRef intersection;
     ProgramRef attribute;
     const float3* vertices;

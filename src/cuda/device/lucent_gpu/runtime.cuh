@@ -120,6 +120,13 @@ struct GpuPolicy {
         return inst.attribute;
     }
     __device__ __forceinline__ bool bound(ProgramRef program) const { return program.id >= 0; }
+    __device__ __forceinline__ bool opaque(const GpuInstance& inst) const { return inst.opaque; }
+    __device__ __forceinline__ unsigned visibility_mask(const GpuInstance& inst) const {
+        return inst.visibility_mask;
+    }
+    __device__ __forceinline__ unsigned user_id(const GpuInstance& inst) const {
+        return inst.user_id;
+    }
 
     __device__ __forceinline__ void call_any_hit(ProgramRef any, void* payload,
                                                  const void* attr) const {

@@ -49,6 +49,16 @@ __device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origi
                                            float3 direction);
 #endif
 
+/// Must a trace see each triangle of this group (any-hit programs to run, instances masked,
+/// culls or kRayFlagTerminateOnFirstHit), or does the closest one answer it?
+__device__ __forceinline__ bool trace_needs_candidates(const Frame& f, const GpuGeometryAccel& ga) {
+    const unsigned flags = f.ray_flags;
+    if ((flags & runtime::kRayFlagsPerCandidate) || ga.instances_masked) return true;
+    if (flags & kRayFlagDisableAnyHit) return false;
+    const unsigned mask = flags & kRayFlagEnforceAnyHit ? ga.any_hit_enforced_mask : ga.any_hit_mask;
+    return (mask >> f.ray_type) & 1u;
+}
+
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                                float3 direction) {
     runtime::enter_space<GpuPolicy>(f, origin, direction);
@@ -57,7 +67,9 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
 #if LUCENT_GPU_TRIANGLE_GROUPS
     if (ga.triangles_only) {
 #if LUCENT_GPU_OCCLUSION
-        if (f.occlusion) {
+        // A facing cull or masked instances need each triangle: the exact filtered path
+        // below (a leaf box mixes instances and loads no triangle).
+        if (f.occlusion && !(f.ray_flags & kRayFlagsFacingCull) && !ga.instances_masked) {
             const bool blocked =
                 f.leaf_boxes
                     ? gpu_bvh_occluded_leaf_boxes(ga.triangles, origin, direction, tmin, f.closest)
@@ -65,9 +77,12 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
             if (blocked) f.has_hit = f.terminated = true;
             return;
         }
+        const bool closest_only = !f.occlusion && !trace_needs_candidates(f, ga);
+#else
+        const bool closest_only = !trace_needs_candidates(f, ga);
 #endif
         GpuHit hit;
-        if (!((ga.any_hit_mask >> f.ray_type) & 1u)) {
+        if (closest_only) {
             if (gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit)) {
                 unsigned k = locate(ga, hit.prim);
                 unsigned local = hit.prim - params.accel_prim_first[ga.prim_first_offset + k];
@@ -170,6 +185,7 @@ __device__ inline void group(Frame& f, const GpuNode& n, float3 origin, float3 d
 
 __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 direction) {
     const GpuNode& n = params.nodes[index];
+    if (!runtime::visible(f, n.visibility_mask)) return;
     switch (n.kind) {
         case kGpuGeometryGroup:
             geometry_group(f, params.accels[n.accel], origin, direction);
@@ -180,7 +196,7 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
 #if LUCENT_GPU_TRANSFORMS
         case kGpuTransform: {
             const runtime::SavedTransform saved =
-                runtime::enter_transform(f, n.to_world, n.to_object);
+                runtime::enter_transform(f, n.to_world, n.to_object, n.instance_id);
             traverse_node(f, params.children[n.first], transform_point(n.to_object, origin),
                           transform_vector(n.to_object, direction));
             runtime::leave_transform(f, saved);
@@ -207,10 +223,12 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
 __device__ __forceinline__ void traverse_root(Frame& f, Handle root, const Ray& ray) {
     const GpuNode& root_node = params.nodes[root.index];
 #if LUCENT_GPU_NESTED
-    if (root_node.kind != kGpuGeometryGroup)
+    if (root_node.kind != kGpuGeometryGroup) {
         traverse_node(f, root.index, ray.origin, ray.direction);
-    else
+        return;
+    }
 #endif
+    if (runtime::visible(f, root_node.visibility_mask))
         geometry_group(f, params.accels[root_node.accel], ray.origin, ray.direction);
 }
 
@@ -220,18 +238,20 @@ __device__ __forceinline__ void GpuPolicy::traverse(Frame& f, Handle root, const
 
 /// trace(): its frame lives on this function's stack.
 __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
-                                       unsigned payload_signature) {
-    runtime::trace(GpuPolicy{}, root, ray, payload, payload_signature);
+                                       unsigned payload_signature, unsigned ray_flags,
+                                       unsigned ray_mask) {
+    runtime::trace(GpuPolicy{}, root, ray, payload, payload_signature, ray_flags, ray_mask);
 }
 
 #if LUCENT_GPU_OCCLUSION
 /// occluded() of the device API for the roots its inline fast path leaves (see occluded()
 /// below): any graph, traversed in an occlusion frame; and the checks that raise exceptions.
-__device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray, bool leaf_boxes) {
+__device__ __noinline__ bool occluded_ray(Handle root, const Ray& ray, bool leaf_boxes,
+                                          unsigned ray_flags, unsigned ray_mask) {
     const GpuPolicy p{};
     if (p.exception_pending()) return false;
-    if (!runtime::occlusion_allowed(p, root, ray)) return false;
-    return runtime::occluded_in_frame(p, root, ray, leaf_boxes);
+    if (!runtime::occlusion_allowed(p, root, ray, leaf_boxes, ray_flags, ray_mask)) return false;
+    return runtime::occluded_in_frame(p, root, ray, leaf_boxes, ray_flags, ray_mask);
 }
 #endif  // LUCENT_GPU_OCCLUSION
 
@@ -252,21 +272,30 @@ __device__ inline void count_exception(int code, unsigned long long linear) {
 
 namespace lucent {
 namespace detail {
-LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* signature) {
-    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)));
+LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* signature,
+                           unsigned ray_flags, unsigned visibility_mask) {
+    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)),
+                   ray_flags, visibility_mask);
 }
 }  // namespace detail
 
 #if LUCENT_GPU_OCCLUSION
-__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test) {
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test,
+                                         unsigned ray_flags, unsigned visibility_mask) {
     const bool leaf_boxes = test == Occlusion::kLeafBoxes;
 #if LUCENT_GPU_TRIANGLE_GROUPS
     // The common shadow root, a GeometryGroup of triangles: the BVH's any-hit traversal right
-    // here (occluded_ray checks the same and raises the exceptions for bad input).
+    // here (occluded_ray checks the same and raises the exceptions for bad input). Flags
+    // other than those occluded() implies, or a partial mask, take occluded_ray's path.
+    const unsigned implied =
+        kRayFlagDisableAnyHit | kRayFlagTerminateOnFirstHit | kRayFlagDisableClosestHit;
     if (root.index < gpu::params.node_count && ray.ray_type < gpu::params.ray_type_count &&
+        !(ray_flags & ~implied) && visibility_mask == kVisibilityMaskAll &&
         !gpu::self().exception_code) {
         const gpu::GpuNode& node = gpu::params.nodes[root.index];
-        if (node.kind == gpu::kGpuGeometryGroup && gpu::params.accels[node.accel].triangles_only) {
+        if (node.kind == gpu::kGpuGeometryGroup && node.visibility_mask == kVisibilityMaskAll &&
+            gpu::params.accels[node.accel].triangles_only &&
+            !gpu::params.accels[node.accel].instances_masked) {
             const gpu::GpuTriangleBvhView& bvh = gpu::params.accels[node.accel].triangles;
             return leaf_boxes ? gpu::gpu_bvh_occluded_leaf_boxes(bvh, ray.origin, ray.direction,
                                                                  ray.tmin, ray.tmax)
@@ -275,7 +304,7 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion 
         }
     }
 #endif
-    return gpu::occluded_ray(root, ray, leaf_boxes);
+    return gpu::occluded_ray(root, ray, leaf_boxes, ray_flags, visibility_mask);
 }
 #endif
 
