@@ -72,6 +72,7 @@ class Traverser {
     void geometry_group(const CompiledNode& n, float3 origin, float3 direction) {
         const core::GeometryAccel& ga = *n.geometry;
         runtime::enter_space<CpuPolicy>(m_frame, origin, direction);
+        m_frame.masked_instances = n.instances_masked;
         const float tmin = m_frame.world_ray.tmin;
         if (ga.triangles_only) {
             accel::TriangleHit hit;

@@ -55,6 +55,9 @@ struct TraceFrame : FrameTransforms<Policy::kTransforms> {
     unsigned ray_type;
     unsigned ray_flags;  // RayFlags of trace() or occluded()
     unsigned ray_mask;   // the ray's visibility mask
+    // The GeometryGroup being traversed has instances whose visibility mask is not 0xff:
+    // candidates check their instance's mask (set by the traversal on entering a group).
+    bool masked_instances;
     float closest;  // upper end of the ray interval: shrinks with each committed hit
     ProgramContext context;
     bool has_hit, terminated, candidate_open;

@@ -62,6 +62,7 @@ __device__ __forceinline__ bool trace_needs_candidates(const Frame& f, const Gpu
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                                float3 direction) {
     runtime::enter_space<GpuPolicy>(f, origin, direction);
+    f.masked_instances = ga.instances_masked;
     const float tmin = f.world_ray.tmin;
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
