@@ -86,6 +86,7 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.spp = args.spp;
     if (!args.aov.empty() || args.aov_given) s.aovs = samples::parse_aovs("--aov", args.aov);
     s.denoise = args.denoise;
+    if (args.denoise_passes) s.denoise_options.iterations = args.denoise_passes;
     for (const std::string& text : args.sets) {
         auto [name, value] = parse_set("--set", text);
         s.sets[name] = value;  // a later --set of the same name wins, as in most CLIs
@@ -140,6 +141,7 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     j["aovs"] = Json::array();
     for (const scene::ExrChannel& c : result.aovs) j["aovs"].push_back(c.name);
     j["denoise"] = settings.denoise;
+    if (settings.denoise) j["denoise_passes"] = settings.denoise_options.iterations;
     Json camera = Json::object();
     auto vec = [](float3 v) { return Json::array({v.x, v.y, v.z}); };
     if (settings.camera.eye) camera["eye"] = vec(*settings.camera.eye);
@@ -234,6 +236,12 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
     cmd->add_flag("--denoise", args.denoise,
                   "Filter the image with the edge-avoiding à-trous denoiser (Dammertz et al. "
                   "2010) guided by the albedo, normal and position of the G-buffer");
+    cmd->add_option("--denoise-passes", args.denoise_passes,
+                    "Passes of the denoiser, the taps of pass i 2^i pixels apart; 0 = its "
+                    "default (3; the paper has 5)")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 10u).description(""))
+        ->capture_default_str();
     cmd->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
     cmd->add_flag("--json", args.json,
                   "Print the settings and stage timings as one JSON object (no progress)");

@@ -27,6 +27,7 @@ struct RenderArgs {
     std::string aov;     // --aov albedo,normal,...: G-buffer layers in the EXR
     bool aov_given = false;  // --aov appeared (so that an empty list is an error)
     bool denoise = false;  // --denoise: the edge-avoiding à-trous filter
+    unsigned denoise_passes = 0;  // --denoise-passes: 0 = DenoiseOptions' default
 };
 
 /// Adds the `render` subcommand to `app`; its options fill `args`.

@@ -15,9 +15,11 @@ AovPasses::AovPasses(Context& ctx, const RenderSettings& settings, unsigned ray_
                       settings.height);
 }
 
-void AovPasses::add_to(const std::vector<std::shared_ptr<Material>>& materials) const {
+void AovPasses::add_to(const std::vector<std::shared_ptr<Material>>& materials,
+                       std::vector<std::shared_ptr<Node>> roots) {
     if (!m_gbuffer) return;
     for (const auto& material : materials) m_gbuffer->add_to(*material);
+    if (!roots.empty()) m_gbuffer->set_roots(std::move(roots));
 }
 
 void AovPasses::set_colour(std::shared_ptr<Buffer> colour) {

@@ -24,8 +24,10 @@ class AovPasses {
               unsigned first_entry, std::shared_ptr<Buffer> camera);
 
     bool active() const { return m_gbuffer.has_value(); }
-    /// Each of the sample's materials needs the G-buffer closest hit (no-op when inactive).
-    void add_to(const std::vector<std::shared_ptr<Material>>& materials) const;
+    /// Each of the sample's materials needs the G-buffer closest hit (no-op when inactive);
+    /// `roots`, when given, are the graphs G-buffer rays trace (GBufferPass::set_roots).
+    void add_to(const std::vector<std::shared_ptr<Material>>& materials,
+                std::vector<std::shared_ptr<Node>> roots = {});
     /// The sample's float4 output, which the denoiser filters (when settings.denoise).
     void set_colour(std::shared_ptr<Buffer> colour);
     /// After the render: launches the G-buffer pass and the denoiser; fills result.aovs,

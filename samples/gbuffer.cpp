@@ -30,6 +30,11 @@ void GBufferPass::add_to(Material& material) const {
     material.set_closest_hit(m_ray_type, m_hit);
 }
 
+void GBufferPass::set_roots(std::vector<std::shared_ptr<Node>> roots) {
+    m_ctx.set_ray_type<sample_gbuffer::GBufferPayload>(m_ray_type, "gbuffer", true,
+                                                       std::move(roots));
+}
+
 const LaunchReport& GBufferPass::launch() {
     m_ctx.launch(m_entry, m_width, m_height);
     return m_ctx.last_launch();

@@ -22,6 +22,9 @@ class GBufferPass {
 
     /// Gives `material` the G-buffer closest hit; it reads the material's Kd and diffuse_map.
     void add_to(Material& material) const;
+    /// The graphs G-buffer rays trace, when the scene holds others whose materials have no
+    /// G-buffer hit (IGI's box graph): Context::set_ray_type's roots.
+    void set_roots(std::vector<std::shared_ptr<Node>> roots);
     /// Launches the pass; returns its report.
     const LaunchReport& launch();
 

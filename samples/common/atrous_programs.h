@@ -14,7 +14,7 @@
 // the first pass and multiplied back in the last (texture detail is then not blurred; Schied
 // et al. 2017 §4.1 do the same), and sigma_rt is given relative to the image's mean
 // illumination, so one value suits any exposure. The position distance d_x is measured from
-// q to p's tangent plane, in units of p's pixel footprint per pixel of offset, so one
+// q to p's tangent plane, in units of p's pixel footprint (its width at p's depth), so one
 // sigma_x suits any scene scale (the Cornell box is in millimetres) and an oblique plane is
 // not mistaken for an edge.
 #pragma once
@@ -77,8 +77,8 @@ LUCENT_HD inline void atrous_pixel(const PassRecord& rec) {
     const float4 ap = rec.aov_albedo[p], np4 = rec.aov_normal[p], xp4 = rec.aov_position[p];
     const float3 np = make_float3(np4.x, np4.y, np4.z), xp = make_float3(xp4.x, xp4.y, xp4.z);
     const bool covered = ap.w > 0.5f;
-    const float step = float(pass.step);
-    // The plane distance's unit at p: its footprint times the offset of a tap, in pixels.
+    const float step = float(pass.step);  // the normal distance is divided by its square
+    // The plane distance's unit at p: the width of its pixel at its depth.
     const float unit = lc_max(pass.footprint * xp4.w, 1e-20f);
     float3 sum = make_float3(0.0f);
     float weights = 0.0f;
@@ -97,10 +97,7 @@ LUCENT_HD inline void atrous_pixel(const PassRecord& rec) {
                 const float4 nq4 = rec.aov_normal[q], xq4 = rec.aov_position[q];
                 const float3 dn = np - make_float3(nq4.x, nq4.y, nq4.z);
                 w *= expf(-dot(dn, dn) / (step * step) / pass.sigma_normal);
-                const float offset = step * sqrtf(float(dx * dx + dy * dy));
-                const float dx_plane =
-                    offset > 0.0f ? dot(np, make_float3(xq4.x, xq4.y, xq4.z) - xp) / (unit * offset)
-                                  : 0.0f;
+                const float dx_plane = dot(np, make_float3(xq4.x, xq4.y, xq4.z) - xp) / unit;
                 w *= expf(-dx_plane * dx_plane / pass.sigma_position);
             }
             sum += w * cq;

@@ -80,7 +80,7 @@ constexpr unsigned kGBufferRay = 2, kGBufferEntry = 1;
 /// Builds the scene of settings.scene (default: cornell) into `ctx`, the camera program at
 /// entry 0 reading `camera`; each material also gets the G-buffer's hit when `aovs` is active.
 PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions& options,
-                const CameraBuffer& camera, const AovPasses* aovs = nullptr) {
+                const CameraBuffer& camera, AovPasses* aovs = nullptr) {
     scene::Scene input = load_render_scene(settings);
     const float extent = scene_extent(input);
     const float epsilon = std::max(1e-4f, 1e-4f * extent);
