@@ -29,8 +29,8 @@ AovSelection parse_aovs(const std::string& flag, const std::vector<std::string>&
 /// The edge-avoiding à-trous filter's parameters (samples/common/atrous_programs.h). The
 /// defaults were chosen on the 4-spp Cornell box against 1024 spp (docs/samples.md has the
 /// figures): 3 passes, not the paper's 5, because the passes with taps 8 and 16 pixels apart
-/// spread the remaining noise of 4 spp into blotches (relative MSE 0.0031 -> 0.0094 and
-/// FLIP 0.066 -> 0.136 at 256x256).
+/// leave broad low-frequency errors (relative MSE 0.0031 -> 0.0094 and FLIP 0.066 -> 0.136
+/// at 256x256).
 struct DenoiseOptions {
     unsigned iterations = 3;      // passes; the taps of pass i are 2^i pixels apart
     float sigma_colour = 8.0f;    // sigma_rt, in units of the mean illumination squared

@@ -117,6 +117,27 @@ TEST(Aov, CornellGBufferHoldsTheMaterialsAndTheGeometry) {
     EXPECT_LT(lo, hi);
 }
 
+TEST(Aov, EverySampleWithAGBufferWritesItsLayersAndDenoises) {
+    for (const lucent::samples::Sample* sample : lucent::samples::all_samples()) {
+        if (!sample->writes_aovs()) continue;
+        RenderSettings settings = cornell(16, 1);
+        settings.aovs.depth = settings.aovs.albedo = true;
+        settings.alpha = settings.denoise = true;
+        const RenderResult r = sample->render(settings);
+        ASSERT_EQ(r.aovs.size(), 5u) << sample->name;
+        EXPECT_EQ(r.aovs[0].name, "A") << sample->name;
+        size_t covered = 0;
+        for (size_t i = 0; i < r.aovs[0].values.size(); ++i)
+            if (r.aovs[0].values[i] == 1.0f) {
+                ++covered;
+                EXPECT_GT(channel(r, "Z")[i], 0.0f) << sample->name << " " << i;
+            }
+        EXPECT_GT(covered, 16u * 16u / 2) << sample->name;
+        EXPECT_EQ(r.image.pixels.size(), 16u * 16u) << sample->name;
+        EXPECT_TRUE(r.camera.has_value()) << sample->name;
+    }
+}
+
 TEST(Denoise, BringsAFourSppCornellBoxMuchNearerTheReference) {
     const auto& pathtracer = lucent::samples::find_sample("pathtracer");
     const RenderResult reference = pathtracer.render(cornell(64, 256));
