@@ -308,9 +308,11 @@ int run_render(const RenderArgs& args) {
     const Clock::time_point written = Clock::now();
     scene::ExrExtras extras;
     if (exr) {
-        extras.channels = std::move(result.aovs);
         extras.attributes =
             exr_metadata(render_json(args, settings, sample, result, 0, ms_since(start)));
+        // The layers move into the file; their names stay for --json.
+        extras.channels = std::move(result.aovs);
+        result.aovs.clear();
         for (const scene::ExrChannel& c : extras.channels) result.aovs.push_back({c.name, {}});
     }
     scene::write_image(args.out, result.image, extras);

@@ -331,6 +331,7 @@ TEST_F(CliTest, RenderAovWritesLayersAlphaAndMetadataIntoTheExr) {
     const nlohmann::json camera = nlohmann::json::parse(exr.attributes.at("lucent.camera"));
     EXPECT_EQ(camera["eye"].size(), 3u);
     const nlohmann::json render = nlohmann::json::parse(exr.attributes.at("lucent.render"));
+    EXPECT_EQ(render["aovs"].size(), 12u) << render.dump(2);  // A and the 11 layers
     bool denoise = false;
     for (const auto& stage : render["stages"]) denoise = denoise || stage["name"] == "denoise";
     EXPECT_TRUE(denoise) << render.dump(2);

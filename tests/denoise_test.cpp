@@ -200,7 +200,9 @@ TEST(Denoise, KeepsAHardEdgeBetweenTwoNormalsAndFlattensTheNoise) {
             const float truth = x < w / 2 ? 0.2f : 0.8f;
             error_before += (noisy[i].x - truth) * (noisy[i].x - truth);
             error_after += (p[i].x - truth) * (p[i].x - truth);
-            if (x == w / 2 - 1 || x == w / 2) EXPECT_NEAR(p[i].x, truth, 0.05f) << x << "," << y;
+            if (x == w / 2 - 1 || x == w / 2) {
+                EXPECT_NEAR(p[i].x, truth, 0.05f) << x << "," << y;
+            }
         }
     EXPECT_LT(error_after, error_before / 10) << error_before << " -> " << error_after;
 }
