@@ -205,6 +205,15 @@ TEST(Denoise, KeepsAHardEdgeBetweenTwoNormalsAndFlattensTheNoise) {
             }
         }
     EXPECT_LT(error_after, error_before / 10) << error_before << " -> " << error_after;
+
+    // The same passes with every edge-stopping weight made flat blur across the edge: what
+    // the check above guards against is real.
+    lucent::samples::DenoiseOptions flat;
+    flat.sigma_colour = flat.sigma_normal = flat.sigma_position = 1e30f;
+    const float4* blurred = denoiser.run(flat, 1.0f, ms).data<float4>();
+    const size_t edge = size_t(h / 2) * w + w / 2;
+    EXPECT_GT(std::fabs(blurred[edge].x - 0.8f), 0.1f) << blurred[edge].x;
+    EXPECT_GT(std::fabs(blurred[edge - 1].x - 0.2f), 0.1f) << blurred[edge - 1].x;
 }
 
 }  // namespace
