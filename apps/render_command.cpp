@@ -2,7 +2,9 @@
 // never leaves a file behind; write_image itself is atomic.
 #include "render_command.h"
 
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -11,6 +13,7 @@
 #include "progress_bar.h"
 #include "samples/sample.h"
 #include "samples/stages.h"
+#include "scene/exr_encoder.h"
 
 namespace lucent::cli {
 namespace {
@@ -81,6 +84,9 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     if (!args.fov.empty()) s.camera.fov_degrees = parse_float("--fov", args.fov, 0, 180, true);
     s.repeat = args.repeat;
     s.spp = args.spp;
+    if (!args.aov.empty() || args.aov_given) s.aovs = samples::parse_aovs("--aov", args.aov);
+    s.denoise = args.denoise;
+    if (args.denoise_passes) s.denoise_options.iterations = args.denoise_passes;
     for (const std::string& text : args.sets) {
         auto [name, value] = parse_set("--set", text);
         s.sets[name] = value;  // a later --set of the same name wins, as in most CLIs
@@ -132,6 +138,10 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     j["spp"] = settings.spp;
     j["repeat"] = settings.repeat;
     j["threads"] = settings.threads;
+    j["aovs"] = Json::array();
+    for (const scene::ExrChannel& c : result.aovs) j["aovs"].push_back(c.name);
+    j["denoise"] = settings.denoise;
+    if (settings.denoise) j["denoise_passes"] = settings.denoise_options.iterations;
     Json camera = Json::object();
     auto vec = [](float3 v) { return Json::array({v.x, v.y, v.z}); };
     if (settings.camera.eye) camera["eye"] = vec(*settings.camera.eye);
@@ -139,6 +149,11 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     if (settings.camera.up) camera["up"] = vec(*settings.camera.up);
     if (settings.camera.fov_degrees) camera["fov"] = *settings.camera.fov_degrees;
     j["camera"] = camera;
+    if (result.camera)
+        j["rendered_camera"] = {{"eye", vec(result.camera->eye)},
+                                {"look", vec(result.camera->look)},
+                                {"up", vec(result.camera->up)},
+                                {"fov", result.camera->fov_degrees}};
     j["stages"] = Json::array();
     for (const samples::StageTiming& stage : result.stages)
         j["stages"].push_back({{"name", stage.name}, {"ms", stage.ms}, {"note", stage.note}});
@@ -148,6 +163,23 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     if (result.report.exception_count() > 0) j["exception_summary"] = result.report.summary();
     j["out"] = args.out;
     return j;
+}
+
+/// The EXR header's metadata: the render's JSON whole ("lucent.render": settings, stages and
+/// times but the write's) and its most wanted parts on their own, as string attributes.
+std::vector<std::pair<std::string, std::string>> exr_metadata(const Json& render) {
+    std::vector<std::pair<std::string, std::string>> out = {
+        {"software", "Lucent"},
+        {"lucent.sample", render["sample"].get<std::string>()},
+        {"lucent.spp", std::to_string(render["spp"].get<unsigned>())},
+        {"lucent.sets", render["sets"].dump()},
+        {"lucent.denoise", render["denoise"].get<bool>() ? "1" : "0"},
+        {"lucent.stages", render["stages"].dump()},
+        {"lucent.render", render.dump()},
+    };
+    if (render.contains("rendered_camera"))
+        out.push_back({"lucent.camera", render["rendered_camera"].dump()});
+    return out;
 }
 
 }  // namespace
@@ -196,6 +228,20 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--fov", args.fov, "Vertical field of view in degrees, (0, 180), over the "
                                        "scene's")
         ->type_name("DEG");
+    cmd->add_option("--aov", args.aov,
+                    "Also write these G-buffer layers into the .exr output beside RGBA: any of "
+                    "albedo, normal, depth, position, instance (comma-separated)")
+        ->type_name("LIST")
+        ->each([&args](const std::string&) { args.aov_given = true; });
+    cmd->add_flag("--denoise", args.denoise,
+                  "Filter the image with the edge-avoiding à-trous denoiser (Dammertz et al. "
+                  "2010) guided by the albedo, normal and position of the G-buffer");
+    cmd->add_option("--denoise-passes", args.denoise_passes,
+                    "Passes of the denoiser, the taps of pass i 2^i pixels apart; 0 = its "
+                    "default (3; the paper has 5)")
+        ->type_name("N")
+        ->check(CLI::Range(0u, 10u).description(""))
+        ->capture_default_str();
     cmd->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
     cmd->add_flag("--json", args.json,
                   "Print the settings and stage timings as one JSON object (no progress)");
@@ -214,16 +260,28 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "  lucent render --sample pathtracer --scene cornell-materials --spp 256\n"
                 "  lucent render --sample igi --eye 278,273,-500 --fov 50   # another view\n"
                 "  lucent render --json --out x.exr     # timings for scripts\n"
+                "  lucent render --sample pathtracer --spp 4 --denoise --out denoised.exr\n"
+                "  lucent render --sample pathtracer --aov albedo,normal,depth --out gbuffer.exr\n"
                 "\nThe camera flags replace the parts of the scene's camera they give; the\n"
                 "scene's own camera (or one framing the scene) gives the rest.\n");
     return cmd;
 }
 
 int run_render(const RenderArgs& args) {
-    const samples::RenderSettings settings = settings_from(args);
+    samples::RenderSettings settings = settings_from(args);
     check_image_path("--out", args.out);
+    std::string extension = std::filesystem::path(args.out).extension().string();
+    for (char& c : extension) c = char(std::tolower((unsigned char)c));
+    const bool exr = extension == ".exr";
+    if (settings.aovs.any() && !exr)
+        throw UsageError("--aov " + quoted(args.aov) + ": AOV layers are channels of an OpenEXR "
+                         "file, and --out " + quoted(args.out) + " is not one; use --out "
+                         "NAME.exr");
     const samples::Sample& sample = samples::find_sample(args.sample);
     sample.read_options(settings);  // every --set checked before the render
+    samples::check_aov_support(sample, settings);
+    // An .exr gets alpha (coverage) from every sample with a G-buffer pass.
+    settings.alpha = exr && sample.writes_aovs();
     const bool talk = !args.quiet && !args.json;
     if (talk) {
         // Before the render, which may take long: what is being rendered.
@@ -248,7 +306,16 @@ int run_render(const RenderArgs& args) {
     samples::RenderResult result = sample.render(run);
     progress.finish();
     const Clock::time_point written = Clock::now();
-    scene::write_image(args.out, result.image);
+    scene::ExrExtras extras;
+    if (exr) {
+        extras.attributes =
+            exr_metadata(render_json(args, settings, sample, result, 0, ms_since(start)));
+        // The layers move into the file; their names stay for --json.
+        extras.channels = std::move(result.aovs);
+        result.aovs.clear();
+        for (const scene::ExrChannel& c : extras.channels) result.aovs.push_back({c.name, {}});
+    }
+    scene::write_image(args.out, result.image, extras);
     const double write_ms = ms_since(written);
     const double total_ms = ms_since(start);
 

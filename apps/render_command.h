@@ -24,6 +24,10 @@ struct RenderArgs {
     std::string eye, look, up, fov;  // the camera, over the scene's (each optional)
     bool quiet = false;  // no header, progress or timings: only errors
     bool json = false;   // the settings and timings as one JSON object on stdout
+    std::string aov;     // --aov albedo,normal,...: G-buffer layers in the EXR
+    bool aov_given = false;  // --aov appeared (so that an empty list is an error)
+    bool denoise = false;  // --denoise: the edge-avoiding à-trous filter
+    unsigned denoise_passes = 0;  // --denoise-passes: 0 = DenoiseOptions' default
 };
 
 /// Adds the `render` subcommand to `app`; its options fill `args`.

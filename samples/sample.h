@@ -5,12 +5,15 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lucent/context.h"
+#include "samples/aov.h"
 #include "samples/camera_override.h"
 #include "samples/options.h"
+#include "scene/exr_encoder.h"
 #include "scene/image_io.h"
 #include "scene/scene.h"
 
@@ -28,6 +31,16 @@ struct RenderSettings {
     int jit_check_sm = 0;  // --jit-check: also compile the CUDA megakernel
     unsigned repeat = 1;   // --repeat: launches timed after the first
     unsigned spp = 0;      // --spp: progressive samples' samples per pixel; 0 = their default
+    /// --aov: G-buffer layers returned as RenderResult::aovs (samples with writes_aovs()).
+    AovSelection aovs;
+    /// Coverage ("A": 1 where the pixel's primary ray hit, 0 background) in RenderResult::aovs;
+    /// `lucent render` asks for it with an .exr output.
+    bool alpha = false;
+    /// --denoise: the image filtered by the edge-avoiding à-trous denoiser.
+    bool denoise = false;
+    DenoiseOptions denoise_options;
+    /// Whether any of the three needs the G-buffer pass.
+    bool wants_gbuffer() const { return aovs.any() || alpha || denoise; }
     /// Also return the sample's intermediate images (RenderResult::layers), for tests.
     bool keep_layers = false;
     /// Interactive sessions return each frame as FrameResult::display (8-bit sRGB, left
@@ -66,6 +79,11 @@ struct RenderResult {
     /// With RenderSettings::keep_layers: named intermediate images (e.g. IGI's "direct",
     /// "indirect", "normal"), each at the resolution it was computed at.
     std::map<std::string, scene::Image> layers;
+    /// RenderSettings::aovs and alpha: the G-buffer's layers, named as EXR channels.
+    std::vector<scene::ExrChannel> aovs;
+    /// The camera the image was rendered from (the scene's with the settings' overrides),
+    /// for the EXR header; samples that know it set it.
+    std::optional<scene::Camera> camera;
 };
 
 /// One frame of an interactive session.
@@ -121,6 +139,9 @@ class Sample {
     OptionValues read_options(const RenderSettings& settings) const {
         return OptionValues(name, options, settings.sets);
     }
+    /// True when render() honours RenderSettings::aovs, alpha and denoise (it launches the
+    /// shared G-buffer pass, samples/aov_passes.h).
+    virtual bool writes_aovs() const { return false; }
     /// Renders one image with these settings.
     virtual RenderResult render(const RenderSettings& settings) const = 0;
     /// Opens an interactive session (size, backend and --set from the settings): the same
@@ -142,5 +163,9 @@ struct RegisterSample {
 const std::vector<const Sample*>& all_samples();
 /// The sample with this name, or a SettingsError listing the names.
 const Sample& find_sample(const std::string& name);
+/// SettingsError when `settings` ask for AOVs or the denoiser (not for alpha alone, which a
+/// sample without a G-buffer simply does not write) and `sample` has no G-buffer pass;
+/// the message names the samples that have one.
+void check_aov_support(const Sample& sample, const RenderSettings& settings);
 
 }  // namespace lucent::samples

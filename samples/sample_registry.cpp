@@ -58,4 +58,14 @@ const Sample& find_sample(const std::string& name) {
                         "; the samples are " + names);
 }
 
+void check_aov_support(const Sample& sample, const RenderSettings& settings) {
+    if (sample.writes_aovs() || (!settings.aovs.any() && !settings.denoise)) return;
+    std::string with;
+    for (const Sample* s : all_samples())
+        if (s->writes_aovs()) with += (with.empty() ? "" : ", ") + s->name;
+    throw SettingsError(std::string(settings.aovs.any() ? "--aov" : "--denoise") +
+                        ": sample '" + sample.name +
+                        "' has no G-buffer pass; the samples with one are " + with);
+}
+
 }  // namespace lucent::samples

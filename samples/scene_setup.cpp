@@ -40,6 +40,7 @@ std::shared_ptr<GeometryGroup> mesh_group(
     const std::vector<std::shared_ptr<Material>>& materials,
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each) {
     auto group = ctx.create_geometry_group();
+    unsigned index = 0;
     for (const auto& mesh : scene.meshes) {
         const MeshBuffers buffers = upload_mesh(ctx, mesh);
         auto triangles = ctx.create_geometry_triangles();
@@ -53,6 +54,7 @@ std::shared_ptr<GeometryGroup> mesh_group(
         (*triangles)["uvs"] = buffers.uvs;
         auto instance = ctx.create_geometry_instance();
         instance->set_geometry(triangles);
+        (*instance)["gbuffer_instance"] = index++;  // the G-buffer's instance AOV
         for (const auto& material : materials) instance->add_material(material);
         group->add_child(instance);
         if (each) each(mesh, buffers);

@@ -34,7 +34,8 @@ MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh);
 /// One GeometryTriangles per mesh of `scene`, each in an instance with all of `materials` (a
 /// triangle's material index picks one), under a new GeometryGroup. Each geometry gets the
 /// attribute program and the variables attribute programs read: "positions", "triangles"
-/// and "uvs" (empty when the mesh has none). `each`, when given, sees every mesh with its
+/// and "uvs" (empty when the mesh has none); each instance gets "gbuffer_instance", the mesh's
+/// index (samples/common/gbuffer_programs.h). `each`, when given, sees every mesh with its
 /// buffers, for graphs built beside this one (IGI's boxes).
 std::shared_ptr<GeometryGroup> mesh_group(
     Context& ctx, const scene::Scene& scene, const std::shared_ptr<Program>& attributes,

@@ -9,8 +9,10 @@
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 
 #include <cstring>
+#include <set>
 #endif
 
 namespace lucent::scene {
@@ -41,12 +43,28 @@ bool exr_supported() {
     return true;
 }
 
-std::vector<unsigned char> encode_exr(const std::string& path, const Image& image) {
+std::vector<unsigned char> encode_exr(const std::string& path, const Image& image,
+                                      const ExrExtras& extras) {
+    const size_t pixels = size_t(image.width) * image.height;
+    std::set<std::string> names = {"R", "G", "B"};
+    for (const ExrChannel& c : extras.channels) {
+        if (c.name.empty() || !names.insert(c.name).second)
+            throw Error("cannot write '" + path + "': EXR channel name '" + c.name +
+                        "' is empty or given twice");
+        if (c.values.size() != pixels)
+            throw Error("cannot write '" + path + "': EXR channel '" + c.name + "' has " +
+                        std::to_string(c.values.size()) + " values for " +
+                        std::to_string(pixels) + " pixels");
+    }
     std::vector<unsigned char> bytes;
     try {
         Imf::Header header(int(image.width), int(image.height));
         header.compression() = Imf::ZIP_COMPRESSION;
         for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+        for (const ExrChannel& c : extras.channels)
+            header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+        for (const auto& [name, value] : extras.attributes)
+            header.insert(name, Imf::StringAttribute(value));
         // float3 pixels, row-major from the top: each channel is a strided view of them.
         char* base = const_cast<char*>(reinterpret_cast<const char*>(image.pixels.data()));
         const size_t xs = sizeof(float3), ys = sizeof(float3) * image.width;
@@ -54,6 +72,11 @@ std::vector<unsigned char> encode_exr(const std::string& path, const Image& imag
         frame.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(float3, x), xs, ys));
         frame.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(float3, y), xs, ys));
         frame.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(float3, z), xs, ys));
+        for (const ExrChannel& c : extras.channels) {
+            char* values = const_cast<char*>(reinterpret_cast<const char*>(c.values.data()));
+            frame.insert(c.name, Imf::Slice(Imf::FLOAT, values, sizeof(float),
+                                            sizeof(float) * image.width));
+        }
         MemoryStream stream(bytes);
         Imf::OutputFile file(stream, header);
         file.setFrameBuffer(frame);
@@ -63,27 +86,47 @@ std::vector<unsigned char> encode_exr(const std::string& path, const Image& imag
     }
     return bytes;
 }
-Image read_exr(const std::string& path) {
+
+ExrFile read_exr_file(const std::string& path) {
     try {
         Imf::InputFile file(path.c_str());
         const Imath::Box2i window = file.header().dataWindow();
-        Image image;
+        ExrFile out;
+        Image& image = out.image;
         image.width = unsigned(window.max.x - window.min.x + 1);
         image.height = unsigned(window.max.y - window.min.y + 1);
-        image.pixels.resize(size_t(image.width) * image.height);
-        char* base = reinterpret_cast<char*>(image.pixels.data()) -
-                     (size_t(window.min.y) * image.width + size_t(window.min.x)) * sizeof(float3);
+        const size_t pixels = size_t(image.width) * image.height;
+        const size_t origin = size_t(window.min.y) * image.width + size_t(window.min.x);
+        image.pixels.resize(pixels);
+        char* base = reinterpret_cast<char*>(image.pixels.data()) - origin * sizeof(float3);
         const size_t xs = sizeof(float3), ys = sizeof(float3) * image.width;
         Imf::FrameBuffer frame;
         frame.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(float3, x), xs, ys));
         frame.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(float3, y), xs, ys));
         frame.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(float3, z), xs, ys));
+        const Imf::ChannelList& list = file.header().channels();
+        for (auto c = list.begin(); c != list.end(); ++c) {
+            const std::string name = c.name();
+            if (name == "R" || name == "G" || name == "B") continue;
+            std::vector<float>& values = out.channels[name];
+            values.resize(pixels);
+            char* at = reinterpret_cast<char*>(values.data()) - origin * sizeof(float);
+            frame.insert(name, Imf::Slice(Imf::FLOAT, at, sizeof(float),
+                                          sizeof(float) * image.width));
+        }
         file.setFrameBuffer(frame);
         file.readPixels(window.min.y, window.max.y);
-        return image;
+        for (auto a = file.header().begin(); a != file.header().end(); ++a)
+            if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&a.attribute()))
+                out.attributes[a.name()] = text->value();
+        return out;
     } catch (const std::exception& e) {
         throw Error("cannot read '" + path + "': " + e.what());
     }
+}
+
+Image read_exr(const std::string& path) {
+    return read_exr_file(path).image;
 }
 #else
 bool exr_supported() {
@@ -94,7 +137,11 @@ Image read_exr(const std::string& path) {
     throw Error("cannot read '" + path + "': this build has no OpenEXR");
 }
 
-std::vector<unsigned char> encode_exr(const std::string& path, const Image&) {
+ExrFile read_exr_file(const std::string& path) {
+    throw Error("cannot read '" + path + "': this build has no OpenEXR");
+}
+
+std::vector<unsigned char> encode_exr(const std::string& path, const Image&, const ExrExtras&) {
     throw Error("cannot write '" + path +
                 "': this build has no OpenEXR (install libopenexr-dev and reconfigure); use "
                 ".pfm for a float image");

@@ -155,6 +155,10 @@ std::vector<unsigned char> to_srgb8(const Image& image) {
 }
 
 void write_image(const std::string& path, const Image& image) {
+    write_image(path, image, ExrExtras{});
+}
+
+void write_image(const std::string& path, const Image& image, const ExrExtras& extras) {
     const std::string ext = lower_extension(path);
     if (ext != ".png" && ext != ".pfm" && ext != ".exr")
         throw Error(
@@ -162,9 +166,12 @@ void write_image(const std::string& path, const Image& image) {
             (ext.empty() ? std::string("no file extension")
                          : "unknown image extension '" + ext + "'") +
             "; use .png (8-bit sRGB), .exr (OpenEXR, float) or .pfm (32-bit float, linear)");
+    if (ext != ".exr" && !extras.empty())
+        throw Error("cannot write '" + path + "': alpha, AOV layers and metadata need an .exr "
+                    "file (OpenEXR holds extra channels; " + ext + " does not)");
     check_image(path, image);
     std::vector<unsigned char> bytes = ext == ".png"   ? encode_png(path, image)
-                                       : ext == ".exr" ? encode_exr(path, image)
+                                       : ext == ".exr" ? encode_exr(path, image, extras)
                                                        : encode_pfm(image);
     TempFile file(path);
     file.write(bytes);

@@ -23,6 +23,11 @@ std::vector<unsigned char> to_srgb8(const Image& image);
 /// Throws lucent::Error naming the path and the reason.
 void write_image(const std::string& path, const Image& image);
 
+struct ExrExtras;  // scene/exr_encoder.h
+/// The same with extra channels and header attributes, which only OpenEXR holds: a path
+/// other than .exr with non-empty extras is a lucent::Error that says to use .exr.
+void write_image(const std::string& path, const Image& image, const ExrExtras& extras);
+
 /// Writes 8-bit RGBA pixels (row 0 at the top, e.g. a lucent::DisplayFrame's) as an RGB PNG,
 /// through a temporary file like write_image. Throws lucent::Error naming the path.
 void write_png_rgba8(const std::string& path, unsigned width, unsigned height,

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "samples/sample.h"
+#include "scene/exr_encoder.h"
 #include "scene/image_io.h"
 
 namespace {
@@ -279,6 +280,69 @@ TEST_F(CliTest, RenderJsonIsOneObjectWithTheStages) {
     EXPECT_GT(j["total_ms"].get<double>(), 0.0);
     EXPECT_EQ(j["out"], path("w.exr"));
     EXPECT_TRUE(fs::exists(path("w.exr")));
+}
+
+TEST_F(CliTest, BadAovNamesTheFlagTheValueAndTheAcceptedOnes) {
+    CliRun run = expect_render_usage_error("--sample pathtracer --size 8x8 --aov albedo,nrmal");
+    EXPECT_NE(run.output.find("--aov 'albedo,nrmal': unknown AOV 'nrmal' (did you mean 'normal'?)"),
+              std::string::npos)
+        << run.output;
+    EXPECT_NE(run.output.find("accepted: albedo, normal, depth, position, instance"),
+              std::string::npos)
+        << run.output;
+    run = expect_render_usage_error("--sample pathtracer --size 8x8 --aov ''");
+    EXPECT_NE(run.output.find("--aov ''"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, AovWithoutAnExrOutputSaysToUseExr) {
+    CliRun run = expect_render_usage_error("--sample pathtracer --size 8x8 --aov depth");
+    EXPECT_NE(run.output.find("use --out NAME.exr"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, AovOrDenoiseOnASampleWithoutAGBufferNamesTheOnesWithIt) {
+    for (const char* flag : {"--denoise", "--aov depth"}) {
+        CliRun run = run_cli(std::string("render --sample whitted --size 8x8 ") + flag +
+                             " --out '" + path("w.exr") + "'");
+        EXPECT_EQ(run.exit_code, 2) << run.output;
+        EXPECT_NE(run.output.find("has no G-buffer pass; the samples with one are"),
+                  std::string::npos)
+            << run.output;
+        EXPECT_TRUE(dir_is_empty());
+    }
+}
+
+TEST_F(CliTest, RenderAovWritesLayersAlphaAndMetadataIntoTheExr) {
+    if (!lucent::scene::exr_supported()) GTEST_SKIP() << "built without OpenEXR";
+    const std::string out = path("pt.exr");
+    CliRun run = run_cli("render --sample pathtracer --size 16x12 --spp 2 --threads 2 -q "
+                         "--aov albedo,normal,depth,position,instance --denoise --set seed=3 "
+                         "--out '" + out + "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const lucent::scene::ExrFile exr = lucent::scene::read_exr_file(out);
+    EXPECT_EQ(exr.image.width, 16u);
+    for (const char* c : {"A", "Albedo.R", "Albedo.G", "Albedo.B", "Nx", "Ny", "Nz", "Px", "Py",
+                          "Pz", "Z", "InstanceId"})
+        EXPECT_TRUE(exr.channels.count(c)) << c;
+    EXPECT_EQ(exr.attributes.at("lucent.sample"), "pathtracer");
+    EXPECT_EQ(exr.attributes.at("lucent.spp"), "2");
+    EXPECT_EQ(exr.attributes.at("lucent.denoise"), "1");
+    const nlohmann::json sets = nlohmann::json::parse(exr.attributes.at("lucent.sets"));
+    EXPECT_EQ(sets["seed"], "3");
+    const nlohmann::json camera = nlohmann::json::parse(exr.attributes.at("lucent.camera"));
+    EXPECT_EQ(camera["eye"].size(), 3u);
+    const nlohmann::json render = nlohmann::json::parse(exr.attributes.at("lucent.render"));
+    EXPECT_EQ(render["aovs"].size(), 12u) << render.dump(2);  // A and the 11 layers
+    bool denoise = false;
+    for (const auto& stage : render["stages"]) denoise = denoise || stage["name"] == "denoise";
+    EXPECT_TRUE(denoise) << render.dump(2);
+    // A plain .exr of the same sample has RGBA and the metadata, no other layer.
+    ASSERT_EQ(run_cli("render --sample pathtracer --size 8x8 --spp 1 -q --out '" + path("a.exr") +
+                      "'").exit_code,
+              0);
+    const lucent::scene::ExrFile plain = lucent::scene::read_exr_file(path("a.exr"));
+    EXPECT_EQ(plain.channels.size(), 1u);
+    EXPECT_TRUE(plain.channels.count("A"));
+    EXPECT_TRUE(plain.attributes.count("lucent.render"));
 }
 
 TEST_F(CliTest, CompareGivesTheFiguresAndFailsAboveAThreshold) {

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "bindings.h"
@@ -38,11 +39,13 @@ std::optional<float3> camera_point(const py::object& value, const char* name) {
     return make_float3(float(v[0]), float(v[1]), float(v[2]));
 }
 
-py::array_t<float> render(const std::string& name, const std::optional<std::string>& scene,
-                          std::pair<unsigned, unsigned> size, const std::string& backend,
-                          unsigned threads, unsigned spp, int jit_check_sm,
-                          const py::object& eye, const py::object& look, const py::object& up,
-                          std::optional<float> fov, const py::kwargs& options) {
+py::object render(const std::string& name, const std::optional<std::string>& scene,
+                  std::pair<unsigned, unsigned> size, const std::string& backend,
+                  unsigned threads, unsigned spp, int jit_check_sm, const py::object& eye,
+                  const py::object& look, const py::object& up, std::optional<float> fov,
+                  bool denoise, unsigned denoise_passes,
+                  const std::optional<std::vector<std::string>>& aovs,
+                  const py::kwargs& options) {
     samples::RenderSettings settings;
     settings.width = size.first;
     settings.height = size.second;
@@ -62,10 +65,20 @@ py::array_t<float> render(const std::string& name, const std::optional<std::stri
     settings.camera.fov_degrees = fov;  // checked with the rest of the camera by the sample
     for (const auto& [key, value] : options)
         settings.sets[key.cast<std::string>()] = option_text(value);
+    settings.denoise = denoise;
+    if (denoise_passes > 10)
+        throw py::value_error("render: denoise_passes must be 0..10; got " +
+                              std::to_string(denoise_passes));
+    if (denoise_passes) settings.denoise_options.iterations = denoise_passes;
     samples::RenderResult result;
     try {
         const samples::Sample& sample = samples::find_sample(name);
         sample.read_options(settings);  // checked before the GIL is released
+        if (aovs) {
+            settings.aovs = samples::parse_aovs("aovs", *aovs);
+            settings.alpha = true;
+        }
+        samples::check_aov_support(sample, settings);
         py::gil_scoped_release release;
         result = sample.render(settings);
     } catch (const samples::SettingsError& e) {
@@ -80,7 +93,19 @@ py::array_t<float> render(const std::string& name, const std::optional<std::stri
         out[4 * i + 2] = image.pixels[i].z;
         out[4 * i + 3] = 1.0f;
     }
-    return rgba;
+    if (!aovs) return rgba;
+    // With aovs: alpha is the coverage, and the layers come as {channel: (H, W) array}.
+    py::dict layers;
+    for (const scene::ExrChannel& c : result.aovs) {
+        if (c.name == "A") {
+            for (size_t i = 0; i < c.values.size(); ++i) out[4 * i + 3] = c.values[i];
+            continue;
+        }
+        py::array_t<float> values({py::ssize_t(image.height), py::ssize_t(image.width)});
+        std::copy(c.values.begin(), c.values.end(), values.mutable_data());
+        layers[py::str(c.name)] = values;
+    }
+    return py::make_tuple(rgba, layers);
 }
 
 const char* kind_name(samples::OptionKind kind) {
@@ -128,14 +153,19 @@ void bind_samples(py::module_& m) {
           py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
           py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
           py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
-          py::arg("fov") = py::none(),
+          py::arg("fov") = py::none(), py::arg("denoise") = false,
+          py::arg("denoise_passes") = 0u, py::arg("aovs") = py::none(),
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
           "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
           "and vertical fov in degrees over the scene's (--eye --look --up --fov; each "
           "None: the scene's), and the sample's options as "
-          "keywords (vpls=64). Returns the linear RGB image as an (H, W, 4) float32 array, "
-          "row 0 at the top, alpha 1.");
+          "keywords (vpls=64). denoise=True filters the image with the edge-avoiding "
+          "à-trous denoiser (--denoise; denoise_passes as --denoise-passes). Returns the "
+          "linear RGB image as an (H, W, 4) float32 array, row 0 at the top, alpha 1; with "
+          "aovs=['albedo', 'normal', 'depth', 'position', 'instance'] (any of them, --aov) "
+          "returns (image, layers): alpha is the coverage and layers maps each EXR channel "
+          "name ('Albedo.R', 'Nx', 'Z', ...) to an (H, W) float32 array.");
     m.def("samples", &list_samples,
           "{name: {'description': ..., 'options': {option: {'kind': 'integer'|'number'|'switch'|'text', "
           "'default': ..., 'help': ..., 'range': (lo, hi) for numbers and integers}}}}");

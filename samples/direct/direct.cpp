@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "samples/aov_passes.h"
 #include "samples/camera_session.h"
 #include "samples/direct/direct_programs.h"
 #include "samples/scene_setup.h"
@@ -25,7 +26,7 @@ struct DirectScene {
 /// Builds the scene of settings.scene (default: cornell) into `ctx`, its camera program at
 /// entry 0 reading `camera`.
 DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValues& options,
-                  const CameraBuffer& camera) {
+                  const CameraBuffer& camera, AovPasses* aovs = nullptr) {
     const float ambient = options.number("ambient");
     const scene::Scene input = load_render_scene(settings);
     ctx.set_ray_type<direct::RadiancePayload>(direct::kRadianceRay, "radiance");
@@ -57,6 +58,7 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
+    if (aovs) aovs->add_to(materials);
     auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
@@ -104,13 +106,21 @@ class DirectSample final : public Sample {
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        const DirectScene scene = build(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.camera, settings.aspect()));
+        // The G-buffer's ray type and entry points come after the sample's own.
+        AovPasses aovs(ctx, settings, direct::kShadowRay + 1, 1, camera.buffer());
+        const DirectScene scene = build(ctx, settings, options, camera, &aovs);
+        aovs.set_colour(scene.output);
+        const sample_common::PinholeCamera pinhole = pinhole_camera(scene.camera, settings.aspect());
+        camera.set(pinhole);
+        out.camera = scene.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
         timed_launch(ctx, 0, settings, out);
         out.image = image_from_output(*scene.output);
+        aovs.finish(pinhole, out);
         return out;
     }
+
+    bool writes_aovs() const override { return true; }
 
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
         return std::make_unique<DirectSession>(*this, settings, read_options(settings));

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "samples/aov_passes.h"
 #include "samples/camera_session.h"
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
@@ -155,7 +156,7 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 /// paper's form of imperfect visibility (IGI paper §4.1, imperfect_visibility=2), a second
 /// graph of one box per triangle as custom primitives ("vpl_shadow_object", traced only by
 /// VPL shadow rays; an empty group otherwise).
-void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
+void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPasses* aovs) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
     DiffuseTextures texture_for(ctx);
@@ -199,6 +200,7 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
     // Radiance and particle rays trace the scene; the boxes need none of their programs.
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
+    if (aovs) aovs->add_to(materials, {top});  // G-buffer rays trace the scene, not the boxes
 }
 
 /// The passes of the IGI paper's Fig. 3 as entry points, each reading and writing its images.
@@ -220,7 +222,8 @@ void add_passes(Context& ctx, const IgiConfig& config, const IgiImages& images,
     auto compose = ctx.create_program(LUCENT_PROGRAM(igi::igi_compose));
     (*compose)["indirect"] = images.irradiance_at_full_resolution(config);
     (*compose)["output"] = images.output;
-    ctx.set_entry_point_count(igi::kEntryCount);
+    // At least the sample's own: the AOV passes' entry points may follow them.
+    ctx.set_entry_point_count(std::max(ctx.entry_point_count(), unsigned(igi::kEntryCount)));
     ctx.set_ray_generation_program(igi::kDirectEntry, camera);
     ctx.set_ray_generation_program(igi::kVplEntry,
                                    ctx.create_program(LUCENT_PROGRAM(igi::igi_generate_vpls)));
@@ -257,7 +260,7 @@ struct IgiScene {
     IgiImages images;
 
     IgiScene(Context& ctx, const RenderSettings& settings, const IgiOptions& options,
-             const CameraBuffer& camera)
+             const CameraBuffer& camera, AovPasses* aovs = nullptr)
         : input(load_render_scene(settings)),
           lights(point_emitters(input, options.area_side)) {
         if (lights.empty())
@@ -267,7 +270,7 @@ struct IgiScene {
                                 "material Ke in its MTL, or add a light to a JSON scene)");
         set_up_context(ctx, options, scene_extent(input));
         add_lights(ctx, lights, options.config);
-        add_graphs(ctx, input, options.imperfect == igi::kBoxGraphVisibility);
+        add_graphs(ctx, input, options.imperfect == igi::kBoxGraphVisibility, aovs);
         images = create_igi_images(ctx, options.config);
         add_passes(ctx, options.config, images, camera);
     }
@@ -355,8 +358,14 @@ class IgiSample final : public Sample {
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        const IgiScene scene(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
+        // The G-buffer's ray type and entry points come after the sample's own.
+        AovPasses aovs(ctx, settings, igi::kVplShadowRay + 1, igi::kEntryCount, camera.buffer());
+        const IgiScene scene(ctx, settings, options, camera, &aovs);
+        aovs.set_colour(scene.images.output);
+        const sample_common::PinholeCamera pinhole =
+            pinhole_camera(scene.input.camera, settings.aspect());
+        camera.set(pinhole);
+        out.camera = scene.input.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start),
                               scene.input.name + ", " +
                                   std::to_string(scene.input.triangle_count()) + " triangles, " +
@@ -364,8 +373,11 @@ class IgiSample final : public Sample {
         render_igi_frames(ctx, options.config, settings, out);
         out.image = image_from_output(*scene.images.output);
         if (settings.keep_layers) keep_layers(options.config, scene.images, out);
+        aovs.finish(pinhole, out);
         return out;
     }
+
+    bool writes_aovs() const override { return true; }
 
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
         return std::make_unique<IgiSession>(*this, settings, IgiOptions(read_options(settings), settings));

@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "samples/aov_passes.h"
 #include "samples/camera_session.h"
 #include "samples/pathtracer/pathtracer_programs.h"
 #include "samples/scene_setup.h"
@@ -73,10 +74,13 @@ struct PathScene {
     std::string note;                       // "cornell, 32 triangles"
 };
 
+/// The G-buffer's ray type and first entry point: after the sample's own.
+constexpr unsigned kGBufferRay = 2, kGBufferEntry = 1;
+
 /// Builds the scene of settings.scene (default: cornell) into `ctx`, the camera program at
-/// entry 0 reading `camera`.
+/// entry 0 reading `camera`; each material also gets the G-buffer's hit when `aovs` is active.
 PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions& options,
-                const CameraBuffer& camera) {
+                const CameraBuffer& camera, AovPasses* aovs = nullptr) {
     scene::Scene input = load_render_scene(settings);
     const float extent = scene_extent(input);
     const float epsilon = std::max(1e-4f, 1e-4f * extent);
@@ -112,6 +116,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         (*material)["ior"] = m.ior;
         materials.push_back(material);
     }
+    if (aovs) aovs->add_to(materials);
     auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 
@@ -230,17 +235,24 @@ class PathtracerSample final : public Sample {
                                            "selects an independent set of random streams"),
                  }) {}
 
+    bool writes_aovs() const override { return true; }
+
     RenderResult render(const RenderSettings& settings) const override {
         const PathOptions options(read_options(settings));
         const Clock::time_point setup_start = Clock::now();
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        const PathScene scene = build(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.camera, settings.aspect()));
+        AovPasses aovs(ctx, settings, kGBufferRay, kGBufferEntry, camera.buffer());
+        const PathScene scene = build(ctx, settings, options, camera, &aovs);
+        aovs.set_colour(scene.output);
+        const sample_common::PinholeCamera pinhole = pinhole_camera(scene.camera, settings.aspect());
+        camera.set(pinhole);
+        out.camera = scene.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start), scene.note});
         render_frames(ctx, settings, out);
         out.image = image_from_output(*scene.output);
+        aovs.finish(pinhole, out);
         return out;
     }
 

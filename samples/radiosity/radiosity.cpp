@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "samples/aov_passes.h"
 #include "samples/camera_session.h"
 #include "samples/radiosity/radiosity_programs.h"
 #include "samples/radiosity/vpl_grid.h"
@@ -78,7 +79,7 @@ void set_up_context(Context& ctx, const scene::Scene& input, const Options& opti
 
 /// One material per scene material (the same surface program for radiance and photon
 /// rays), and the meshes under "top_object".
-void add_geometry(Context& ctx, const scene::Scene& input) {
+void add_geometry(Context& ctx, const scene::Scene& input, AovPasses* aovs) {
     DiffuseTextures texture_for(ctx);
     auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_surface));
     std::vector<std::shared_ptr<Material>> materials;
@@ -92,6 +93,7 @@ void add_geometry(Context& ctx, const scene::Scene& input) {
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
         materials.push_back(material);
     }
+    if (aovs) aovs->add_to(materials);
     auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
     ctx["top_object"] = mesh_group(ctx, input, attributes, materials);
 }
@@ -106,7 +108,7 @@ struct Passes {
 
 /// The area lights, the G-buffer, and the three entry points: photons, G-buffer, shading.
 Passes create_passes(Context& ctx, const scene::Scene& input, const Options& options,
-                     unsigned w, unsigned h, const CameraBuffer& camera) {
+                     unsigned w, unsigned h, const CameraBuffer& camera, AovPasses* aovs) {
     Passes p;
     const std::vector<sample_common::AreaLight> lights = area_lights(input);
     auto light_buffer =
@@ -122,7 +124,7 @@ Passes create_passes(Context& ctx, const scene::Scene& input, const Options& opt
     p.scattered =
         ctx.create_buffer<radiosity::Vpl>(BufferType::kInputOutput, p.photons * options.bounces);
 
-    add_geometry(ctx, input);
+    add_geometry(ctx, input, aovs);
 
     auto image = [&ctx, w, h] { return ctx.create_buffer<float4>(BufferType::kInputOutput, w, h); };
     ctx["gbuffer_position"] = image();
@@ -141,7 +143,8 @@ Passes create_passes(Context& ctx, const scene::Scene& input, const Options& opt
     (*shade)["camera"] = camera.buffer();
     (*shade)["output"] = p.output;
     (*shade)["vpls"] = options.merge ? p.merged : p.scattered;
-    ctx.set_entry_point_count(radiosity::kEntryCount);
+    // At least the sample's own: the AOV passes' entry points may follow them.
+    ctx.set_entry_point_count(std::max(ctx.entry_point_count(), unsigned(radiosity::kEntryCount)));
     ctx.set_ray_generation_program(radiosity::kPhotonEntry, photon_program);
     ctx.set_ray_generation_program(radiosity::kGBufferEntry, gbuffer);
     ctx.set_ray_generation_program(radiosity::kShadeEntry, shade);
@@ -218,10 +221,11 @@ struct RadiosityScene {
     Passes passes;
 
     RadiosityScene(Context& ctx, const RenderSettings& settings, const Options& options,
-                   const CameraBuffer& camera)
+                   const CameraBuffer& camera, AovPasses* aovs = nullptr)
         : input(load_lit_scene(settings)) {
         set_up_context(ctx, input, options);
-        passes = create_passes(ctx, input, options, settings.width, settings.height, camera);
+        passes =
+            create_passes(ctx, input, options, settings.width, settings.height, camera, aovs);
     }
 };
 
@@ -291,15 +295,25 @@ class RadiositySample final : public Sample {
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        RadiosityScene scene(ctx, settings, options, camera);
-        camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
+        // The G-buffer's ray type and entry points come after the sample's own.
+        AovPasses aovs(ctx, settings, radiosity::kPhotonRay + 1, radiosity::kEntryCount,
+                       camera.buffer());
+        RadiosityScene scene(ctx, settings, options, camera, &aovs);
+        aovs.set_colour(scene.passes.output);
+        const sample_common::PinholeCamera pinhole =
+            pinhole_camera(scene.input.camera, settings.aspect());
+        camera.set(pinhole);
+        out.camera = scene.input.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start),
                               scene.input.name + ", " +
                                   std::to_string(scene.input.triangle_count()) + " triangles"});
         render_passes(ctx, scene.input, options, settings, scene.passes, out);
         out.image = image_from_output(*scene.passes.output);
+        aovs.finish(pinhole, out);
         return out;
     }
+
+    bool writes_aovs() const override { return true; }
 
     std::unique_ptr<InteractiveSession> open(const RenderSettings& settings) const override {
         return std::make_unique<RadiositySession>(*this, settings, Options(read_options(settings)));
