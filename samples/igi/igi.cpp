@@ -158,7 +158,7 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -176,7 +176,7 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
         materials.push_back(material);
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
-    auto boxes = ctx.create_geometry_group();
+    std::vector<std::shared_ptr<GeometryInstance>> box_instances;  // per mesh, as the scene's
     auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_bounds));
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_intersect));
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
@@ -191,9 +191,12 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph) {
         auto box_instance = ctx.create_geometry_instance();
         box_instance->set_geometry(box_geometry);
         box_instance->add_material(box_material);
-        boxes->add_child(box_instance);
+        box_instances.push_back(box_instance);
     };
     auto top = mesh_group(ctx, input, attributes, materials, add_boxes);
+    // The boxes are in object space like the triangles, placed by the same instances.
+    std::shared_ptr<Node> boxes = box_graph ? place_meshes(ctx, input, box_instances)
+                                            : std::shared_ptr<Node>(ctx.create_geometry_group());
     ctx["top_object"] = top;
     ctx["vpl_shadow_object"] = boxes;
     // Radiance and particle rays trace the scene; the boxes need none of their programs.

@@ -34,7 +34,7 @@ void add_light_geometry(scene::Scene& s, float tolerance) {
                           light.corner + light.edge1 + light.edge2, light.corner + light.edge2};
         mesh.indices = {uint3{0, 1, 2}, uint3{0, 2, 3}};
         mesh.materials.assign(2, unsigned(s.materials.size() - 1));
-        s.meshes.push_back(std::move(mesh));
+        scene::add_untransformed_mesh(s, std::move(mesh));
     }
 }
 
@@ -97,7 +97,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_dielectric)),
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_coated)),
     };
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();

@@ -79,7 +79,7 @@ void set_up_context(Context& ctx, const scene::Scene& input, const Options& opti
 /// One material per scene material (the same surface program for radiance and photon
 /// rays), and the meshes under "top_object".
 void add_geometry(Context& ctx, const scene::Scene& input) {
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_surface));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
