@@ -38,6 +38,14 @@ float scene_extent(const scene::Scene& scene) {
                      std::fabs(b.hi.y), std::fabs(b.hi.z)});
 }
 
+std::string scene_note(const scene::Scene& scene) {
+    std::string note = scene.name + ", " + std::to_string(scene.triangle_count()) + " triangles";
+    if (!scene.instances.empty())
+        note += " stored, " + std::to_string(scene.drawn_triangle_count()) + " drawn by " +
+                std::to_string(scene.instances.size()) + " instances";
+    return note;
+}
+
 MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh) {
     MeshBuffers b;
     b.positions = ctx.create_buffer<float3>(BufferType::kInput, unsigned(mesh.positions.size()));

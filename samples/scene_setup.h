@@ -27,6 +27,10 @@ scene::Scene load_render_scene(const RenderSettings& settings);
 /// offsets for secondary rays scale with it (the Cornell box is in millimetres).
 float scene_extent(const scene::Scene& scene);
 
+/// The scene's name and size for a stage's note: "cornell, 32 triangles", or with instances
+/// "spheres, 4098 triangles stored, 4096002 drawn by 1001 instances".
+std::string scene_note(const scene::Scene& scene);
+
 /// A mesh's arrays as input buffers (uvs may be an empty buffer).
 struct MeshBuffers {
     std::shared_ptr<Buffer> positions, triangles, materials, uvs;

@@ -19,6 +19,7 @@ namespace lucent::scene {
 enum class MaterialKind {
     kLambert,     // diffuse reflectance `diffuse`
     kMetal,       // GGX microfacet conductor, Schlick Fresnel with `specular` as its colour
+                  // (`diffuse` when `specular` is black: a glTF metal's base colour)
     kDielectric,  // smooth glass of index `ior`
     kCoated,      // a clear GGX coat of index `ior` and `roughness` over a Lambert `diffuse`
 };

@@ -6,7 +6,10 @@ instancing would build). A ground quad, a camera and a point light come with it;
 buffer is embedded as base64, so the file stands alone.
 
   python3 scripts/make_instanced_gltf.py --instances 1000 --out /tmp/spheres.gltf
-  python3 scripts/make_instanced_gltf.py --instances 1000 --flatten --out /tmp/flat.gltf
+  python3 scripts/make_instanced_gltf.py --instances 1000 --flatten --out /tmp/flat.glb
+
+An --out ending in .glb writes the binary container (the buffer as its BIN chunk, no base64:
+what a large flattened scene should be measured as, the parser's cost being the file's).
 """
 import argparse
 import base64
@@ -113,13 +116,23 @@ def main():
                                                       "metallicFactor": 0, "roughnessFactor": 0.5}},
             {"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1],
                                                        "metallicFactor": 0, "roughnessFactor": 1}}],
-        "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," +
-                     base64.b64encode(bytes(blob)).decode()}],
+        "buffers": [{"byteLength": len(blob)}],
         "bufferViews": views,
         "accessors": accessors,
     }
-    with open(args.out, "w") as f:
-        json.dump(gltf, f)
+    if args.out.endswith(".glb"):
+        text = json.dumps(gltf).encode()
+        text += b" " * (-len(text) % 4)
+        blob.extend(b"\0" * (-len(blob) % 4))
+        with open(args.out, "wb") as f:
+            f.write(b"glTF" + struct.pack("<II", 2, 12 + 8 + len(text) + 8 + len(blob)))
+            f.write(struct.pack("<I", len(text)) + b"JSON" + text)
+            f.write(struct.pack("<I", len(blob)) + b"BIN\0" + bytes(blob))
+    else:
+        gltf["buffers"][0]["uri"] = ("data:application/octet-stream;base64," +
+                                     base64.b64encode(bytes(blob)).decode())
+        with open(args.out, "w") as f:
+            json.dump(gltf, f)
     drawn = len(triangles) * (1 if args.flatten else args.instances) + 2
     print(f"{args.out}: {args.instances} spheres of {len(sphere(args.rings, args.segments)[1])} "
           f"triangles ({'flattened' if args.flatten else 'instanced'}), {drawn} triangles drawn")

@@ -62,7 +62,7 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
 
     DirectScene out{ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height),
                     input.camera,
-                    input.name + ", " + std::to_string(input.triangle_count()) + " triangles"};
+                    scene_note(input)};
     auto program = ctx.create_program(LUCENT_PROGRAM(direct::direct_camera));
     (*program)["camera"] = camera.buffer();
     (*program)["output"] = out.output;

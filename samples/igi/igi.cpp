@@ -361,8 +361,7 @@ class IgiSample final : public Sample {
         const IgiScene scene(ctx, settings, options, camera);
         camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start),
-                              scene.input.name + ", " +
-                                  std::to_string(scene.input.triangle_count()) + " triangles, " +
+                              scene_note(scene.input) + ", " +
                                   std::to_string(scene.lights.size()) + " point emitters"});
         render_igi_frames(ctx, options.config, settings, out);
         out.image = image_from_output(*scene.images.output);

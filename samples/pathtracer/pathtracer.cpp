@@ -105,7 +105,11 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         material->set_closest_hit(pathtracer::kRadianceRay, closest_hits[int(m.kind)]);
         (*material)["Kd"] = m.diffuse;
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
-        (*material)["Ks"] = m.specular;
+        // A metal's colour is `specular`; a glTF metal carries it as its base colour in
+        // `diffuse` (what the Phong samples read as Kd) and leaves `specular` black.
+        const bool metal_by_diffuse =
+            m.kind == scene::MaterialKind::kMetal && max_component(m.specular) <= 0.0f;
+        (*material)["Ks"] = metal_by_diffuse ? m.diffuse : m.specular;
         (*material)["Ke"] = m.emission;
         // Perceptual roughness squared (Burley 2012); a floor keeps GGX finite in float.
         (*material)["alpha"] = std::max(m.roughness * m.roughness, 1e-3f);
@@ -128,7 +132,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     (*out.camera_program)["output"] = out.output;
     set_variables(*out.camera_program, *out.miss, options);
     ctx.set_ray_generation_program(0, out.camera_program);
-    out.note = input.name + ", " + std::to_string(input.triangle_count()) + " triangles";
+    out.note = scene_note(input);
     return out;
 }
 

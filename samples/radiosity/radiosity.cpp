@@ -50,8 +50,9 @@ scene::Scene load_lit_scene(const RenderSettings& settings) {
     if (area_lights(input).empty())
         throw SettingsError("radiosity: scene '" + input.name +
                             "' has no area light nor emissive triangle; the photons leave area "
-                            "lights (try --scene cornell, give a material Ke in its MTL, or add "
-                            "{\"type\": \"area\", ...} to a JSON scene's lights)");
+                            "lights (try --scene cornell, give a material Ke in its MTL or an "
+                            "emissiveFactor in its glTF file, or add {\"type\": \"area\", "
+                            "...} to a JSON scene's lights)");
     return input;
 }
 
@@ -294,8 +295,7 @@ class RadiositySample final : public Sample {
         RadiosityScene scene(ctx, settings, options, camera);
         camera.set(pinhole_camera(scene.input.camera, settings.aspect()));
         out.stages.push_back({"scene setup", ms_since(setup_start),
-                              scene.input.name + ", " +
-                                  std::to_string(scene.input.triangle_count()) + " triangles"});
+                              scene_note(scene.input)});
         render_passes(ctx, scene.input, options, settings, scene.passes, out);
         out.image = image_from_output(*scene.passes.output);
         return out;
