@@ -140,6 +140,9 @@ GltfReader::Elements GltfReader::elements(int index, const std::string& where) c
     if (component_size <= 0) fail(at + ".componentType", "unknown component type");
     if (components <= 0) fail(at + ".type", "unknown element type");
     const uint64_t element = uint64_t(component_size) * uint64_t(components);
+    // glTF 2.0 §3.6.2.4: a stride is at most 252 bytes (so stride x count cannot overflow).
+    if (view.byteStride > 252)
+        fail(view_at + ".byteStride", std::to_string(view.byteStride) + " bytes; at most 252");
     const uint64_t stride = view.byteStride ? uint64_t(view.byteStride) : element;
     if (stride < element)
         fail(view_at + ".byteStride", "a stride of " + std::to_string(stride) +
@@ -151,8 +154,14 @@ GltfReader::Elements GltfReader::elements(int index, const std::string& where) c
                           std::to_string(uint64_t(view.byteOffset) + view.byteLength) +
                           " lie outside buffer " + std::to_string(view.buffer) + " of " +
                           std::to_string(buffer.data.size()) + " bytes");
-    // Elements 0 .. count-1 within the view; counts are bounded by the buffer, so no overflow.
-    if (a.count > 0) {
+    // Elements 0 .. count-1 within the view; offsets and counts are bounded by the buffer
+    // first, so the sums below cannot overflow.
+    if (a.count == 0) return {buffer.data.data(), size_t(stride), 0, a.componentType, components, a.normalized};
+    if (uint64_t(a.byteOffset) > uint64_t(view.byteLength))
+        fail(at + ".byteOffset", std::to_string(a.byteOffset) + " lies beyond bufferView " +
+                                     std::to_string(a.bufferView) + " of " +
+                                     std::to_string(view.byteLength) + " bytes");
+    {
         const uint64_t end = uint64_t(a.byteOffset) + stride * (uint64_t(a.count) - 1) + element;
         if (uint64_t(a.count) > buffer.data.size() || end > uint64_t(view.byteLength))
             fail(at, std::to_string(a.count) + " elements from byte " +
@@ -518,7 +527,7 @@ Scene GltfReader::read() {
     std::vector<Visit> stack;
     for (size_t i = roots.size(); i-- > 0;)
         stack.push_back({roots[i], identity_matrix(), roots_at + "[" + std::to_string(i) + "]", false});
-    std::vector<bool> on_path(m_model.nodes.size(), false);
+    std::vector<bool> on_path(m_model.nodes.size(), false), seen(m_model.nodes.size(), false);
     std::vector<int> camera_node(m_model.cameras.size(), -1);
     std::vector<Matrix4x3> camera_world(m_model.cameras.size());
     while (!stack.empty()) {
@@ -531,6 +540,12 @@ Scene GltfReader::read() {
         check_index(v.node, m_model.nodes.size(), "node", v.where);
         if (on_path[size_t(v.node)])
             fail(v.where, "node " + std::to_string(v.node) + " is its own ancestor (a cycle)");
+        // glTF's nodes form disjoint trees (§3.5.1): a node reached twice has two parents,
+        // and a file of such nodes could ask for exponentially many visits.
+        if (seen[size_t(v.node)])
+            fail(v.where, "node " + std::to_string(v.node) +
+                              " is reached a second time (a node has one parent at most)");
+        seen[size_t(v.node)] = true;
         const tinygltf::Node& node = m_model.nodes[size_t(v.node)];
         const std::string at = at_index("nodes", size_t(v.node));
         const Matrix4x3 world = multiply(v.parent, local_matrix(node, at));

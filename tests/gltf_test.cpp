@@ -401,6 +401,11 @@ TEST_F(GltfScenes, MalformedFilesNameTheFileAndTheJsonPath) {
   "nodes": [{"children": [1]}, {"mesh": 0, "children": [0]}], "scenes": [{"nodes": [0]}])"));
     EXPECT_EQ(error_of(cycle), cycle + ": nodes[1].children[0]: node 0 is its own ancestor (a cycle)");
 
+    const std::string twice = write("twice.gltf", gltf(std::string(kSquareMesh) + R"(,
+  "nodes": [{"children": [2]}, {"children": [2]}, {"mesh": 0}], "scenes": [{"nodes": [0, 1]}])"));
+    EXPECT_EQ(error_of(twice), twice + ": nodes[1].children[0]: node 2 is reached a second time "
+                                       "(a node has one parent at most)");
+
     const std::string draco = write("d.gltf", gltf(std::string(kSquareMesh) + R"(,
   "extensionsRequired": ["KHR_draco_mesh_compression"], "nodes": [{"mesh": 0}])"));
     EXPECT_EQ(error_of(draco), draco + ": extensionsRequired[0]: the file requires "
