@@ -139,6 +139,7 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     if (settings.camera.look) camera["look"] = vec(*settings.camera.look);
     if (settings.camera.up) camera["up"] = vec(*settings.camera.up);
     if (settings.camera.fov_degrees) camera["fov"] = *settings.camera.fov_degrees;
+    if (settings.scene_camera) camera["index"] = *settings.scene_camera;  // --camera N
     j["camera"] = camera;
     j["stages"] = Json::array();
     for (const samples::StageTiming& stage : result.stages)
