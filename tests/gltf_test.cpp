@@ -360,6 +360,37 @@ TEST_F(GltfScenes, RenderHitsTheInstancedMeshWhereItsTransformPutsIt) {
         << "the scaled instance reaches 0.25 from its centre, not 0.4";
 }
 
+TEST_F(GltfScenes, ShadingNormalsOfANonUniformlyScaledInstanceAreByTheInverseTranspose) {
+    // The square at x = -1.5 facing the light (+z), and at x = +1.5 turned 45 degrees about y
+    // and then stretched 3x along x (matrix S R). The plane's normal is then
+    // (sin 45 / 3, 0, cos 45) normalised, 18.4 degrees from +z (cosine 0.949); transformed by
+    // the matrix itself it would be (3 sin 45, 0, cos 45), 71.6 degrees off (cosine 0.316).
+    // A far light on +z lights the two in the ratio of the cosines.
+    const std::string rest = std::string(kSquareMesh) + R"(,
+  "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 100000}]}},
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+  "nodes": [{"mesh": 0, "translation": [-1.5, 0, 0]},
+            {"mesh": 0, "matrix": [2.1213203, 0, -0.7071068, 0,  0, 1, 0, 0,
+                                   2.1213203, 0, 0.7071068, 0,  1.5, 0, 0, 1]},
+            {"camera": 0, "translation": [0, 0, 6]},
+            {"translation": [0, 0, 100], "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+    lucent::samples::RenderSettings settings;
+    settings.width = settings.height = 64;
+    settings.backend = lucent::BackendKind::kCpu;
+    settings.threads = 2;
+    settings.scene = write("n.gltf", gltf(rest));
+    const auto r = lucent::samples::find_sample("direct").render(settings);
+    auto pixel = [&](float x) {  // the pixel of world point (x, 0, 0)
+        const int px = int((x / 6.0f / std::tan(0.35f) * 0.5f + 0.5f) * 64);
+        return r.image.pixels[size_t(32) * 64 + size_t(px)];
+    };
+    const float reference = pixel(-1.5f).x, tilted = pixel(1.5f).x;
+    ASSERT_GT(reference, 0.1f);
+    // The light, seen from the two centres, leans 0.86 degrees inwards (towards x = 0): away
+    // from the tilted normal, so cos(18.43 + 0.86) / cos(0.86) = 0.944.
+    EXPECT_NEAR(tilted / reference, 0.944f, 0.005f);
+}
+
 TEST_F(GltfScenes, MalformedFilesNameTheFileAndTheJsonPath) {
     const std::string mesh_bad_accessor = R"(
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1},
