@@ -256,7 +256,11 @@ std::string GltfReader::texture(int index, const std::string& where) {
     if (image.image.empty() || image.width <= 0 || image.height <= 0 || image.component != 4 ||
         image.bits != 8 ||
         image.image.size() != size_t(image.width) * size_t(image.height) * 4)
-        fail(image_at, "no decoded pixels (an image tinygltf did not load)");
+        fail(image_at, (image.uri.empty() || image.uri.rfind("data:", 0) == 0
+                            ? std::string("its image")
+                            : "'" + image.uri + "'") +
+                           " was not loaded (a missing or unreadable file: tinygltf only "
+                           "warns, so the texture would be lost)");
     TextureImage texels{unsigned(image.width), unsigned(image.height), {}};
     float to_linear[256];  // base colour textures are sRGB-encoded, alpha linear (glTF 2.0 §3.9)
     for (int i = 0; i < 256; ++i) to_linear[i] = srgb_to_linear(float(i) / 255.0f);

@@ -253,6 +253,30 @@ TEST_F(GltfScenes, BaseColourTextureIsLinearisedAndUvsFlipped) {
     EXPECT_FLOAT_EQ(s.meshes[0].uvs[3].y, 1.0f);
 }
 
+TEST_F(GltfScenes, ExternalBufferAndImageFilesAreReadBesideTheGltfFile) {
+    write("square.bin", square_buffer());
+    const unsigned char rgba[4] = {0, 255, 0, 255};
+    stbi_write_png((dir / "green.png").string().c_str(), 1, 1, 4, rgba, 4);
+    std::string text = gltf(R"(
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2}, "indices": 1,
+                              "material": 0}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+  "textures": [{"source": 0}], "images": [{"uri": "green.png"}],
+  "nodes": [{"mesh": 0}])");
+    const size_t b = text.find("\"uri\": \"data:");
+    text.replace(b, text.find('"', b + 8) + 1 - b, "\"uri\": \"square.bin\"");
+    const Scene s = lucent::scene::load_scene(write("external.gltf", text));
+    EXPECT_FLOAT_EQ(s.meshes.at(0).positions[1].x, 0.5f);
+    ASSERT_EQ(s.textures.size(), 1u);
+    EXPECT_FLOAT_EQ(s.textures.begin()->second.texels[0].y, 1.0f);
+    fs::remove(dir / "green.png");
+    testing::internal::CaptureStderr();  // tinygltf's warning
+    const std::string error = error_of((dir / "external.gltf").string());
+    testing::internal::GetCapturedStderr();
+    EXPECT_EQ(error.rfind((dir / "external.gltf").string() + ": ", 0), 0u) << error;
+    EXPECT_NE(error.find("images[0]: 'green.png' was not loaded"), std::string::npos) << error;
+}
+
 const char* kCameras = R"(,
   "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}},
               {"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}},
