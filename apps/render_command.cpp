@@ -78,6 +78,7 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.scene = args.scene;
     s.verbose = args.verbose;
     if (!args.jit_check.empty()) s.jit_check_sm = parse_sm("--jit-check", args.jit_check);
+    if (args.camera >= 0) s.scene_camera = unsigned(args.camera);
     if (!args.eye.empty()) s.camera.eye = parse_vec3("--eye", args.eye);
     if (!args.look.empty()) s.camera.look = parse_vec3("--look", args.look);
     if (!args.up.empty()) s.camera.up = parse_vec3("--up", args.up);
@@ -148,6 +149,7 @@ Json render_json(const RenderArgs& args, const samples::RenderSettings& settings
     if (settings.camera.look) camera["look"] = vec(*settings.camera.look);
     if (settings.camera.up) camera["up"] = vec(*settings.camera.up);
     if (settings.camera.fov_degrees) camera["fov"] = *settings.camera.fov_degrees;
+    if (settings.scene_camera) camera["index"] = *settings.scene_camera;  // --camera N
     j["camera"] = camera;
     if (result.camera)
         j["rendered_camera"] = {{"eye", vec(result.camera->eye)},
@@ -221,6 +223,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
         ->type_name("N")
         ->check(CLI::Range(0u, 1000000u).description(""))
         ->capture_default_str();
+    cmd->add_option("--camera", args.camera,
+                    "The scene file's camera N (glTF's cameras, from 0); default: its first")
+        ->type_name("N")
+        ->check(CLI::Range(0, 1 << 30).description(""));
     cmd->add_option("--eye", args.eye, "Camera position, over the scene's")->type_name("X,Y,Z");
     cmd->add_option("--look", args.look, "Point the camera looks at, over the scene's")
         ->type_name("X,Y,Z");
@@ -259,11 +265,13 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 "  lucent render --jit-check sm_90      # also compile the GPU megakernel\n"
                 "  lucent render --sample pathtracer --scene cornell-materials --spp 256\n"
                 "  lucent render --sample igi --eye 278,273,-500 --fov 50   # another view\n"
+                "  lucent render --sample pathtracer --scene model.glb --camera 1\n"
                 "  lucent render --json --out x.exr     # timings for scripts\n"
                 "  lucent render --sample pathtracer --spp 4 --denoise --out denoised.exr\n"
                 "  lucent render --sample pathtracer --aov albedo,normal,depth --out gbuffer.exr\n"
                 "\nThe camera flags replace the parts of the scene's camera they give; the\n"
-                "scene's own camera (or one framing the scene) gives the rest.\n");
+                "scene's own camera (--camera N of a glTF file's, or one framing the scene)\n"
+                "gives the rest.\n");
     return cmd;
 }
 

@@ -21,6 +21,7 @@ struct RenderArgs {
     unsigned repeat = 1;    // launches; >1 reports the median launch time
     unsigned spp = 0;       // samples per pixel of progressive samples; 0 = the sample's default
     std::string jit_check;  // e.g. "sm_90": also compile the CUDA megakernel (no GPU needed)
+    int camera = -1;                 // --camera N: the scene file's camera N; -1 = its first
     std::string eye, look, up, fov;  // the camera, over the scene's (each optional)
     bool quiet = false;  // no header, progress or timings: only errors
     bool json = false;   // the settings and timings as one JSON object on stdout

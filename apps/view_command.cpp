@@ -35,6 +35,10 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
     cmd->add_option("--scene", args.scene,
                     "Built-in scene or scene file (default: the sample's own)")
         ->type_name("NAME|FILE");
+    cmd->add_option("--camera", args.camera,
+                    "Start from the scene file's camera N (glTF's cameras, from 0)")
+        ->type_name("N")
+        ->check(CLI::Range(0, 1 << 30).description(""));
     cmd->add_option("--set", args.sets, "Sample option (repeatable)")->type_name("NAME=VALUE");
     cmd->add_option("--threads", args.threads,
                     "CPU worker threads, 0 = one per core but one (left to the window)")
@@ -87,6 +91,7 @@ int run_view(const ViewArgs& args) {
         settings.threads = cores > 1 ? cores - 1 : 1;
     }
     settings.scene = args.scene;
+    if (args.camera >= 0) settings.scene_camera = unsigned(args.camera);
     settings.spp = args.spp;
     for (const std::string& text : args.sets) {
         auto [name, value] = parse_set("--set", text);

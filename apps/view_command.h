@@ -14,6 +14,7 @@ struct ViewArgs {
     std::string backend = "auto";
     std::string devices;
     std::string scene;
+    int camera = -1;  // --camera N: the scene file's camera N to start from; -1 = its first
     std::vector<std::string> sets;
     unsigned threads = 0;
     unsigned spp = 0;        // progressive samples stop refining here; 0 = never

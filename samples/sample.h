@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,6 +26,7 @@ struct RenderSettings {
     std::vector<DeviceSpec> devices;          // --devices: launches spread over these
     unsigned threads = 0;                     // CPU workers, 0 = all cores
     std::string scene;                        // built-in scene name or file; empty = default
+    std::optional<unsigned> scene_camera;     // --camera N: the file's camera N (glTF)
     CameraOverride camera;                    // --eye --look --up --fov: over the scene's
     std::map<std::string, std::string> sets;  // --set name=value, checked by the sample
     bool verbose = false;

@@ -1,5 +1,6 @@
 #include "samples/scene_setup.h"
 
+#include "samples/settings_error.h"
 #include "scene/texture_image.h"
 
 #include <algorithm>
@@ -10,16 +11,39 @@ namespace lucent::samples {
 
 scene::Scene load_render_scene(const RenderSettings& settings) {
     scene::Scene scene = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    if (settings.scene_camera) {
+        const unsigned n = *settings.scene_camera;
+        const size_t count = scene.cameras.size();
+        if (n >= count)
+            throw SettingsError("--camera " + std::to_string(n) + ": scene '" + scene.name +
+                                "' has " + std::to_string(count) +
+                                (count == 1 ? " camera of its own" : " cameras of its own") +
+                                (count == 0 ? "" : " (0 to " + std::to_string(count - 1) + ")"));
+        if (!scene.cameras[n].unusable.empty())
+            throw SettingsError("--camera " + std::to_string(n) + ": " + scene.cameras[n].unusable);
+        scene.camera = scene.cameras[n];
+    }
     if (!settings.camera.empty()) scene.camera = settings.camera.applied_to(scene.camera);
     return scene;
 }
 
 float scene_extent(const scene::Scene& scene) {
-    float extent = 0;
-    for (const auto& mesh : scene.meshes)
-        for (const float3& p : mesh.positions)
-            extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    return extent;
+    // The world-space box's corners: an instance's transform moves and scales its mesh.
+    bool any = false;
+    for (const scene::Instance& i : scene::drawn_instances(scene))
+        any = any || !scene.meshes[i.mesh].positions.empty();
+    if (!any) return 0;
+    const scene::Bounds b = scene::scene_bounds(scene);
+    return std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x),
+                     std::fabs(b.hi.y), std::fabs(b.hi.z)});
+}
+
+std::string scene_note(const scene::Scene& scene) {
+    std::string note = scene.name + ", " + std::to_string(scene.triangle_count()) + " triangles";
+    if (!scene.instances.empty())
+        note += " stored, " + std::to_string(scene.drawn_triangle_count()) + " drawn by " +
+                std::to_string(scene.instances.size()) + " instances";
+    return note;
 }
 
 MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh) {
@@ -35,11 +59,39 @@ MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh) {
     return b;
 }
 
-std::shared_ptr<GeometryGroup> mesh_group(
+std::shared_ptr<Node> place_meshes(Context& ctx, const scene::Scene& scene,
+                                   const std::vector<std::shared_ptr<GeometryInstance>>& per_mesh) {
+    if (scene.instances.empty()) {
+        auto group = ctx.create_geometry_group();
+        for (const auto& instance : per_mesh)
+            if (instance) group->add_child(instance);
+        return group;
+    }
+    std::vector<std::shared_ptr<GeometryGroup>> groups(per_mesh.size());
+    auto top = ctx.create_group();
+    for (const scene::Instance& placed : scene.instances) {
+        if (placed.mesh >= per_mesh.size())
+            throw Error("place_meshes: instance of mesh " + std::to_string(placed.mesh) +
+                        " in a scene of " + std::to_string(per_mesh.size()) + " meshes");
+        if (!per_mesh[placed.mesh]) continue;
+        auto& group = groups[placed.mesh];
+        if (!group) {  // the first instance of this mesh: its GeometryGroup, shared by the rest
+            group = ctx.create_geometry_group();
+            group->add_child(per_mesh[placed.mesh]);
+        }
+        auto transform = ctx.create_transform();
+        transform->set_matrix(placed.transform);
+        transform->set_child(group);
+        top->add_child(transform);
+    }
+    return top;
+}
+
+std::shared_ptr<Node> mesh_group(
     Context& ctx, const scene::Scene& scene, const std::shared_ptr<Program>& attributes,
     const std::vector<std::shared_ptr<Material>>& materials,
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each) {
-    auto group = ctx.create_geometry_group();
+    std::vector<std::shared_ptr<GeometryInstance>> instances;
     unsigned index = 0;
     for (const auto& mesh : scene.meshes) {
         const MeshBuffers buffers = upload_mesh(ctx, mesh);
@@ -56,10 +108,10 @@ std::shared_ptr<GeometryGroup> mesh_group(
         instance->set_geometry(triangles);
         (*instance)["gbuffer_instance"] = index++;  // the G-buffer's instance AOV
         for (const auto& material : materials) instance->add_material(material);
-        group->add_child(instance);
+        instances.push_back(instance);
         if (each) each(mesh, buffers);
     }
-    return group;
+    return place_meshes(ctx, scene, instances);
 }
 
 sample_common::PinholeCamera pinhole_camera(const scene::Camera& c, float aspect) {
@@ -139,9 +191,16 @@ scene::Image image_from_output(const Buffer& output, unsigned layer) {
 std::shared_ptr<TextureSampler> DiffuseTextures::operator()(const std::string& file) {
     auto& sampler = m_samplers[file];
     if (sampler) return sampler;
-    const scene::TextureImage image = file.empty()
-                                          ? scene::TextureImage{1, 1, {make_float4(1, 1, 1, 1)}}
-                                          : scene::load_texture(file);
+    scene::TextureImage loaded;
+    const scene::TextureImage* carried = nullptr;
+    if (m_scene) {
+        auto it = m_scene->textures.find(file);
+        if (it != m_scene->textures.end()) carried = &it->second;
+    }
+    if (!carried)
+        loaded = file.empty() ? scene::TextureImage{1, 1, {make_float4(1, 1, 1, 1)}}
+                              : scene::load_texture(file);
+    const scene::TextureImage& image = carried ? *carried : loaded;
     auto texels = m_ctx.create_buffer<float4>(BufferType::kInput, image.width, image.height);
     texels->upload(image.texels);
     sampler = m_ctx.create_texture_sampler();

@@ -17,13 +17,19 @@
 
 namespace lucent::samples {
 
-/// The scene of settings.scene (default: the Cornell box), with the parts of its camera that
-/// settings.camera gives replaced (SettingsError for a camera that cannot see).
+/// The scene of settings.scene (default: the Cornell box), its camera settings.scene_camera
+/// of the file's own when given (SettingsError naming how many it has when out of range),
+/// with the parts of it that settings.camera gives replaced (SettingsError for a camera
+/// that cannot see).
 scene::Scene load_render_scene(const RenderSettings& settings);
 
-/// The largest coordinate magnitude of any vertex: offsets for secondary rays scale with
-/// it (the Cornell box is in millimetres).
+/// The largest coordinate magnitude of any vertex where the scene draws it (world space):
+/// offsets for secondary rays scale with it (the Cornell box is in millimetres).
 float scene_extent(const scene::Scene& scene);
+
+/// The scene's name and size for a stage's note: "cornell, 32 triangles", or with instances
+/// "spheres, 4098 triangles stored, 4096002 drawn by 1001 instances".
+std::string scene_note(const scene::Scene& scene);
 
 /// A mesh's arrays as input buffers (uvs may be an empty buffer).
 struct MeshBuffers {
@@ -32,15 +38,25 @@ struct MeshBuffers {
 MeshBuffers upload_mesh(Context& ctx, const scene::Mesh& mesh);
 
 /// One GeometryTriangles per mesh of `scene`, each in an instance with all of `materials` (a
-/// triangle's material index picks one), under a new GeometryGroup. Each geometry gets the
+/// triangle's material index picks one), placed by place_meshes. Each geometry gets the
 /// attribute program and the variables attribute programs read: "positions", "triangles"
-/// and "uvs" (empty when the mesh has none); each instance gets "gbuffer_instance", the mesh's
-/// index (samples/common/gbuffer_programs.h). `each`, when given, sees every mesh with its
-/// buffers, for graphs built beside this one (IGI's boxes).
-std::shared_ptr<GeometryGroup> mesh_group(
+/// and "uvs" (empty when the mesh has none); their data stay in object space, the hit
+/// programs take normals to the world (lucent::object_to_world_normal). Each instance gets
+/// "gbuffer_instance", the mesh's index (samples/common/gbuffer_programs.h). `each`, when
+/// given, sees every mesh with its buffers, for graphs built beside this one (IGI's boxes).
+std::shared_ptr<Node> mesh_group(
     Context& ctx, const scene::Scene& scene, const std::shared_ptr<Program>& attributes,
     const std::vector<std::shared_ptr<Material>>& materials,
     const std::function<void(const scene::Mesh&, const MeshBuffers&)>& each = {});
+
+/// One GeometryInstance per mesh of `scene` (null for a mesh to leave out) as the scene
+/// draws them. Without Scene::instances: every instance under one GeometryGroup, as the
+/// scene's meshes were always built. With them: a GeometryGroup per mesh, built once, and
+/// a Group over one Transform per instance, each pointing at its mesh's GeometryGroup, so a
+/// mesh drawn a thousand times has one BVH (and one copy of its buffers) and the Group's
+/// BVH has a thousand boxes.
+std::shared_ptr<Node> place_meshes(Context& ctx, const scene::Scene& scene,
+                                   const std::vector<std::shared_ptr<GeometryInstance>>& per_mesh);
 
 /// The scene's lights as the input buffers "point_lights", "area_lights" and
 /// "area_light_cdf" (light_cdf of them) on the context, in the layouts of
@@ -73,13 +89,16 @@ scene::Image image_from_output(const Buffer& output, unsigned layer = 0);
 
 /// Diffuse maps as texture samplers (bilinear, repeating), each file loaded once; a
 /// material without one ("") gets a 1x1 white texel, so programs always sample a texture.
+/// Given a scene, a name that is a key of its Scene::textures (a glTF image) is that image.
 class DiffuseTextures {
   public:
-    explicit DiffuseTextures(Context& ctx) : m_ctx(ctx) {}
+    explicit DiffuseTextures(Context& ctx, const scene::Scene* scene = nullptr)
+        : m_ctx(ctx), m_scene(scene) {}
     std::shared_ptr<TextureSampler> operator()(const std::string& file);
 
   private:
     Context& m_ctx;
+    const scene::Scene* m_scene;
     std::map<std::string, std::shared_ptr<TextureSampler>> m_samplers;
 };
 

@@ -23,9 +23,17 @@ bool lies_on(const AreaLight& light, float3 c, float tolerance) {
     return std::fabs(dot(w, normal)) / std::sqrt(area2) <= tolerance && inside;
 }
 
-float3 centroid(const Mesh& mesh, size_t t) {
+/// Triangle t of a mesh where an instance draws it: lights live in world space, so an
+/// instanced emitter is one light per instance, of the area its transform gives it.
+struct WorldTriangle {
+    float3 p0, p1, p2;
+    float3 centroid() const { return (p0 + p1 + p2) / 3.0f; }
+};
+WorldTriangle world_triangle(const Mesh& mesh, const Instance& instance, size_t t) {
     const uint3 v = mesh.indices[t];
-    return (mesh.positions[v.x] + mesh.positions[v.y] + mesh.positions[v.z]) / 3.0f;
+    return {transform_point(instance.transform, mesh.positions[v.x]),
+            transform_point(instance.transform, mesh.positions[v.y]),
+            transform_point(instance.transform, mesh.positions[v.z])};
 }
 
 /// Distances below which two surfaces count as one: a thousandth of the scene's size.
@@ -38,38 +46,41 @@ float coincidence_tolerance(const Scene& scene) {
 }  // namespace
 
 bool has_emitting_geometry(const Scene& s, const AreaLight& light, float tolerance) {
-    for (const Mesh& mesh : s.meshes)
+    for (const Instance& instance : drawn_instances(s)) {
+        const Mesh& mesh = s.meshes[instance.mesh];
         for (size_t t = 0; t < mesh.indices.size(); ++t)
             if (max_component(s.materials[mesh.materials[t]].emission) > 0 &&
-                lies_on(light, centroid(mesh, t), tolerance))
+                lies_on(light, world_triangle(mesh, instance, t).centroid(), tolerance))
                 return true;
+    }
     return false;
 }
 
 std::vector<AreaLight> emitter_lights(const Scene& s) {
     std::vector<AreaLight> lights = s.area_lights;
     const float tolerance = coincidence_tolerance(s);
-    for (const Mesh& mesh : s.meshes)
+    for (const Instance& instance : drawn_instances(s)) {
+        const Mesh& mesh = s.meshes[instance.mesh];
         for (size_t t = 0; t < mesh.indices.size(); ++t) {
             const float3 emission = s.materials[mesh.materials[t]].emission;
             if (!(max_component(emission) > 0)) continue;
-            const uint3 v = mesh.indices[t];
-            const float3 p0 = mesh.positions[v.x], e1 = mesh.positions[v.y] - p0,
-                         e2 = mesh.positions[v.z] - p0;
+            const WorldTriangle w = world_triangle(mesh, instance, t);
+            const float3 p0 = w.p0, e1 = w.p1 - p0, e2 = w.p2 - p0;
             if (!(length(cross(e1, e2)) > 0)) continue;  // degenerate: no area, no light
-            const float3 c = centroid(mesh, t);
+            const float3 c = w.centroid();
             if (std::any_of(s.area_lights.begin(), s.area_lights.end(),
                             [&](const AreaLight& l) { return lies_on(l, c, tolerance); }))
                 continue;
             lights.push_back(AreaLight{p0, e1, e2, emission, /*triangle=*/true});
         }
+    }
     return lights;
 }
 
 bool has_lights(const Scene& s) {
     if (!s.point_lights.empty() || !s.area_lights.empty()) return true;
-    for (const Mesh& mesh : s.meshes)
-        for (unsigned m : mesh.materials)
+    for (const Instance& instance : drawn_instances(s))
+        for (unsigned m : s.meshes[instance.mesh].materials)
             if (max_component(s.materials[m].emission) > 0) return true;
     return false;
 }

@@ -1,5 +1,5 @@
 // A Scene from a JSON description (nlohmann-json): camera, materials, meshes (OBJ files or
-// inline triangles) and point or area lights. Syntax errors name file:line:column; other
+// inline triangles), instances placing meshes by transforms, and point or area lights. Syntax errors name file:line:column; other
 // errors name the file and the JSON location ("/lights/1/position") and what is expected.
 #include <cmath>
 #include <cstdlib>
@@ -160,6 +160,80 @@ json parse_file(const std::string& path) {
         throw Error(path + ": " + e.what());
     }
 }
+
+/// A 3x3 rotation of `degrees` about `axis` (Rodrigues), as the rows of a Matrix4x3.
+Matrix4x3 rotation(float3 axis, float degrees) {
+    const float3 a = normalize(axis);
+    const float r = degrees * 3.14159265358979f / 180.0f, c = std::cos(r), s = std::sin(r),
+                t = 1 - c;
+    return Matrix4x3{{t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y, 0,
+                      t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x, 0,
+                      t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c, 0}};
+}
+
+/// "instances": [{"mesh": i, "translate": [x,y,z], "rotate": [ax,ay,az,degrees],
+/// "scale": s or [sx,sy,sz]}] (applied scale, then rotate, then translate), or "matrix": 12
+/// numbers, the rows of a 3x4 object-to-world matrix. Each places every Scene mesh that
+/// /meshes/i gave; with instances, a mesh no instance places is an error (it would vanish).
+void read_instances(const JsonReader& r, const json& list,
+                    const std::vector<std::pair<unsigned, unsigned>>& mesh_range, Scene& scene) {
+    if (!list.is_array() || list.empty())
+        r.fail("/instances", "expected an array of instances: [{\"mesh\": 0, \"translate\": [x,y,z]}]");
+    std::vector<bool> placed(mesh_range.size(), false);
+    for (size_t i = 0; i < list.size(); ++i) {
+        const std::string at = "/instances/" + std::to_string(i);
+        const json& inst = list[i];
+        r.only(inst, {"mesh", "translate", "rotate", "scale", "matrix"}, at);
+        const json& mesh = r.member(inst, "mesh", at);
+        if (!mesh.is_number_integer() || mesh.get<long long>() < 0 ||
+            mesh.get<long long>() >= (long long)mesh_range.size())
+            r.fail(at + "/mesh", "expected the index of an entry of /meshes, 0.." +
+                                     std::to_string(mesh_range.size()) + " (exclusive)");
+        const size_t m = mesh.get<size_t>();
+        Matrix4x3 transform = identity_matrix();
+        if (inst.contains("matrix")) {
+            if (inst.contains("translate") || inst.contains("rotate") || inst.contains("scale"))
+                r.fail(at + "/matrix", "give either \"matrix\" or translate/rotate/scale");
+            const json& mat = inst["matrix"];
+            if (!mat.is_array() || mat.size() != 12)
+                r.fail(at + "/matrix", "expected 12 numbers: the rows of a 3x4 matrix");
+            for (size_t k = 0; k < 12; ++k)
+                transform.m[k] = r.number(mat[k], at + "/matrix/" + std::to_string(k));
+        } else {
+            if (inst.contains("scale")) {
+                const json& sc = inst["scale"];
+                const float3 f = sc.is_array() ? r.vec3(sc, at + "/scale")
+                                               : make_float3(r.number(sc, at + "/scale"));
+                transform = Matrix4x3{{f.x, 0, 0, 0, 0, f.y, 0, 0, 0, 0, f.z, 0}};
+            }
+            if (inst.contains("rotate")) {
+                const json& rot = inst["rotate"];
+                if (!rot.is_array() || rot.size() != 4)
+                    r.fail(at + "/rotate", "expected [axis x, axis y, axis z, degrees]");
+                const float3 axis = make_float3(r.number(rot[0], at + "/rotate/0"),
+                                                r.number(rot[1], at + "/rotate/1"),
+                                                r.number(rot[2], at + "/rotate/2"));
+                if (!(length(axis) > 0)) r.fail(at + "/rotate", "the axis is zero");
+                transform = multiply(rotation(axis, r.number(rot[3], at + "/rotate/3")), transform);
+            }
+            if (inst.contains("translate")) {
+                const float3 t = r.vec3(inst["translate"], at + "/translate");
+                transform.m[3] += t.x, transform.m[7] += t.y, transform.m[11] += t.z;
+            }
+        }
+        Matrix4x3 inverse;
+        if (!invert(transform, inverse))
+            r.fail(at, "the transform is singular (a zero scale); rays could not enter it");
+        placed[m] = true;
+        for (unsigned k = mesh_range[m].first; k < mesh_range[m].second; ++k)
+            scene.instances.push_back({k, transform});
+    }
+    for (size_t m = 0; m < placed.size(); ++m)
+        if (!placed[m])
+            r.fail("/meshes/" + std::to_string(m),
+                   "no instance places this mesh; with \"instances\" only placed meshes are "
+                   "drawn (add {\"mesh\": " + std::to_string(m) + "} or remove it)");
+}
 }  // namespace
 
 namespace detail {
@@ -178,7 +252,7 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
     JsonReader r(path);
     if (!root.is_object())
         r.fail("/", "a scene is a JSON object with camera, materials, meshes, lights");
-    r.only(root, {"camera", "materials", "meshes", "lights"}, "");
+    r.only(root, {"camera", "materials", "meshes", "instances", "lights"}, "");
 
     Scene scene;
     scene.name = fs::path(path).stem().string();
@@ -243,8 +317,17 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
     if (!root.contains("meshes") || !root["meshes"].is_array() || root["meshes"].empty())
         r.fail("/meshes", "a scene needs at least one mesh: [{\"file\": \"model.obj\"}]");
     const json& meshes = root["meshes"];
+    // The Scene meshes each entry gives (an OBJ file gives one per object), for "instances".
+    std::vector<std::pair<unsigned, unsigned>> mesh_range;
     for (size_t i = 0; i < meshes.size(); ++i) {
         const std::string at = "/meshes/" + std::to_string(i);
+        const unsigned first_mesh = unsigned(scene.meshes.size());
+        struct RangeEnd {  // records the entry's meshes however the loop body leaves
+            std::vector<std::pair<unsigned, unsigned>>& ranges;
+            const Scene& scene;
+            unsigned first;
+            ~RangeEnd() { ranges.push_back({first, unsigned(scene.meshes.size())}); }
+        } range_end{mesh_range, scene, first_mesh};
         const json& m = meshes[i];
         r.only(m, {"file", "positions", "triangles", "material"}, at);
         int override_material = -1;
@@ -307,6 +390,8 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
         }
         scene.meshes.push_back(std::move(mesh));
     }
+
+    if (root.contains("instances")) read_instances(r, root["instances"], mesh_range, scene);
 
     if (root.contains("lights")) {
         const json& lights = root["lights"];

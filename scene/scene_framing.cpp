@@ -9,16 +9,17 @@ namespace lucent::scene {
 
 Bounds scene_bounds(const Scene& scene) {
     Bounds b{make_float3(1e30f), make_float3(-1e30f)};
-    for (const Mesh& mesh : scene.meshes)
-        for (const float3& p : mesh.positions) {
-            b.lo = fminf(b.lo, p);
-            b.hi = fmaxf(b.hi, p);
+    for (const Instance& instance : drawn_instances(scene))
+        for (const float3& p : scene.meshes[instance.mesh].positions) {
+            const float3 w = transform_point(instance.transform, p);
+            b.lo = fminf(b.lo, w);
+            b.hi = fmaxf(b.hi, w);
         }
     return b;
 }
 
 Camera framing_camera(const Scene& scene) {
-    if (scene.triangle_count() == 0)
+    if (scene.drawn_triangle_count() == 0)
         throw Error("framing_camera: scene '" + scene.name + "' has no triangles to frame");
     const Bounds b = scene_bounds(scene);
     const float3 centre = 0.5f * (b.lo + b.hi);

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libgtest-dev libembree-dev libtinyobjloader-dev libstb-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libembree-dev libtinyobjloader-dev libtinygltf-dev libstb-dev libcli11-dev nlohmann-json3-dev
   libfftw3-dev libopenexr-dev clang libclang-rt-14-dev
   libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   xvfb xauth

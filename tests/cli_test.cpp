@@ -569,3 +569,32 @@ TEST(CliBenchPresent, BadFlagsNameTheFlag) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(CliTest, CameraOutOfRangeNamesTheCountAndWritesNothing) {
+    CliRun run = expect_render_usage_error("--sample direct --scene cornell --size 8x8 --camera 2");
+    EXPECT_NE(run.output.find("--camera 2: scene 'cornell' has 0 cameras of its own"),
+              std::string::npos)
+        << run.output;
+    run = expect_render_usage_error("--size 8x8 --camera 0");  // whitted: its own scene
+    EXPECT_NE(run.output.find("scene 'whitted' has 0 cameras of its own"), std::string::npos)
+        << run.output;
+}
+
+TEST_F(CliTest, MalformedGltfIsOneLineNamingTheJsonPathAndWritesNothing) {
+    const fs::path scene = fs::temp_directory_path() /
+                           ("lucent_cli_test_" + std::to_string(getpid()) + "_bad.gltf");
+    std::ofstream(scene) << R"({"asset": {"version": "2.0"}, "nodes": [{"mesh": 3}], "meshes": []})";
+    CliRun run = run_cli("render --sample direct --size 8x8 --scene '" + scene.string() +
+                         "' --out '" + path("out.png") + "'");
+    fs::remove(scene);
+    EXPECT_NE(run.exit_code, 0) << run.output;
+    EXPECT_TRUE(dir_is_empty()) << "a failed render left a file behind";
+    EXPECT_NE(run.output.find(scene.string() + ": nodes[0].mesh: mesh 3 is out of range (the "
+                                               "file has 0)"),
+              std::string::npos)
+        << run.output;
+}
+
+}  // namespace

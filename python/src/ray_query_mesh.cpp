@@ -42,9 +42,12 @@ MeshData load_mesh(const std::string& path) {
         return mesh;
     }
     const scene::Scene scene = scene::load_scene(path);
-    for (const scene::Mesh& m : scene.meshes) {
+    // Joined where the scene draws them: each instance's vertices in world space.
+    for (const scene::Instance& instance : scene::drawn_instances(scene)) {
+        const scene::Mesh& m = scene.meshes[instance.mesh];
         const unsigned base = unsigned(mesh.positions.size());
-        mesh.positions.insert(mesh.positions.end(), m.positions.begin(), m.positions.end());
+        for (const float3& p : m.positions)
+            mesh.positions.push_back(transform_point(instance.transform, p));
         for (uint3 tri : m.indices)
             mesh.indices.push_back(make_uint3(tri.x + base, tri.y + base, tri.z + base));
     }

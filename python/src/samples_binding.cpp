@@ -43,7 +43,7 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
                   std::pair<unsigned, unsigned> size, const std::string& backend,
                   unsigned threads, unsigned spp, int jit_check_sm, const py::object& eye,
                   const py::object& look, const py::object& up, std::optional<float> fov,
-                  bool denoise, unsigned denoise_passes,
+                  std::optional<unsigned> camera, bool denoise, unsigned denoise_passes,
                   const std::optional<std::vector<std::string>>& aovs,
                   const py::kwargs& options) {
     samples::RenderSettings settings;
@@ -63,6 +63,7 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
     settings.camera.look = camera_point(look, "look");
     settings.camera.up = camera_point(up, "up");
     settings.camera.fov_degrees = fov;  // checked with the rest of the camera by the sample
+    settings.scene_camera = camera;     // the scene file's camera N (--camera N)
     for (const auto& [key, value] : options)
         settings.sets[key.cast<std::string>()] = option_text(value);
     settings.denoise = denoise;
@@ -153,13 +154,15 @@ void bind_samples(py::module_& m) {
           py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
           py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
           py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
-          py::arg("fov") = py::none(), py::arg("denoise") = false,
-          py::arg("denoise_passes") = 0u, py::arg("aovs") = py::none(),
+          py::arg("fov") = py::none(), py::arg("camera") = py::none(),
+          py::arg("denoise") = false, py::arg("denoise_passes") = 0u,
+          py::arg("aovs") = py::none(),
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
           "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
           "and vertical fov in degrees over the scene's (--eye --look --up --fov; each "
-          "None: the scene's), and the sample's options as "
+          "None: the scene's), camera N of the scene file's own (a glTF file's cameras, "
+          "--camera N; None: its first), and the sample's options as "
           "keywords (vpls=64). denoise=True filters the image with the edge-avoiding "
           "à-trous denoiser (--denoise; denoise_passes as --denoise-passes). Returns the "
           "linear RGB image as an (H, W, 4) float32 array, row 0 at the top, alpha 1; with "

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import lucent
-from conftest import BACKEND
+from conftest import BACKEND, REPO
 
 
 def read_pfm(path):
@@ -98,3 +98,23 @@ def test_samples_lists_every_sample_with_its_options():
         for o in s["options"].values():
             if o["kind"] == "switch":
                 assert isinstance(o["default"], bool)
+
+
+def test_render_a_gltf_scene_by_path(tmp_path, cli):
+    """A .gltf path is a scene like any other: scripts/make_instanced_gltf.py writes 4
+    instanced spheres with a camera and a point light; the image is the CLI's, spheres lit,
+    and camera=N picks the file's camera N (out of range: an error naming the count)."""
+    path = tmp_path / "spheres.gltf"
+    subprocess.run(["/usr/bin/python3", str(REPO / "scripts" / "make_instanced_gltf.py"),
+                    "--instances", "4", "--rings", "8", "--segments", "16", "--out", str(path)],
+                   check=True, capture_output=True)
+    image = lucent.render("direct", scene=str(path), size=(32, 32), backend=BACKEND)
+    out = tmp_path / "g.pfm"
+    subprocess.run([cli, "render", "--sample", "direct", "--scene", str(path), "--size", "32x32",
+                    "--backend", BACKEND, "--camera", "0", "--out", str(out)], check=True,
+                   capture_output=True)
+    np.testing.assert_array_equal(image[..., :3], read_pfm(out))
+    red = image[..., 0] > 2 * image[..., 1] + 0.01  # the spheres are red, the ground grey
+    assert red.sum() > 20
+    with pytest.raises(Exception, match="--camera 1: scene 'spheres' has 1 camera of its own"):
+        lucent.render("direct", scene=str(path), size=(8, 8), backend=BACKEND, camera=1)

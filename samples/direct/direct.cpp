@@ -46,7 +46,7 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
     ctx["area_samples"] = unsigned(options.integer("area_samples"));
     ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
 
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     auto lambert = ctx.create_program(LUCENT_PROGRAM(direct::direct_lambert));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
@@ -64,7 +64,7 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
 
     DirectScene out{ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height),
                     input.camera,
-                    input.name + ", " + std::to_string(input.triangle_count()) + " triangles"};
+                    scene_note(input)};
     auto program = ctx.create_program(LUCENT_PROGRAM(direct::direct_camera));
     (*program)["camera"] = camera.buffer();
     (*program)["output"] = out.output;

@@ -23,6 +23,10 @@ FogOptions checked_options(const Sample& sample, const RenderSettings& settings)
         throw SettingsError("--scene " + settings.scene +
                             ": the fog sample renders its own scene (the OptiX SDK tutorial's); "
                             "leave --scene out");
+    if (settings.scene_camera)
+        throw SettingsError("--camera " + std::to_string(*settings.scene_camera) +
+                            ": the fog sample's scene has 0 cameras of its own (its camera "
+                            "orbits; --eye --look --up --fov replace it)");
     return read_fog_options(values);
 }
 

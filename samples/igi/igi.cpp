@@ -159,7 +159,7 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPasses* aovs) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -177,7 +177,7 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPass
         materials.push_back(material);
     }
     auto attributes = ctx.create_program(LUCENT_PROGRAM(sample_common::mesh_normal_uv));
-    auto boxes = ctx.create_geometry_group();
+    std::vector<std::shared_ptr<GeometryInstance>> box_instances;  // per mesh, as the scene's
     auto box_bounds = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_bounds));
     auto box_intersect = ctx.create_program(LUCENT_PROGRAM(igi::igi_triangle_box_intersect));
     auto box_material = ctx.create_material();  // occlusion queries run no hit programs
@@ -192,9 +192,12 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPass
         auto box_instance = ctx.create_geometry_instance();
         box_instance->set_geometry(box_geometry);
         box_instance->add_material(box_material);
-        boxes->add_child(box_instance);
+        box_instances.push_back(box_instance);
     };
     auto top = mesh_group(ctx, input, attributes, materials, add_boxes);
+    // The boxes are in object space like the triangles, placed by the same instances.
+    std::shared_ptr<Node> boxes = box_graph ? place_meshes(ctx, input, box_instances)
+                                            : std::shared_ptr<Node>(ctx.create_geometry_group());
     ctx["top_object"] = top;
     ctx["vpl_shadow_object"] = boxes;
     // Radiance and particle rays trace the scene; the boxes need none of their programs.
@@ -367,8 +370,7 @@ class IgiSample final : public Sample {
         camera.set(pinhole);
         out.camera = scene.input.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start),
-                              scene.input.name + ", " +
-                                  std::to_string(scene.input.triangle_count()) + " triangles, " +
+                              scene_note(scene.input) + ", " +
                                   std::to_string(scene.lights.size()) + " point emitters"});
         render_igi_frames(ctx, options.config, settings, out);
         out.image = image_from_output(*scene.images.output);

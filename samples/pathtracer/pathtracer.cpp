@@ -35,7 +35,7 @@ void add_light_geometry(scene::Scene& s, float tolerance) {
                           light.corner + light.edge1 + light.edge2, light.corner + light.edge2};
         mesh.indices = {uint3{0, 1, 2}, uint3{0, 2, 3}};
         mesh.materials.assign(2, unsigned(s.materials.size() - 1));
-        s.meshes.push_back(std::move(mesh));
+        scene::add_untransformed_mesh(s, std::move(mesh));
     }
 }
 
@@ -101,7 +101,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_dielectric)),
         ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_coated)),
     };
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
         auto material = ctx.create_material();
@@ -109,7 +109,11 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         material->set_closest_hit(pathtracer::kRadianceRay, closest_hits[int(m.kind)]);
         (*material)["Kd"] = m.diffuse;
         (*material)["diffuse_map"] = texture_for(m.diffuse_texture);
-        (*material)["Ks"] = m.specular;
+        // A metal's colour is `specular`; a glTF metal carries it as its base colour in
+        // `diffuse` (what the Phong samples read as Kd) and leaves `specular` black.
+        const bool metal_by_diffuse =
+            m.kind == scene::MaterialKind::kMetal && max_component(m.specular) <= 0.0f;
+        (*material)["Ks"] = metal_by_diffuse ? m.diffuse : m.specular;
         (*material)["Ke"] = m.emission;
         // Perceptual roughness squared (Burley 2012); a floor keeps GGX finite in float.
         (*material)["alpha"] = std::max(m.roughness * m.roughness, 1e-3f);
@@ -133,7 +137,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     (*out.camera_program)["output"] = out.output;
     set_variables(*out.camera_program, *out.miss, options);
     ctx.set_ray_generation_program(0, out.camera_program);
-    out.note = input.name + ", " + std::to_string(input.triangle_count()) + " triangles";
+    out.note = scene_note(input);
     return out;
 }
 

@@ -51,8 +51,9 @@ scene::Scene load_lit_scene(const RenderSettings& settings) {
     if (area_lights(input).empty())
         throw SettingsError("radiosity: scene '" + input.name +
                             "' has no area light nor emissive triangle; the photons leave area "
-                            "lights (try --scene cornell, give a material Ke in its MTL, or add "
-                            "{\"type\": \"area\", ...} to a JSON scene's lights)");
+                            "lights (try --scene cornell, give a material Ke in its MTL or an "
+                            "emissiveFactor in its glTF file, or add {\"type\": \"area\", "
+                            "...} to a JSON scene's lights)");
     return input;
 }
 
@@ -80,7 +81,7 @@ void set_up_context(Context& ctx, const scene::Scene& input, const Options& opti
 /// One material per scene material (the same surface program for radiance and photon
 /// rays), and the meshes under "top_object".
 void add_geometry(Context& ctx, const scene::Scene& input, AovPasses* aovs) {
-    DiffuseTextures texture_for(ctx);
+    DiffuseTextures texture_for(ctx, &input);
     auto surface = ctx.create_program(LUCENT_PROGRAM(radiosity::radiosity_surface));
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
@@ -305,8 +306,7 @@ class RadiositySample final : public Sample {
         camera.set(pinhole);
         out.camera = scene.input.camera;
         out.stages.push_back({"scene setup", ms_since(setup_start),
-                              scene.input.name + ", " +
-                                  std::to_string(scene.input.triangle_count()) + " triangles"});
+                              scene_note(scene.input)});
         render_passes(ctx, scene.input, options, settings, scene.passes, out);
         out.image = image_from_output(*scene.passes.output);
         aovs.finish(pinhole, out);

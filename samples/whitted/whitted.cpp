@@ -86,6 +86,10 @@ void check_scene(const RenderSettings& settings) {
         throw SettingsError("--scene " + settings.scene +
                             ": the whitted sample has one built-in scene; accepted names are "
                             "'whitted' (or no --scene)");
+    if (settings.scene_camera)
+        throw SettingsError("--camera " + std::to_string(*settings.scene_camera) +
+                            ": scene 'whitted' has 0 cameras of its own (use --eye --look "
+                            "--up --fov)");
     if (settings.width == 0 || settings.height == 0)
         throw SettingsError("whitted: image size " + std::to_string(settings.width) + "x" +
                             std::to_string(settings.height) + " is empty; give --size WxH");

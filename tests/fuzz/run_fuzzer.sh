@@ -11,7 +11,8 @@ mkdir -p "$build"
 exe="$build/${name}_fuzzer"
 scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$root/scene/obj_scene.cpp"
                "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp" "$root/scene/cornell_materials.cpp"
-               "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp" "$root/scene/input_file.cpp")
+               "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp" "$root/scene/input_file.cpp"
+               "$root/scene/gltf_scene.cpp" "$root/scene/texture_image.cpp" "$root/scene/exr_encoder.cpp")
 defines=()
 case $name in
   obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"
@@ -23,11 +24,13 @@ case $name in
               corpus_name=json ;;
   scene_ply) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".ply"')
              corpus_name=ply ;;
+  scene_gltf) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".gltf"')
+              corpus_name=gltf ;;  # .gltf: the loader tells GLB containers by their magic
   *) echo "unknown fuzz target $name" >&2; exit 2 ;;
 esac
-libs=(-ltinyobjloader)
+libs=(-ltinyobjloader -ltinygltf -lstb)  # tinygltf: Debian's shared build (not instrumented)
 if ! clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-     "${defines[@]}" -I "$root/include" -I "$root" "${sources[@]}" "${libs[@]}" -o "$exe" 2> "$build/${name}_build.log"; then
+     "${defines[@]}" -I "$root/include" -I "$root" -I /usr/include/stb "${sources[@]}" "${libs[@]}" -o "$exe" 2> "$build/${name}_build.log"; then
     if grep -q "libclang_rt.fuzzer\|fsanitize=fuzzer" "$build/${name}_build.log"; then
         echo "fuzz.$name: no libFuzzer runtime (libclang-rt-14-dev), skipped"; exit 77
     fi

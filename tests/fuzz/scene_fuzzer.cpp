@@ -1,4 +1,4 @@
-// libFuzzer target for the scene loaders (JSON and OBJ + MTL): any bytes must give a scene
+// libFuzzer target for the scene loaders (JSON, OBJ + MTL, PLY, glTF): any bytes must give a scene
 // or a lucent::Error, never a crash, a hang or undefined behaviour. The extension of the
 // temporary file picks the loader (LUCENT_FUZZ_EXTENSION, set by run_fuzzer.sh).
 #include <unistd.h>
@@ -30,6 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                     i.z >= mesh.positions.size() || mesh.materials[t] >= scene.materials.size())
                     __builtin_trap();  // a loaded scene must be consistent
             }
+        for (const auto& instance : scene.instances)
+            if (instance.mesh >= scene.meshes.size()) __builtin_trap();
     } catch (const lucent::Error&) {
     }
     return 0;
