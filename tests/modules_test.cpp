@@ -6,6 +6,7 @@
 
 #include "test_support.h"
 #include "tests/modules/undeclared_occlusion_programs.h"
+#include "tests/modules/undeclared_ray_flags_programs.h"
 #include "tests/modules/unembedded_programs.h"
 #include "tests/programs/occlusion_programs.h"
 #include "tests/programs/twin_a_programs.h"
@@ -297,6 +298,40 @@ TEST(Modules, OccludedWithoutItsDeclarationDoesNotCompileForTheGpu) {
     Context ctx(jit_check_options());
     ctx.add_module(ModuleSource::from_file(path));
     expect_error([&] { run_fill(ctx); }, {"kUsesOccluded"}, "occluded() not declared");
+}
+
+TEST(Modules, RayFlagsWithoutTheirDeclarationAreRefusedOnTheCpuToo) {
+    ContextOptions cpu_only;
+    cpu_only.backend = BackendKind::kCpu;
+    Context ctx(cpu_only);
+    ctx.set_entry_point_count(1);
+    ctx.set_ray_type<TestPayload>(0, "radiance");
+    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
+    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
+    (*probe)["out"] = out;
+    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
+    (*probe)["top"] = make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
+    ctx.set_ray_generation_program(0, probe);
+    expect_error([&] { ctx.launch(0, 1); }, {"ray flags", "kUsesRayFlags"},
+                 "ray flags from an undeclared module on the CPU");
+}
+
+TEST(Modules, RayFlagsWithoutTheirDeclarationDoNotCompileForTheGpu) {
+    if (!can_jit_check()) GTEST_SKIP() << "no CUDA backend or NVRTC here";
+    Context ctx(jit_check_options());
+    ctx.add_module(ModuleSource::from_file(std::string(LUCENT_TESTS_DIR) +
+                                           "/modules/undeclared_ray_flags_programs.h"));
+    ctx.set_entry_point_count(1);
+    ctx.set_ray_type<TestPayload>(0, "radiance");
+    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
+    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
+    (*probe)["out"] = out;
+    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
+    (*probe)["top"] = make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
+    ctx.set_ray_generation_program(0, probe);
+    expect_error([&] { ctx.launch(0, 1); }, {"kUsesRayFlags"}, "ray flags not declared");
 }
 
 }  // namespace

@@ -9,7 +9,7 @@ from conftest import BACKEND
 MODULE = """
 #include "lucent/device.h"
 namespace py_ray_control {
-LUCENT_MODULE(py_ray_control)
+LUCENT_MODULE(py_ray_control, lucent::kUsesRayFlags)
 using namespace lucent;
 
 struct Payload { float depth; unsigned id; };

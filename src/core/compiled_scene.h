@@ -141,6 +141,19 @@ struct CompiledScene {
     /// Some bound program's module declares kUsesOccluded: occluded() may be called (the
     /// GPU's megakernel has its occlusion path only then, and the CPU refuses it otherwise).
     bool uses_occluded = false;
+    /// Some bound program's module declares kUsesRayFlags: trace() and occluded() may get
+    /// ray flags and visibility masks.
+    bool uses_ray_flags = false;
+    /// Per-ray control is needed: modules pass ray flags, or some node or instance has a
+    /// visibility mask, an instance id or opaque geometry (the GPU's LUCENT_GPU_RAY_CONTROL).
+    bool needs_ray_control() const {
+        if (uses_ray_flags) return true;
+        for (const CompiledNode& n : nodes)
+            if (n.visibility_mask != kVisibilityMaskAll || n.instance_id != 0) return true;
+        for (const CompiledInstance& i : instances)
+            if (i.visibility_mask != kVisibilityMaskAll || i.user_id != 0 || i.opaque) return true;
+        return false;
+    }
     /// Module texts given to the Context at run time (the GPU backend's JIT reads them
     /// before the texts embedded in the binary).
     std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>> module_sources;

@@ -86,6 +86,7 @@ CompiledProgram SceneCompiler::pack(const std::shared_ptr<Program>& program,
     // occluded() is there only when a module declares it: the same rule on both backends.
     const ModuleInfo* module = out.desc->module;
     m_scene->uses_occluded = m_scene->uses_occluded || (module && module->uses(kUsesOccluded));
+    m_scene->uses_ray_flags = m_scene->uses_ray_flags || (module && module->uses(kUsesRayFlags));
     out.label = program->describe() + (owner.empty() ? "" : " of " + owner);
     out.record = std::make_shared<PackedRecord>();
     out.record->resize(info.size);

@@ -25,6 +25,7 @@ struct CpuPolicy {
     using PayloadTag = const void*;  // the payload type's detail::TypeTag
     static constexpr bool kTransforms = true;
     static constexpr bool kOcclusion = true;
+    static constexpr bool kRayControl = true;
     static constexpr unsigned kAttributeBytes = kMaxAttributeBytes;
 
     ThreadState* ts;
@@ -138,6 +139,9 @@ inline const core::CompiledScene& CpuPolicy::scene() const {
 /// The calling thread's state (set by the launch loop).
 ThreadState& thread_state();
 void set_thread_state(ThreadState* state);
+/// Throws the error a program gets for passing ray flags or a mask from a module that does
+/// not declare kUsesRayFlags (the GPU's megakernel would not compile the call).
+void require_ray_flags_declared();
 
 /// occluded() of the device API.
 bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test, unsigned ray_flags,

@@ -6,6 +6,7 @@
 
 #include "cpu/cpu_state.h"
 #include "lucent/device/api.h"
+#include "lucent/error.h"
 
 namespace lucent {
 
@@ -24,6 +25,14 @@ ThreadState& thread_state() {
 void set_thread_state(ThreadState* state) {
     t_state = state;
 }
+void require_ray_flags_declared() {
+    // The GPU's megakernel would not compile such a call either (lucent/device/api.h).
+    if (!thread_state().scene || !thread_state().scene->uses_ray_flags)
+        throw Error(
+            "trace() or occluded() is given ray flags or a visibility mask, but no module of "
+            "this scene declares it; declare it in the module that calls it: "
+            "LUCENT_MODULE(name, lucent::kUsesRayFlags)");
+}
 }  // namespace cpu
 
 namespace detail {
@@ -35,6 +44,7 @@ namespace detail {
                                    const void* payload_tag, unsigned ray_flags,
                                    unsigned visibility_mask) {
     const Ray ray{origin, tmin, direction, tmax, ray_type};
+    if ((ray_flags | (visibility_mask ^ kVisibilityMaskAll)) != 0) cpu::require_ray_flags_declared();
     runtime::trace(runtime::backend(), root, ray, payload, payload_tag, ray_flags,
                    visibility_mask);
 }
@@ -43,6 +53,7 @@ bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, f
                      unsigned ray_type, unsigned occlusion, unsigned ray_flags,
                      unsigned visibility_mask) {
     const Ray ray{origin, tmin, direction, tmax, ray_type};
+    if ((ray_flags | (visibility_mask ^ kVisibilityMaskAll)) != 0) cpu::require_ray_flags_declared();
     return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion), ray_flags,
                          visibility_mask);
 }

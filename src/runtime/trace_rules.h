@@ -179,13 +179,13 @@ LUCENT_RUNTIME_INLINE SavedTransform enter_transform(Frame& f, const Matrix4x3& 
     f.to_world = saved.transformed ? compose(saved.to_world, to_world) : to_world;
     f.to_object = saved.transformed ? compose(to_object, saved.to_object) : to_object;
     f.transformed = true;
-    f.instance_id = instance_id;
+    if constexpr (Frame::kRayControl) f.instance_id = instance_id;
     return saved;
 }
 template <class Frame>
 LUCENT_RUNTIME_INLINE void leave_transform(Frame& f, const SavedTransform& saved) {
     f.transformed = saved.transformed;
-    f.instance_id = saved.instance_id;
+    if constexpr (Frame::kRayControl) f.instance_id = saved.instance_id;
     f.to_world = saved.to_world;
     f.to_object = saved.to_object;
 }
@@ -195,6 +195,11 @@ LUCENT_RUNTIME_INLINE void leave_transform(Frame& f, const SavedTransform& saved
 /// Does a node or instance with visibility mask `mask` take part in this trace?
 template <class Frame>
 LUCENT_HD inline bool visible(const Frame& f, unsigned mask) {
+    if constexpr (!Frame::kRayControl) {  // every mask is 0xff
+        (void)f;
+        (void)mask;
+        return true;
+    }
     return (mask & f.ray_mask) != 0;
 }
 
@@ -203,6 +208,7 @@ LUCENT_HD inline bool visible(const Frame& f, unsigned mask) {
 template <class P>
 LUCENT_HD inline bool opaque_for_ray(const P& p, const FrameOf<P>& f,
                                      const typename P::Instance& inst) {
+    if constexpr (!P::kRayControl) return false;  // no geometry is opaque
     if (f.ray_flags & kRayFlagDisableAnyHit) return true;
     if (f.ray_flags & kRayFlagEnforceAnyHit) return false;
     return p.opaque(inst);
@@ -349,7 +355,7 @@ LUCENT_HD inline void commit(FrameOf<P>& f, unsigned instance, unsigned prim, fl
     f.hit_pending = false;
     if constexpr (P::kTransforms) {
         f.hit_transformed = f.transformed;
-        f.hit_instance_id = f.instance_id;
+        if constexpr (P::kRayControl) f.hit_instance_id = f.instance_id;
         if (f.transformed) {
             f.hit_to_world = f.to_world;
             f.hit_to_object = f.to_object;
@@ -518,13 +524,18 @@ LUCENT_RUNTIME_INLINE void begin_frame(FrameOf<P>& f, const Ray& ray, void* payl
     if constexpr (P::kTransforms) {
         f.object_ray = ray;
         f.transformed = false;
-        f.instance_id = 0;
     }
     f.payload = payload;
     f.ray_type = ray.ray_type;
-    f.ray_flags = ray_flags;
-    f.ray_mask = ray_mask;
-    f.masked_instances = false;
+    if constexpr (P::kRayControl) {
+        f.ray_flags = ray_flags;
+        f.ray_mask = ray_mask;
+        f.masked_instances = false;
+        if constexpr (P::kTransforms) f.instance_id = 0;
+    } else {  // ray_allowed refused anything else
+        (void)ray_flags;
+        (void)ray_mask;
+    }
     f.closest = ray.tmax;
     f.has_hit = false;
     f.terminated = false;

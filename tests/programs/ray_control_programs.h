@@ -7,7 +7,7 @@
 
 namespace lucent_tests {
 inline namespace ray_control_module {
-LUCENT_MODULE(test_ray_control, lucent::kUsesOccluded)
+LUCENT_MODULE(test_ray_control, lucent::kUsesOccluded, lucent::kUsesRayFlags)
 
 struct ControlRay {
     float3 origin, direction;

@@ -110,6 +110,25 @@ LUCENT_HD unsigned primitive_index();
 /// shares a bit with `visibility_mask` (0 visits nothing). Contradicting flags (two of
 /// kRayFlagsAnyHitChoice, both facing culls) or a mask above 0xff raise
 /// kExceptionInvalidRayFlags.
+/// A module that passes them declares so: LUCENT_MODULE(name, lucent::kUsesRayFlags).
+#if defined(__CUDACC_RTC__) && defined(LUCENT_GPU_RAY_CONTROL) && !LUCENT_GPU_RAY_CONTROL
+// No module of this megakernel declares kUsesRayFlags and the scene has no masks, ids or
+// opaque geometry: the megakernel has no per-ray control, and a call with flags is a
+// compile error that says what to declare.
+template <class Payload>
+__device__ void trace(Handle, const Ray&, Payload&, unsigned, unsigned = kVisibilityMaskAll) {
+    static_assert(detail::dependent_false<Payload>,
+                  "trace() with ray flags or a visibility mask is called by a module that "
+                  "does not declare it: write LUCENT_MODULE(name, lucent::kUsesRayFlags)");
+}
+/// trace() with no ray flags, visiting everything.
+template <class Payload>
+LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
+    detail::trace_erased(root, ray, &payload,
+                         reinterpret_cast<const void*>(sizeof(Payload) << 8 | alignof(Payload)),
+                         kRayFlagNone, kVisibilityMaskAll);
+}
+#else
 template <class Payload>
 LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload, unsigned ray_flags,
                      unsigned visibility_mask = kVisibilityMaskAll) {
@@ -128,6 +147,7 @@ template <class Payload>
 LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload) {
     trace(root, ray, payload, kRayFlagNone, kVisibilityMaskAll);
 }
+#endif
 
 /// What occluded() counts as blocking a ray.
 enum class Occlusion : unsigned {
@@ -169,6 +189,19 @@ __device__ bool occluded(Handle, const Ray&, Occlusion = Occlusion::kExact,
     static_assert(detail::dependent_false<Undeclared>,
                   "occluded() is called by a module that does not declare it: write "
                   "LUCENT_MODULE(name, lucent::kUsesOccluded)");
+    return false;
+}
+#elif defined(__CUDACC_RTC__) && defined(LUCENT_GPU_RAY_CONTROL) && !LUCENT_GPU_RAY_CONTROL
+// No per-ray control in this megakernel (see trace()): occluded() takes no flags.
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray,
+                                         Occlusion test = Occlusion::kExact);
+template <class Undeclared = void>
+__device__ bool occluded(Handle, const Ray&, Occlusion, unsigned,
+                         unsigned = kVisibilityMaskAll) {
+    static_assert(detail::dependent_false<Undeclared>,
+                  "occluded() with ray flags or a visibility mask is called by a module that "
+                  "does not declare it: write LUCENT_MODULE(name, lucent::kUsesOccluded, "
+                  "lucent::kUsesRayFlags)");
     return false;
 }
 #elif defined(__CUDACC_RTC__)

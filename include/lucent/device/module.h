@@ -25,6 +25,12 @@ enum ModuleUses : unsigned {
     /// A program calls occluded(): the GPU traversal keeps its any-hit early exit. A module
     /// that calls occluded() without declaring it does not compile for the GPU.
     kUsesOccluded = 1u << 0,
+    /// A program passes ray flags or a visibility mask to trace() or occluded() (their
+    /// fourth and fifth arguments): the GPU megakernel keeps the per-ray control code, which
+    /// it otherwise compiles out unless the scene has masks, ids or opaque geometry (OptiX
+    /// paper §4.3). A module that passes them without declaring it does not compile for the
+    /// GPU, and the CPU refuses the launch.
+    kUsesRayFlags = 1u << 1,
 };
 
 namespace detail {

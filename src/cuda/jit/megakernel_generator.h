@@ -38,6 +38,7 @@ struct KernelShape {
     bool exceptions = false;        // any exception enabled (else bounds checks are compiled out)
     bool print = false;
     bool occlusion = false;  // some bound module declares kUsesOccluded
+    bool ray_control = false;  // ray flags, masks, ids or opaque geometry (needs_ray_control)
     unsigned max_depth = 1;
     unsigned attribute_bytes = 16;
 };

@@ -28,6 +28,9 @@
 #ifndef LUCENT_GPU_OCCLUSION
 #define LUCENT_GPU_OCCLUSION 1  // some program calls occluded(): traversal checks for it
 #endif
+#ifndef LUCENT_GPU_RAY_CONTROL
+#define LUCENT_GPU_RAY_CONTROL 1  // ray flags, visibility masks, instance ids, opaque geometry
+#endif
 #ifndef LUCENT_GPU_MIN_BLOCKS
 #define LUCENT_GPU_MIN_BLOCKS 1  // __launch_bounds__ hint: blocks per SM to fit in registers
 #endif
@@ -74,6 +77,7 @@ struct GpuPolicy {
     using PayloadTag = unsigned;  // sizeof(payload) << 8 | alignof(payload)
     static constexpr bool kTransforms = LUCENT_GPU_TRANSFORMS;
     static constexpr bool kOcclusion = LUCENT_GPU_OCCLUSION;
+    static constexpr bool kRayControl = LUCENT_GPU_RAY_CONTROL;
     static constexpr unsigned kAttributeBytes = LUCENT_GPU_ATTRIBUTE_BYTES;
 
     __device__ __forceinline__ ThreadState& thread() const;

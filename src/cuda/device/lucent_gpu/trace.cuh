@@ -52,6 +52,9 @@ __device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origi
 /// Must a trace see each triangle of this group (any-hit programs to run, instances masked,
 /// culls or kRayFlagTerminateOnFirstHit), or does the closest one answer it?
 __device__ __forceinline__ bool trace_needs_candidates(const Frame& f, const GpuGeometryAccel& ga) {
+#if !LUCENT_GPU_RAY_CONTROL
+    return (ga.any_hit_mask >> f.ray_type) & 1u;
+#endif
     const unsigned flags = f.ray_flags;
     if ((flags & runtime::kRayFlagsPerCandidate) || ga.instances_masked) return true;
     if (flags & kRayFlagDisableAnyHit) return false;
@@ -62,7 +65,9 @@ __device__ __forceinline__ bool trace_needs_candidates(const Frame& f, const Gpu
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
                                                float3 direction) {
     runtime::enter_space<GpuPolicy>(f, origin, direction);
+#if LUCENT_GPU_RAY_CONTROL
     f.masked_instances = ga.instances_masked;
+#endif
     const float tmin = f.world_ray.tmin;
     (void)tmin;  // unused when the scene has only one kind of group
 #if LUCENT_GPU_TRIANGLE_GROUPS
@@ -70,7 +75,8 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
 #if LUCENT_GPU_OCCLUSION
         // A facing cull or masked instances need each triangle: the exact filtered path
         // below (a leaf box mixes instances and loads no triangle).
-        if (f.occlusion && !(f.ray_flags & kRayFlagsFacingCull) && !ga.instances_masked) {
+        if (f.occlusion && !(f.ray_flags & kRayFlagsFacingCull) &&
+            !(LUCENT_GPU_RAY_CONTROL && ga.instances_masked)) {
             const bool blocked =
                 f.leaf_boxes
                     ? gpu_bvh_occluded_leaf_boxes(ga.triangles, origin, direction, tmin, f.closest)
@@ -238,11 +244,20 @@ __device__ __forceinline__ void GpuPolicy::traverse(Frame& f, Handle root, const
 }
 
 /// trace(): its frame lives on this function's stack.
+#if LUCENT_GPU_RAY_CONTROL
 __device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
                                        unsigned payload_signature, unsigned ray_flags,
                                        unsigned ray_mask) {
     runtime::trace(GpuPolicy{}, root, ray, payload, payload_signature, ray_flags, ray_mask);
 }
+#else
+// Without per-ray control the flags are constants (api.h refuses others at compile time).
+__device__ __noinline__ void trace_ray(Handle root, const Ray& ray, void* payload,
+                                       unsigned payload_signature) {
+    runtime::trace(GpuPolicy{}, root, ray, payload, payload_signature, kRayFlagNone,
+                   kVisibilityMaskAll);
+}
+#endif
 
 #if LUCENT_GPU_OCCLUSION
 /// occluded() of the device API for the roots its inline fast path leaves (see occluded()
@@ -275,14 +290,21 @@ namespace lucent {
 namespace detail {
 LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* signature,
                            unsigned ray_flags, unsigned visibility_mask) {
+#if LUCENT_GPU_RAY_CONTROL
     gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)),
                    ray_flags, visibility_mask);
+#else
+    (void)ray_flags;
+    (void)visibility_mask;
+    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)));
+#endif
 }
 }  // namespace detail
 
 #if LUCENT_GPU_OCCLUSION
-__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test,
-                                         unsigned ray_flags, unsigned visibility_mask) {
+namespace gpu {
+__device__ __forceinline__ bool occluded_query(Handle root, const Ray& ray, Occlusion test,
+                                               unsigned ray_flags, unsigned visibility_mask) {
     const bool leaf_boxes = test == Occlusion::kLeafBoxes;
 #if LUCENT_GPU_TRIANGLE_GROUPS
     // The common shadow root, a GeometryGroup of triangles: the BVH's any-hit traversal right
@@ -294,9 +316,10 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion 
         !(ray_flags & ~implied) && visibility_mask == kVisibilityMaskAll &&
         !gpu::self().exception_code) {
         const gpu::GpuNode& node = gpu::params.nodes[root.index];
-        if (node.kind == gpu::kGpuGeometryGroup && node.visibility_mask == kVisibilityMaskAll &&
-            gpu::params.accels[node.accel].triangles_only &&
-            !gpu::params.accels[node.accel].instances_masked) {
+        if (node.kind == gpu::kGpuGeometryGroup &&
+            (!LUCENT_GPU_RAY_CONTROL || (node.visibility_mask == kVisibilityMaskAll &&
+                                         !gpu::params.accels[node.accel].instances_masked)) &&
+            gpu::params.accels[node.accel].triangles_only) {
             const gpu::GpuTriangleBvhView& bvh = gpu::params.accels[node.accel].triangles;
             return leaf_boxes ? gpu::gpu_bvh_occluded_leaf_boxes(bvh, ray.origin, ray.direction,
                                                                  ray.tmin, ray.tmax)
@@ -307,6 +330,18 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion 
 #endif
     return gpu::occluded_ray(root, ray, leaf_boxes, ray_flags, visibility_mask);
 }
+}  // namespace gpu
+
+#if LUCENT_GPU_RAY_CONTROL
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test,
+                                         unsigned ray_flags, unsigned visibility_mask) {
+    return gpu::occluded_query(root, ray, test, ray_flags, visibility_mask);
+}
+#else
+__device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion test) {
+    return gpu::occluded_query(root, ray, test, kRayFlagNone, kVisibilityMaskAll);
+}
+#endif
 #endif
 
 }  // namespace lucent
