@@ -264,26 +264,42 @@ TEST(Modules, NvrtcErrorsNameTheModulesFileAndLine) {
                  "an NVRTC error");
 }
 
-TEST(Modules, OccludedWithoutItsDeclarationIsRefusedOnTheCpuToo) {
-    ContextOptions cpu_only;
-    cpu_only.backend = BackendKind::kCpu;
-    Context ctx(cpu_only);
+ContextOptions cpu_only_options() {
+    ContextOptions options;
+    options.backend = BackendKind::kCpu;
+    return options;
+}
+
+/// A one-index launch of `probe` (a ray generation with `top` and `out`) over a square at
+/// z = 5: the scene of the tests of undeclared device-API features.
+struct ProbeScene {
+    std::shared_ptr<Material> material;
+    std::shared_ptr<Buffer> out;
+};
+ProbeScene set_up_probe(Context& ctx, const ProgramDesc& probe_desc) {
     ctx.set_entry_point_count(1);
     ctx.set_ray_type<TestPayload>(0, "radiance");
-    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_occlusion::shadow_probe));
-    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
-    (*probe)["out"] = out;
-    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
+    auto probe = ctx.create_program(probe_desc);
+    ProbeScene scene;
+    scene.out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
+    (*probe)["out"] = scene.out;
+    scene.material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
     (*probe)["top"] = make_geometry_group(
-        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
+        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), scene.material)});
     ctx.set_ray_generation_program(0, probe);
+    return scene;
+}
+
+TEST(Modules, OccludedWithoutItsDeclarationIsRefusedOnTheCpuToo) {
+    Context ctx(cpu_only_options());
+    const ProbeScene probe = set_up_probe(ctx, LUCENT_PROGRAM(undeclared_occlusion::shadow_probe));
     expect_error([&] { ctx.launch(0, 1); }, {"occluded()", "kUsesOccluded"},
                  "occluded() from an undeclared module on the CPU");
     // Once a bound module declares it (the megakernel-wide rule the GPU follows), the call
     // runs: the square blocks the probe.
-    material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
+    probe.material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
     ctx.launch(0, 1);
-    EXPECT_EQ(read_buffer<unsigned>(*out)[0], 1u);
+    EXPECT_EQ(read_buffer<unsigned>(*probe.out)[0], 1u);
 }
 
 TEST(Modules, OccludedWithoutItsDeclarationDoesNotCompileForTheGpu) {
@@ -301,18 +317,8 @@ TEST(Modules, OccludedWithoutItsDeclarationDoesNotCompileForTheGpu) {
 }
 
 TEST(Modules, RayFlagsWithoutTheirDeclarationAreRefusedOnTheCpuToo) {
-    ContextOptions cpu_only;
-    cpu_only.backend = BackendKind::kCpu;
-    Context ctx(cpu_only);
-    ctx.set_entry_point_count(1);
-    ctx.set_ray_type<TestPayload>(0, "radiance");
-    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
-    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
-    (*probe)["out"] = out;
-    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
-    (*probe)["top"] = make_geometry_group(
-        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
-    ctx.set_ray_generation_program(0, probe);
+    Context ctx(cpu_only_options());
+    set_up_probe(ctx, LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
     expect_error([&] { ctx.launch(0, 1); }, {"ray flags", "kUsesRayFlags"},
                  "ray flags from an undeclared module on the CPU");
 }
@@ -322,15 +328,7 @@ TEST(Modules, RayFlagsWithoutTheirDeclarationDoNotCompileForTheGpu) {
     Context ctx(jit_check_options());
     ctx.add_module(ModuleSource::from_file(std::string(LUCENT_TESTS_DIR) +
                                            "/modules/undeclared_ray_flags_programs.h"));
-    ctx.set_entry_point_count(1);
-    ctx.set_ray_type<TestPayload>(0, "radiance");
-    auto probe = ctx.create_program(LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
-    auto out = ctx.create_buffer<unsigned>(BufferType::kOutput, 1);
-    (*probe)["out"] = out;
-    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
-    (*probe)["top"] = make_geometry_group(
-        ctx, {make_instance(ctx, make_triangles(ctx, square_at(5)), material)});
-    ctx.set_ray_generation_program(0, probe);
+    set_up_probe(ctx, LUCENT_PROGRAM(undeclared_ray_flags::culling_probe));
     expect_error([&] { ctx.launch(0, 1); }, {"kUsesRayFlags"}, "ray flags not declared");
 }
 

@@ -52,14 +52,15 @@ __device__ __noinline__ void traverse_node(Frame& f, unsigned node, float3 origi
 /// Must a trace see each triangle of this group (any-hit programs to run, instances masked,
 /// culls or kRayFlagTerminateOnFirstHit), or does the closest one answer it?
 __device__ __forceinline__ bool trace_needs_candidates(const Frame& f, const GpuGeometryAccel& ga) {
-#if !LUCENT_GPU_RAY_CONTROL
-    return (ga.any_hit_mask >> f.ray_type) & 1u;
-#endif
+#if LUCENT_GPU_RAY_CONTROL
     const unsigned flags = f.ray_flags;
     if ((flags & runtime::kRayFlagsPerCandidate) || ga.instances_masked) return true;
     if (flags & kRayFlagDisableAnyHit) return false;
     const unsigned mask = flags & kRayFlagEnforceAnyHit ? ga.any_hit_enforced_mask : ga.any_hit_mask;
     return (mask >> f.ray_type) & 1u;
+#else
+    return (ga.any_hit_mask >> f.ray_type) & 1u;
+#endif
 }
 
 __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel& ga, float3 origin,
