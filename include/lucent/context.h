@@ -208,6 +208,7 @@ class Context : public VariableScope {
     std::shared_ptr<GeometryInstance> create_geometry_instance();
     std::shared_ptr<Geometry> create_geometry();
     std::shared_ptr<GeometryTriangles> create_geometry_triangles();
+    std::shared_ptr<GeometrySpheres> create_geometry_spheres();
     std::shared_ptr<Material> create_material();
 
     // ---- compile and launch ---------------------------------------------------

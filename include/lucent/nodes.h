@@ -1,5 +1,6 @@
 // The scene graph (OptiX paper §3.2): Group, GeometryGroup, Transform, Selector, and the
-// leaves GeometryInstance, Geometry, GeometryTriangles and Material; plus Acceleration.
+// leaves GeometryInstance, Geometry, GeometryTriangles, GeometrySpheres and Material; plus
+// Acceleration.
 // Nodes may have several parents (instancing); any node may be the root of a trace.
 #pragma once
 
@@ -135,11 +136,18 @@ class Transform : public Node {
 
 class Material;
 
-/// Common base of Geometry (custom primitives) and GeometryTriangles (built in).
+/// What a geometry's primitives are: programs of the user's (Geometry), or built into
+/// the engine's traversal with their own intersection code (OptiX's OptixPrimitiveType).
+enum class PrimitiveType { kCustom, kTriangles, kSpheres };
+const char* primitive_type_name(PrimitiveType type);
+
+/// Common base of Geometry (custom primitives) and the built-in GeometryTriangles and
+/// GeometrySpheres.
 class GeometryBase : public ContextObject, public VariableScope {
   public:
     using ContextObject::ContextObject;
-    virtual bool is_triangles() const = 0;
+    virtual PrimitiveType primitive_type() const = 0;
+    bool is_triangles() const { return primitive_type() == PrimitiveType::kTriangles; }
     virtual unsigned primitive_count() const = 0;
     std::string scope_name() const override { return describe(); }
     /// GeometryFlags, or'ed (default kGeometryFlagNone); kGeometryFlagDisableAnyHit makes the
@@ -160,7 +168,7 @@ class Geometry : public GeometryBase {
   public:
     using GeometryBase::GeometryBase;
     std::string describe() const override;
-    bool is_triangles() const override { return false; }
+    PrimitiveType primitive_type() const override { return PrimitiveType::kCustom; }
     void set_primitive_count(unsigned count);
     unsigned primitive_count() const override { return m_count; }
     void set_bounding_box_program(std::shared_ptr<Program> program);
@@ -179,7 +187,7 @@ class GeometryTriangles : public GeometryBase {
   public:
     using GeometryBase::GeometryBase;
     std::string describe() const override;
-    bool is_triangles() const override { return true; }
+    PrimitiveType primitive_type() const override { return PrimitiveType::kTriangles; }
     void set_vertices(std::shared_ptr<Buffer> vertices);
     void set_indices(std::shared_ptr<Buffer> indices);
     void set_material_indices(std::shared_ptr<Buffer> material_indices);
@@ -193,6 +201,28 @@ class GeometryTriangles : public GeometryBase {
   private:
     std::shared_ptr<Buffer> m_vertices, m_indices, m_material_indices;
     std::shared_ptr<Program> m_attributes;
+};
+
+/// Built-in spheres (OptiX's OPTIX_PRIMITIVE_TYPE_SPHERE): a float3 centre buffer, a float
+/// radius buffer with one radius per sphere or one for all, and an optional unsigned
+/// per-sphere material index buffer. Hit programs read BuiltinSphereAttributes (the
+/// object-space normal); a ray reports both of a sphere's intersections, so one starting inside hits
+/// its far side. Bounds come from the centres and radii: no programs to write.
+class GeometrySpheres : public GeometryBase {
+  public:
+    using GeometryBase::GeometryBase;
+    std::string describe() const override;
+    PrimitiveType primitive_type() const override { return PrimitiveType::kSpheres; }
+    void set_centers(std::shared_ptr<Buffer> centers);
+    void set_radii(std::shared_ptr<Buffer> radii);
+    void set_material_indices(std::shared_ptr<Buffer> material_indices);
+    const std::shared_ptr<Buffer>& centers() const { return m_centers; }
+    const std::shared_ptr<Buffer>& radii() const { return m_radii; }
+    const std::shared_ptr<Buffer>& material_indices() const { return m_material_indices; }
+    unsigned primitive_count() const override;
+
+  private:
+    std::shared_ptr<Buffer> m_centers, m_radii, m_material_indices;
 };
 
 /// Closest-hit and any-hit programs per ray type.

@@ -34,6 +34,7 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     GeometryBase,
     GeometryGroup,
     GeometryInstance,
+    GeometrySpheres,
     GeometryTriangles,
     Group,
     LaunchReport,

@@ -164,6 +164,16 @@ void bind_nodes(py::module_& m) {
         .def_property("attribute_program", &GeometryTriangles::attribute_program,
                       &GeometryTriangles::set_attribute_program);
 
+    py::class_<GeometrySpheres, GeometryBase, std::shared_ptr<GeometrySpheres>>(
+        m, "GeometrySpheres",
+        "Built-in spheres: a float3 centre Buffer, a float radius Buffer (one per sphere or one "
+        "for all) and an optional uint per-sphere material index Buffer. Hit programs read "
+        "BuiltinSphereAttributes (object-space normal, entering).")
+        .def_property("centers", &GeometrySpheres::centers, &GeometrySpheres::set_centers)
+        .def_property("radii", &GeometrySpheres::radii, &GeometrySpheres::set_radii)
+        .def_property("material_indices", &GeometrySpheres::material_indices,
+                      &GeometrySpheres::set_material_indices);
+
     py::class_<Material, std::shared_ptr<Material>> material(
         m, "Material", "Closest-hit and any-hit programs per ray type.");
     material.def("set_closest_hit", &Material::set_closest_hit, py::arg("ray_type"),

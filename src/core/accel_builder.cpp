@@ -51,6 +51,9 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
         grow(box, inst.vertices[t.x]);
         grow(box, inst.vertices[t.y]);
         grow(box, inst.vertices[t.z]);
+    } else if (inst.type == PrimitiveType::kSpheres) {
+        const float3 c = inst.centers[prim], r = make_float3(inst.radius(prim));
+        box = Aabb{c - r, c + r};
     } else {
         try {
             inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
@@ -81,13 +84,20 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     bool triangles_only = !node.instances.empty();
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = m_scene->instances[i];
-        structure.add(inst.source).add(inst.triangles).add(inst.primitive_count);
+        structure.add(inst.source).add(inst.type).add(inst.primitive_count);
         if (const GeometryTriangles* tris = triangles_of(inst)) {
             structure.add(tris->indices().get())
                 .add(tris->indices() ? tris->indices()->version() : 0);
             content.add(tris->vertices().get()).add(tris->vertices()->version());
             m_rebuild_inputs.push_back(tris->vertices().get());
             if (tris->indices()) m_rebuild_inputs.push_back(tris->indices().get());
+        } else if (inst.type == PrimitiveType::kSpheres) {
+            triangles_only = false;
+            auto& spheres = static_cast<const GeometrySpheres&>(*inst.source->geometry());
+            for (const Buffer* b : {spheres.centers().get(), spheres.radii().get()}) {
+                content.add(b).add(b->version());
+                m_rebuild_inputs.push_back(b);
+            }
         } else {
             triangles_only = false;
             content.add_bytes(inst.bounding_box.rec(), inst.bounding_box.desc->record->size);

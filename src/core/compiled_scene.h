@@ -56,7 +56,8 @@ struct CompiledMaterial {
 /// A GeometryInstance with its records resolved (GeometryInstance scope included).
 struct CompiledInstance {
     const GeometryInstance* source = nullptr;
-    bool triangles = false;
+    PrimitiveType type = PrimitiveType::kCustom;
+    bool triangles = false;  // type == kTriangles
     unsigned primitive_count = 0;
     CompiledProgram intersection, bounding_box, attribute;
     std::vector<CompiledMaterial> materials;
@@ -67,7 +68,12 @@ struct CompiledInstance {
     // Built-in triangles (host pointers into the Buffers).
     const float3* vertices = nullptr;
     const uint3* indices = nullptr;  // null: triangle i is vertices 3i..3i+2
-    const unsigned* material_indices = nullptr;
+    const unsigned* material_indices = nullptr;  // triangles and spheres
+    // Built-in spheres.
+    const float3* centers = nullptr;
+    const float* radii = nullptr;
+    bool single_radius = false;  // radii[0] for every sphere
+    float radius(unsigned prim) const { return radii[single_radius ? 0 : prim]; }
 };
 
 /// Acceleration data of a GeometryGroup, kept across compiles while unchanged.

@@ -360,6 +360,9 @@ std::shared_ptr<Geometry> Context::create_geometry() {
 std::shared_ptr<GeometryTriangles> Context::create_geometry_triangles() {
     return std::make_shared<GeometryTriangles>(m_impl->shared, m_impl->next_name("triangles"));
 }
+std::shared_ptr<GeometrySpheres> Context::create_geometry_spheres() {
+    return std::make_shared<GeometrySpheres>(m_impl->shared, m_impl->next_name("spheres"));
+}
 std::shared_ptr<Material> Context::create_material() {
     return std::make_shared<Material>(m_impl->shared, m_impl->next_name("material"));
 }

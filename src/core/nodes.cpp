@@ -221,6 +221,49 @@ unsigned GeometryTriangles::primitive_count() const {
     return m_vertices ? unsigned(m_vertices->count() / 3) : 0;
 }
 
+const char* primitive_type_name(PrimitiveType type) {
+    switch (type) {
+        case PrimitiveType::kCustom:
+            return "custom";
+        case PrimitiveType::kTriangles:
+            return "triangles";
+        case PrimitiveType::kSpheres:
+            return "spheres";
+    }
+    return "?";
+}
+
+std::string GeometrySpheres::describe() const {
+    return "GeometrySpheres '" + name() + "'";
+}
+void GeometrySpheres::set_centers(std::shared_ptr<Buffer> centers) {
+    require(centers, *this, "centre buffer");
+    if (!same_type(centers->element(), type_info_of<float3>()) || centers->dimensionality() != 1)
+        throw Error(describe() + ": centres must be a 1D buffer of float3, got " +
+                    centers->describe());
+    m_centers = std::move(centers);
+    changed();
+}
+void GeometrySpheres::set_radii(std::shared_ptr<Buffer> radii) {
+    require(radii, *this, "radius buffer");
+    if (!same_type(radii->element(), type_info_of<float>()) || radii->dimensionality() != 1)
+        throw Error(describe() + ": radii must be a 1D buffer of float, got " +
+                    radii->describe());
+    m_radii = std::move(radii);
+    changed();
+}
+void GeometrySpheres::set_material_indices(std::shared_ptr<Buffer> material_indices) {
+    if (material_indices && (material_indices->dimensionality() != 1 ||
+                             !same_type(material_indices->element(), type_info_of<unsigned>())))
+        throw Error(describe() + ": material indices must be a 1D buffer of unsigned, got " +
+                    material_indices->describe());
+    m_material_indices = std::move(material_indices);
+    changed();
+}
+unsigned GeometrySpheres::primitive_count() const {
+    return m_centers ? unsigned(m_centers->count()) : 0;
+}
+
 std::string Material::describe() const {
     return "Material '" + name() + "'";
 }

@@ -1,6 +1,8 @@
 // Scene compilation: graph discovery, checks, program binding (see scene_compiler.h).
 #include "core/scene_compiler.h"
 
+#include "core/builtin_geometry.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -190,7 +192,8 @@ void SceneCompiler::compile_instance(unsigned index) {
     const GeometryBase& geometry = *gi.geometry();
     CompiledInstance out;
     out.source = &gi;
-    out.triangles = geometry.is_triangles();
+    out.type = geometry.primitive_type();
+    out.triangles = out.type == PrimitiveType::kTriangles;
     out.primitive_count = geometry.primitive_count();
     out.opaque = geometry.flags() & kGeometryFlagDisableAnyHit;
     out.visibility_mask = gi.visibility_mask();
@@ -198,46 +201,15 @@ void SceneCompiler::compile_instance(unsigned index) {
 
     ScopeChain geometry_scope;
     geometry_scope.then(&gi).then(&geometry).then(m_state.context);
-    if (out.triangles) {
+    if (out.type == PrimitiveType::kTriangles) {
         auto& tris = static_cast<const GeometryTriangles&>(geometry);
-        if (!tris.vertices())
-            throw Error(tris.describe() + " has no vertex buffer; set one with set_vertices");
-        out.vertices = tris.vertices()->data<float3>();
-        size_t vertex_count = tris.vertices()->count();
-        if (tris.indices()) {
-            out.indices = static_cast<const uint3*>(tris.indices()->raw());
-            for (unsigned i = 0; i < out.primitive_count; ++i) {
-                uint3 t = out.indices[i];
-                if (t.x >= vertex_count || t.y >= vertex_count || t.z >= vertex_count)
-                    throw Error(tris.describe() + ": triangle " + std::to_string(i) +
-                                " uses vertex " + std::to_string(std::max({t.x, t.y, t.z})) +
-                                " but there are " + std::to_string(vertex_count) +
-                                " vertices; fix the index buffer");
-            }
-        } else if (vertex_count % 3 != 0) {
-            throw Error(tris.describe() +
-                        ": without an index buffer the vertex count must be a "
-                        "multiple of 3, got " +
-                        std::to_string(vertex_count));
-        }
-        if (tris.material_indices()) {
-            if (tris.material_indices()->count() != out.primitive_count)
-                throw Error(tris.describe() + ": the material index buffer has " +
-                            std::to_string(tris.material_indices()->count()) + " entries for " +
-                            std::to_string(out.primitive_count) +
-                            " triangles; give one per triangle");
-            out.material_indices = tris.material_indices()->data<unsigned>();
-            for (unsigned i = 0; i < out.primitive_count; ++i)
-                if (out.material_indices[i] >= gi.material_count())
-                    throw Error(tris.describe() + ": triangle " + std::to_string(i) +
-                                " selects material " + std::to_string(out.material_indices[i]) +
-                                " but " + gi.describe() + " has " +
-                                std::to_string(gi.material_count()) +
-                                "; add materials or fix the index");
-        }
+        bind_triangles(tris, gi, out);
         out.attribute = pack(tris.attribute_program(), geometry_scope, gi.describe());
         out.attributes =
             out.attribute ? out.attribute.desc->attributes : &type_info_of<TriangleAttributes>();
+    } else if (out.type == PrimitiveType::kSpheres) {
+        bind_spheres(static_cast<const GeometrySpheres&>(geometry), gi, out);
+        out.attributes = &type_info_of<BuiltinSphereAttributes>();
     } else {
         auto& custom = static_cast<const Geometry&>(geometry);
         if (!custom.intersection_program())

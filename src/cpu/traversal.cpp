@@ -117,6 +117,9 @@ class Traverser {
                                                   v))
                     runtime::triangle_candidate(m_policy, m_frame, n.instances[k], local, t,
                                                 make_float2(u, v));
+            } else if (inst.type == PrimitiveType::kSpheres) {
+                runtime::sphere_candidates(m_policy, m_frame, n.instances[k], local, origin,
+                                           direction, inst.centers[local], inst.radius(local));
             } else {
                 runtime::run_intersection(m_policy, m_frame, n.instances[k], inst, local);
             }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "lucent/device/api.h"
+#include "lucent/device/sphere_intersect.h"
 #include "runtime/trace_frame.h"
 
 // The GPU's tuning: these run inside trace_ray's frame (inlined, as they were written
@@ -422,6 +423,72 @@ LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned ins
     }
     if (f.ray_flags & kRayFlagTerminateOnFirstHit) f.terminated = true;
     return true;
+}
+
+/// Writes a built-in primitive's attributes into a frame's attribute bytes.
+template <class Storage, class A>
+LUCENT_HD inline void store_attributes(Storage& out, const A& attributes) {
+    static_assert(sizeof(A) <= sizeof(out.bytes), "attributes larger than the frame holds");
+#if LUCENT_GPU_CODE
+    *reinterpret_cast<A*>(out.bytes) = attributes;
+#else
+    __builtin_memcpy(out.bytes, &attributes, sizeof attributes);
+#endif
+}
+
+/// A hit of a built-in primitive other than a triangle (a sphere) at t, inside the ray's
+/// interval, with the attributes its intersection computed: the instance's mask and the
+/// ray's opacity culls, any-hit (unless opaque), then commit. True if accepted. The facing
+/// culls are for triangles only, as in OptiX.
+template <class P, class A>
+LUCENT_HD inline bool primitive_candidate(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                          unsigned prim, float t, const A& attributes) {
+    const typename P::Instance& inst = p.instance(instance_index);
+    if (f.masked_instances && !visible(f, p.visibility_mask(inst))) return false;
+    if ((f.ray_flags & (kRayFlagCullDisabledAnyHit | kRayFlagCullEnforcedAnyHit)) &&
+        culled_by_opacity(f, opaque_for_ray(p, f, inst)))
+        return false;
+    if constexpr (P::kOcclusion) {
+        if (f.occlusion) {  // occluded(): any intersection answers the query
+            f.has_hit = f.terminated = true;
+            return true;
+        }
+    }
+    const unsigned material = p.triangle_material(inst, prim);
+    const typename P::Program any = p.any_hit(inst, material, f.ray_type);
+    if (p.bound(any) && !opaque_for_ray(p, f, inst)) {
+        f.instance = instance_index;
+        f.prim = prim;
+        store_attributes(f.scratch, attributes);
+        f.candidate_t = t;
+        if (!run_any_hit(p, f, any)) return false;
+    }
+    commit<P>(f, instance_index, prim, t, material);
+    store_attributes(f.hit_attr, attributes);
+    if (f.ray_flags & kRayFlagTerminateOnFirstHit) f.terminated = true;
+    return true;
+}
+
+/// A built-in sphere: both of its intersections inside the ray's interval, nearer first (a
+/// ray from inside, or one whose any-hit ignored the near side, gets the far side).
+template <class P>
+LUCENT_HD inline void sphere_candidates(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                        unsigned prim, float3 origin, float3 direction,
+                                        float3 center, float radius) {
+    float t0, t1;
+    if (!intersect_sphere(origin, direction, center, radius, t0, t1)) return;
+    const float tmin = f.world_ray.tmin;
+    for (int side = 0; side < 2; ++side) {
+        const float t = side == 0 ? t0 : t1;
+        if (!(t > tmin && t < f.closest)) continue;
+        BuiltinSphereAttributes a;
+        // The hit's offset from the centre, divided by the radius first (a tiny sphere's
+        // squared offset would underflow), then made unit length against rounding.
+        a.normal = (origin - center + t * direction) * (1.0f / radius);
+        a.normal = a.normal * (1.0f / length(a.normal));
+        a.entering = side == 0 ? 1u : 0u;
+        if (primitive_candidate(p, f, instance_index, prim, t, a) || f.terminated) return;
+    }
 }
 
 // ---- the device API of intersection and any-hit programs --------------------------------------

@@ -145,6 +145,14 @@ struct TriangleAttributes {
     float3 geometric_normal;
 };
 
+/// Attributes of built-in spheres (GeometrySpheres): the object-space unit normal at the
+/// hit, pointing out of the sphere, and whether the ray entered the sphere there (1) or
+/// left it (0: the far side, e.g. of a ray that starts inside).
+struct BuiltinSphereAttributes {
+    float3 normal;
+    unsigned entering;
+};
+
 /// A record with no variables, for programs that need none.
 struct NoRecord {};
 

@@ -20,6 +20,11 @@ void put(DeviceBuffer& memory, const std::vector<T>& values) {
         memory.upload(values.data(), values.size() * sizeof(T));
 }
 
+static_assert(unsigned(PrimitiveType::kCustom) == gpu::kGpuCustom &&
+                  unsigned(PrimitiveType::kTriangles) == gpu::kGpuTriangles &&
+                  unsigned(PrimitiveType::kSpheres) == gpu::kGpuSpheres,
+              "GpuInstance::type holds lucent::PrimitiveType's values");
+
 const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
     return inst.triangles ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
                           : nullptr;
@@ -185,6 +190,7 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
     for (const core::CompiledInstance& inst : scene.instances) {
         gpu::GpuInstance g{};
         g.triangles = inst.triangles;
+        g.type = unsigned(inst.type);
         g.prim_count = inst.primitive_count;
         g.opaque = inst.opaque;
         g.visibility_mask = inst.visibility_mask;
@@ -196,6 +202,14 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
             g.indices = reinterpret_cast<const uint3*>(device_pointer(tris->indices()));
             g.material_indices =
                 reinterpret_cast<const unsigned*>(device_pointer(tris->material_indices()));
+        }
+        if (inst.type == PrimitiveType::kSpheres) {
+            auto& spheres = static_cast<const GeometrySpheres&>(*inst.source->geometry());
+            g.centers = reinterpret_cast<const float3*>(device_pointer(spheres.centers()));
+            g.radii = reinterpret_cast<const float*>(device_pointer(spheres.radii()));
+            g.single_radius = inst.single_radius;
+            g.material_indices =
+                reinterpret_cast<const unsigned*>(device_pointer(spheres.material_indices()));
         }
         g.material_offset = unsigned(flat.materials.size() / std::max(1u, ray_types));
         g.material_count = unsigned(inst.materials.size());

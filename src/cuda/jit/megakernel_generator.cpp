@@ -29,8 +29,10 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
         }
     }
     size_t attributes = 16;
-    for (const core::CompiledInstance& inst : scene.instances)
+    for (const core::CompiledInstance& inst : scene.instances) {
         attributes = std::max(attributes, inst.attributes->size);
+        shape.spheres |= inst.type == PrimitiveType::kSpheres;
+    }
     shape.attribute_bytes = unsigned((attributes + 15) / 16 * 16);
     shape.exceptions = !scene.enabled_exceptions.empty();
     shape.print = scene.print_enabled;
@@ -190,6 +192,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_SELECTORS " << shape.selectors << "\n"
         << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
         << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
+        << "#define LUCENT_GPU_SPHERES " << shape.spheres << "\n"
         << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
         << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
         << "#define LUCENT_GPU_OCCLUSION " << shape.occlusion << "\n"

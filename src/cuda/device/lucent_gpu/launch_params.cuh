@@ -68,8 +68,12 @@ struct GpuGeometryAccel {
     GpuTriangleBvhView triangles;  // triangles_only path (triangle ids are global primitives)
 };
 
+/// GpuInstance::type: lucent::PrimitiveType's values.
+enum GpuPrimitiveType : unsigned { kGpuCustom = 0, kGpuTriangles = 1, kGpuSpheres = 2 };
+
 struct GpuInstance {
     unsigned triangles;
+    unsigned type;  // GpuPrimitiveType
     unsigned prim_count;
     unsigned opaque;  // kGeometryFlagDisableAnyHit
     unsigned visibility_mask;
@@ -78,7 +82,10 @@ struct GpuInstance {
     ProgramRef attribute;
     const float3* vertices;
     const uint3* indices;
-    const unsigned* material_indices;
+    const unsigned* material_indices;  // triangles and spheres
+    const float3* centers;             // spheres
+    const float* radii;
+    unsigned single_radius;  // radii[0] for every sphere
     unsigned material_offset;  // materials[(material_offset + m) * ray_type_count + r]
     unsigned material_count;
 };

@@ -22,6 +22,9 @@
 #ifndef LUCENT_GPU_TRIANGLE_GROUPS
 #define LUCENT_GPU_TRIANGLE_GROUPS 1  // groups made only of triangles (GPU triangle BVH)
 #endif
+#ifndef LUCENT_GPU_SPHERES
+#define LUCENT_GPU_SPHERES 1  // built-in spheres (GeometrySpheres)
+#endif
 #ifndef LUCENT_GPU_TILES
 #define LUCENT_GPU_TILES 1  // warps take 8x4 tiles of 2D launches
 #endif

@@ -122,7 +122,15 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
             if (intersect_triangle_watertight(wray, inst.vertices[t.x], inst.vertices[t.y],
                                               inst.vertices[t.z], tmin, f.closest, th, u, v))
                 triangle_candidate(f, instance_index, local, th, make_float2(u, v));
-        } else {
+        }
+#if LUCENT_GPU_SPHERES
+        else if (inst.type == kGpuSpheres) {
+            runtime::sphere_candidates(GpuPolicy{}, f, instance_index, local, origin, direction,
+                                       inst.centers[local],
+                                       inst.radii[inst.single_radius ? 0 : local]);
+        }
+#endif
+        else {
             runtime::run_intersection(GpuPolicy{}, f, instance_index, inst, local);
         }
         return f.terminated || self().exception_code != 0;
