@@ -27,15 +27,14 @@ scene::Scene load_render_scene(const RenderSettings& settings) {
     return scene;
 }
 
-float scene_extent(const scene::Scene& scene) {
-    // The world-space box's corners: an instance's transform moves and scales its mesh.
+float scene_size(const scene::Scene& scene) {
+    // The world-space box: an instance's transform moves and scales its mesh.
     bool any = false;
     for (const scene::Instance& i : scene::drawn_instances(scene))
         any = any || !scene.meshes[i.mesh].positions.empty();
     if (!any) return 0;
     const scene::Bounds b = scene::scene_bounds(scene);
-    return std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x),
-                     std::fabs(b.hi.y), std::fabs(b.hi.z)});
+    return max_component(b.hi - b.lo);
 }
 
 std::string scene_note(const scene::Scene& scene) {
