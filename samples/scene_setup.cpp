@@ -23,7 +23,18 @@ scene::Scene load_render_scene(const RenderSettings& settings) {
             throw SettingsError("--camera " + std::to_string(n) + ": " + scene.cameras[n].unusable);
         scene.camera = scene.cameras[n];
     }
-    if (!settings.camera.empty()) scene.camera = settings.camera.applied_to(scene.camera);
+    if (!settings.camera.empty()) {
+        scene.camera = settings.camera.applied_to(scene.camera);
+        return scene;
+    }
+    // The scene's own camera is checked as the flags are: a file's camera that cannot see
+    // (a glTF node's singular matrix, a JSON up along the view) is an error, not a black image.
+    try {
+        scene.camera = CameraOverride{}.applied_to(scene.camera);
+    } catch (const SettingsError& e) {
+        throw SettingsError("scene '" + scene.name + "': its " + e.what() +
+                            "; fix the scene's camera, or replace it with --eye --look --up --fov");
+    }
     return scene;
 }
 

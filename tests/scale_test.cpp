@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -143,7 +144,7 @@ class ScaledScene : public ::testing::Test {
                ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::create_directories(dir);
     }
-    void TearDown() override { if (!getenv("DUMP")) fs::remove_all(dir); }
+    void TearDown() override { fs::remove_all(dir); }
 
     /// The file of `base` placed by `m`.
     std::string write(const Scene& base, const Placement& m, const std::string& stem) {
@@ -168,25 +169,40 @@ RenderResult render(const std::string& sample, const std::string& scene,
 }
 
 /// Each sample that renders a scene, with settings small enough for a test, and the most
-/// relative MSE (lucent::scene::compare_images) its scaled renders may be from the box at
-/// scale 1. The random streams are keyed by pixel and frame, not by position, so a sample
-/// renders the moved box with the same random numbers: what differs is rounding, which
-/// moves a ray across an edge here and there (a light's edge, a block's silhouette).
+/// relative MSE (lucent::scene::compare_images) its render of the box moved to 1e6 may be
+/// from the box at 0. The random streams are keyed by pixel and frame, not by position, so
+/// a sample renders the moved box with the same random numbers: what differs is rounding.
+/// At 1e6 a float's spacing is 1/16 mm, a nine-thousandth of the box, and the light hangs
+/// 1.6 spacings below the ceiling: rays cross edges here and there, and a path that does
+/// carries its difference through its bounces. Measured (48x48, CPU): direct 5.4e-4,
+/// pathtracer 0.0127, igi 0.0047, radiosity 0.0049; before the offset of Wächter and Binder
+/// 0.025, 0.29, 0.055 and 0.099. The bounds are about twice the measured figures.
 struct SampleCase {
     std::string sample;
     std::map<std::string, std::string> sets;
     unsigned spp;
-    double max_relmse;
+    double max_relmse_far;
 };
 
 const std::vector<SampleCase>& sample_cases() {
     static const std::vector<SampleCase> cases = {
-        {"direct", {{"area_samples", "4"}}, 0, 0.01},
-        {"pathtracer", {{"max_depth", "4"}}, 2, 0.05},
-        {"igi", {{"vpls", "32"}, {"area_samples", "1"}}, 0, 0.05},
-        {"radiosity", {{"photons", "64"}, {"area_samples", "4"}}, 0, 0.05},
+        {"direct", {{"area_samples", "4"}}, 0, 0.002},
+        {"pathtracer", {{"max_depth", "4"}}, 2, 0.03},
+        {"igi", {{"vpls", "32"}, {"area_samples", "1"}}, 0, 0.01},
+        {"radiosity", {{"photons", "64"}, {"area_samples", "4"}}, 0, 0.01},
     };
     return cases;
+}
+
+/// Scaled about 0, every float keeps its relative spacing, so the images agree to rounding:
+/// measured below 4e-11 in every sample (before: up to 0.29, the path tracer at 1e-6).
+constexpr double kMaxRelmseScaled = 1e-6;
+/// Moved by 1e3 the spacing grows 8x (1/4096 mm): measured at most 3.6e-6 (radiosity).
+constexpr double kMaxRelmseNear = 1e-4;
+
+double max_relmse(const SampleCase& c, const Placement& m) {
+    if (m.offset == 0) return kMaxRelmseScaled;
+    return m.offset <= 1e3 ? kMaxRelmseNear : c.max_relmse_far;
 }
 
 const std::vector<Placement>& placements() {
@@ -206,14 +222,78 @@ TEST_F(ScaledScene, EverySampleRendersTheCornellBoxAlikeAtEveryScaleAndOffset) {
         ASSERT_GT(brightness / reference.image.pixels.size(), 0.05)
             << c.sample << ": the reference is lit";
         for (const Placement& m : placements()) {
-            const std::string scene = write(box, m, "placed" + std::to_string(m.scale) + "_" + std::to_string(m.offset));
+            const std::string scene = write(box, m, "placed");
             const RenderResult r = render(c.sample, scene, c.sets, c.spp);
             EXPECT_EQ(r.report.exception_count(), 0u) << c.sample << ", " << m.name();
             const auto diff = lucent::scene::compare_images(reference.image, r.image);
             std::printf("%-10s %-22s relmse %.3g rmse %.3g flip %.3g\n", c.sample.c_str(),
                         m.name().c_str(), diff.relmse, diff.rmse, diff.flip_mean);
-            EXPECT_LT(diff.relmse, c.max_relmse) << c.sample << ", " << m.name();
-            if (getenv("DUMP")) { lucent::scene::write_image("/tmp/scale_dump/" + c.sample + "_" + std::to_string(m.scale) + "_" + std::to_string(m.offset) + ".pfm", r.image); lucent::scene::write_image("/tmp/scale_dump/" + c.sample + "_ref.pfm", reference.image);}
+            EXPECT_LT(diff.relmse, max_relmse(c, m)) << c.sample << ", " << m.name();
+        }
+    }
+}
+
+// ---- cameras that cannot see -----------------------------------------------------------------
+
+/// The Cornell box with `camera` as its JSON camera.
+std::string with_camera(const fs::path& dir, const lucent::scene::Camera& camera) {
+    Scene box = one_material_per_mesh(lucent::scene::cornell_box(true));
+    box.camera = camera;
+    const fs::path path = dir / "camera.json";
+    std::ofstream(path) << scene_json(box);
+    return path.string();
+}
+
+TEST_F(ScaledScene, AJsonCameraThatCannotSeeIsRefusedWithItsKey) {
+    using lucent::scene::Camera;
+    const float3 eye{278, 273, -800}, look{278, 273, 0};
+    struct Bad {
+        Camera camera;
+        std::string key;
+    };
+    for (const Bad& bad : {Bad{Camera{eye, look, {0, 0, 1}, 40}, "/camera/up"},
+                           Bad{Camera{eye, look, {0, 0, -3}, 40}, "/camera/up"},
+                           Bad{Camera{eye, look, {0, 0, 0}, 40}, "/camera/up"},
+                           Bad{Camera{eye, eye, {0, 1, 0}, 40}, "same point"},
+                           Bad{Camera{eye, look, {0, 1, 0}, 180}, "/camera/fov"},
+                           Bad{Camera{eye, look, {0, 1, 0}, 0}, "/camera/fov"}}) {
+        const std::string path = with_camera(dir, bad.camera);
+        lucent_tests::expect_error([&] { lucent::scene::load_scene(path); },
+                                   {"camera.json", bad.key}, bad.key.c_str());
+    }
+    // An up at an angle to the view loads: only the degenerate ones are refused.
+    EXPECT_NO_THROW(lucent::scene::load_scene(with_camera(dir, Camera{eye, look, {0, 1, 1}, 40})));
+}
+
+TEST_F(ScaledScene, EveryDegenerateCameraFlagIsRefusedByEverySampleBeforeItRenders) {
+    struct Bad {
+        lucent::samples::CameraOverride camera;
+        std::vector<std::string> words;
+    };
+    const float3 eye{278, 273, -800};
+    std::vector<Bad> bads;
+    bads.push_back({{eye, float3{278, 1000, -800}, std::nullopt, std::nullopt},
+                    {"up", "along the view direction", "--up"}});  // looking straight up, up +y
+    bads.push_back({{eye, eye, std::nullopt, std::nullopt}, {"same point", "--eye", "--look"}});
+    bads.push_back({{std::nullopt, std::nullopt, float3{0, 0, 0}, std::nullopt}, {"up 0,0,0", "--up"}});
+    bads.push_back({{std::nullopt, std::nullopt, std::nullopt, 180.0f}, {"fov 180", "--fov"}});
+    bads.push_back({{std::nullopt, std::nullopt, std::nullopt, -5.0f}, {"fov -5", "(0, 180)"}});
+    for (const lucent::samples::Sample* sample : lucent::samples::all_samples()) {
+        if (sample->name == "tea") continue;  // noise images: no camera
+        for (const Bad& bad : bads) {
+            RenderSettings settings;
+            settings.width = settings.height = 8;
+            settings.backend = lucent_tests::test_backend();
+            settings.threads = 2;
+            settings.camera = bad.camera;
+            try {
+                sample->render(settings);
+                ADD_FAILURE() << sample->name << ": rendered with " << bad.words[0];
+            } catch (const lucent::samples::SettingsError& e) {
+                for (const std::string& word : bad.words)
+                    EXPECT_NE(std::string(e.what()).find(word), std::string::npos)
+                        << sample->name << ": " << e.what() << " should name " << word;
+            }
         }
     }
 }
