@@ -39,21 +39,19 @@ scene::Camera CameraOverride::applied_to(scene::Camera camera) const {
                                 " is not a point of finite coordinates");
     if (!(camera.fov_degrees > 0.0f && camera.fov_degrees < 180.0f))
         throw SettingsError("camera: fov " + number(camera.fov_degrees) +
-                            " degrees; the vertical field of view must be in (0, 180)");
+                            " degrees; the vertical field of view must be in (0, 180) (--fov)");
     const float3 view = camera.look - camera.eye;
     const float distance = length(view);
     if (!(distance > 0.0f))
         throw SettingsError("camera: eye and look are the same point (" + text(camera.eye) +
-                            "); the camera looks from eye towards look, so move one of them");
-    // An up within about 0.06 degrees of the view direction leaves the image's orientation
-    // to rounding (the renders were only background).
-    const float up_length = length(camera.up);
-    if (!(up_length > 0.0f) ||
-        length(cross(view / distance, camera.up / up_length)) < 1e-3f)
+                            "); the camera looks from eye towards look, so move one of them "
+                            "(--eye, --look)");
+    if (scene::up_along_view(camera))
         throw SettingsError("camera: up " + text(camera.up) +
                             " is zero or along the view direction from eye " + text(camera.eye) +
                             " to look " + text(camera.look) +
-                            "; give an up at an angle to it (e.g. 0,1,0 for a horizontal view)");
+                            "; give an up at an angle to it (--up, e.g. 0,1,0 for a horizontal "
+                            "view)");
     return camera;
 }
 

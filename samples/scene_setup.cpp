@@ -23,19 +23,29 @@ scene::Scene load_render_scene(const RenderSettings& settings) {
             throw SettingsError("--camera " + std::to_string(n) + ": " + scene.cameras[n].unusable);
         scene.camera = scene.cameras[n];
     }
-    if (!settings.camera.empty()) scene.camera = settings.camera.applied_to(scene.camera);
+    if (!settings.camera.empty()) {
+        scene.camera = settings.camera.applied_to(scene.camera);
+        return scene;
+    }
+    // The scene's own camera is checked as the flags are: a file's camera that cannot see
+    // (a glTF node's singular matrix, a JSON up along the view) is an error, not a black image.
+    try {
+        scene.camera = CameraOverride{}.applied_to(scene.camera);
+    } catch (const SettingsError& e) {
+        throw SettingsError("scene '" + scene.name + "': its " + e.what() +
+                            "; fix the scene's camera, or replace it with --eye --look --up --fov");
+    }
     return scene;
 }
 
-float scene_extent(const scene::Scene& scene) {
-    // The world-space box's corners: an instance's transform moves and scales its mesh.
+float scene_size(const scene::Scene& scene) {
+    // The world-space box: an instance's transform moves and scales its mesh.
     bool any = false;
     for (const scene::Instance& i : scene::drawn_instances(scene))
         any = any || !scene.meshes[i.mesh].positions.empty();
     if (!any) return 0;
     const scene::Bounds b = scene::scene_bounds(scene);
-    return std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z), std::fabs(b.hi.x),
-                     std::fabs(b.hi.y), std::fabs(b.hi.z)});
+    return max_component(b.hi - b.lo);
 }
 
 std::string scene_note(const scene::Scene& scene) {

@@ -23,9 +23,11 @@ namespace lucent::samples {
 /// that cannot see).
 scene::Scene load_render_scene(const RenderSettings& settings);
 
-/// The largest coordinate magnitude of any vertex where the scene draws it (world space):
-/// offsets for secondary rays scale with it (the Cornell box is in millimetres).
-float scene_extent(const scene::Scene& scene);
+/// The longest side of the box of every vertex the scene draws (world space; 0 without any):
+/// what distances that depend on the scene's size are fractions of (the Cornell box is in
+/// millimetres), and what sample_common::offset_ray_origin's offset near 0 follows. Not
+/// where the scene is: a box moved to 1e6 has the size it had at 0.
+float scene_size(const scene::Scene& scene);
 
 /// The scene's name and size for a stage's note: "cornell, 32 triangles", or with instances
 /// "spheres, 4098 triangles stored, 4096002 drawn by 1001 instances".

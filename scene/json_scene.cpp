@@ -435,6 +435,10 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
     }
     if (length(scene.camera.look - scene.camera.eye) == 0)
         r.fail("/camera", "eye and look are the same point");
+    if (up_along_view(scene.camera))
+        r.fail(camera.contains("up") ? "/camera/up" : "/camera",
+               "up is zero or along the view direction from eye to look; give an up at an angle "
+               "to it (e.g. [0, 1, 0] for a horizontal view, [0, 0, 1] looking straight down)");
     return scene;
 }
 

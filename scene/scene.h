@@ -127,6 +127,11 @@ Bounds scene_bounds(const Scene& scene);
 /// scene without a camera of its own gets: an OBJ, or a JSON file without "camera").
 Camera framing_camera(const Scene& scene);
 
+/// True when the camera's up is zero or within about 0.06 degrees of its view direction
+/// (eye to look, which must differ): the image's orientation is then left to rounding, and
+/// the renders were only background.
+bool up_along_view(const Camera& camera);
+
 /// Every area light of the scene: its declared ones, then each triangle whose material
 /// emits (Ke in MTL, "emission" in JSON) as a triangle light, unless it lies on a declared
 /// light (the built-in Cornell box's light is both a declared light and its geometry).

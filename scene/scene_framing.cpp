@@ -1,4 +1,5 @@
-// The bounds of a scene and the camera that frames them, for scenes that bring no camera.
+// The bounds of a scene and the camera that frames them, for scenes that bring no camera;
+// whether a camera's up leaves its image an orientation.
 #include <algorithm>
 #include <cmath>
 
@@ -27,6 +28,12 @@ Camera framing_camera(const Scene& scene) {
     // The bounding sphere fits the 45-degree vertical field of view from 2.8 radii away
     // (sin 22.5 degrees = 0.38 > 1 / 2.8), in front of the +z face.
     return Camera{centre + make_float3(0, 0, 2.8f * radius), centre, {0, 1, 0}, 45};
+}
+
+bool up_along_view(const Camera& c) {
+    const float3 view = c.look - c.eye;
+    const float distance = length(view), up_length = length(c.up);
+    return !(up_length > 0.0f) || !(length(cross(view / distance, c.up / up_length)) >= 1e-3f);
 }
 
 }  // namespace lucent::scene

@@ -1,11 +1,13 @@
 // The device code the samples share, one program module that each sample's module includes:
 // the mesh records and the attribute programs of scene::Scene triangles, the light layouts
-// (lights.h), sampling (sampling.h) and the pinhole camera in a buffer (camera.h).
+// (lights.h), sampling (sampling.h), the pinhole camera in a buffer (camera.h) and the
+// origins of secondary rays (ray_offset.h).
 #pragma once
 
 #include "lucent/device.h"
 #include "samples/common/camera.h"
 #include "samples/common/lights.h"
+#include "samples/common/ray_offset.h"
 #include "samples/common/sampling.h"
 
 namespace sample_common {

@@ -44,7 +44,7 @@ DirectScene build(Context& ctx, const RenderSettings& settings, const OptionValu
                            : make_float3(3.14159265f * d * d);
     ctx["camera"] = camera.buffer();
     ctx["area_samples"] = unsigned(options.integer("area_samples"));
-    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * scene_extent(input));
+    ctx["scene_size"] = scene_size(input);
 
     DiffuseTextures texture_for(ctx, &input);
     auto lambert = ctx.create_program(LUCENT_PROGRAM(direct::direct_lambert));

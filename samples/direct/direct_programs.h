@@ -40,7 +40,7 @@ struct SurfaceRecord {
     lucent::BufferView<PointLight> point_lights;
     lucent::BufferView<AreaLight> area_lights;
     unsigned area_samples;  // per area light: a stratified sqrt(n) x sqrt(n) grid
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
     // A scene without lights: a point light of this intensity at the camera's eye (zero:
     // none), which sees every point the camera's rays hit, so it needs no shadow ray.
@@ -48,19 +48,18 @@ struct SurfaceRecord {
     lucent::BufferView<const sample_common::PinholeCamera> camera;
 };
 LUCENT_RECORD(SurfaceRecord, Kd, Ke, diffuse_map, point_lights, area_lights, area_samples,
-              scene_epsilon, top_object, headlight, camera)
+              scene_size, top_object, headlight, camera)
 
 struct MissRecord {
     float3 background;
 };
 LUCENT_RECORD(MissRecord, background)
 
-/// Fraction of light from `p` that reaches `target`: 0 or 1, an occlusion query (every
-/// surface is opaque). The ray stops just short of the target, so an emitter's own surface
-/// does not shadow it.
-LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 p, float3 target) {
-    return lucent::occluded(rec.top_object,
-                            lucent::make_ray(p, target - p, kShadowRay, rec.scene_epsilon, 0.999f))
+/// Fraction of light from `origin` (a hit point moved off its surface) that reaches `target`
+/// (a point light, or a point of an area light moved off it towards `origin`): 0 or 1, an
+/// occlusion query (every surface is opaque).
+LUCENT_HD inline float visibility(const SurfaceRecord& rec, float3 origin, float3 target) {
+    return lucent::occluded(rec.top_object, sample_common::segment_ray(origin, target, kShadowRay))
                ? 0.0f
                : 1.0f;
 }
@@ -87,7 +86,7 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
     const float3 p = ray.origin + lucent::t_hit() * ray.direction;
     const float3 n = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
                                  ray.direction);
-    const float3 origin = p + rec.scene_epsilon * n;
+    const float3 origin = sample_common::offset_ray_origin(p, n, rec.scene_size);
     float3 color = rec.Ke;
     const float3 texel = sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
     const float3 albedo = rec.Kd * texel * (1.0f / 3.14159265f);  // Lambert: rho / pi
@@ -124,7 +123,10 @@ LUCENT_CLOSEST_HIT(direct_lambert, direct::SurfaceRecord, direct::RadiancePayloa
             const float cos_surface = dot(n, to) / d, cos_light = -dot(light_normal, to) / d;
             if (cos_surface > 0.0f && cos_light > 0.0f)
                 sum += light.emission *
-                       (cos_surface * cos_light / d2 * direct::visibility(rec, origin, q));
+                       (cos_surface * cos_light / d2 *
+                        direct::visibility(rec, origin,
+                                           sample_common::offset_ray_origin(q, light_normal,
+                                                                            rec.scene_size)));
         }
         color += albedo * sum * (area / float(side * side));
     }

@@ -23,8 +23,11 @@ namespace {
 
 /// The scene's lights as IGI's point emitters: point lights as they are; each area light
 /// (declared, or an emissive triangle) as a side x side grid of cosine lobes at its cells'
-/// centres (sample_common::light_point's equal-area cells), sharing its power L A pi.
+/// centres (sample_common::light_point's equal-area cells), sharing its power L A pi, each
+/// moved off the light's surface (sample_common::offset_ray_origin) so that a shadow ray
+/// towards it, or a particle leaving it, does not meet the light's own triangles.
 std::vector<igi::PointEmitter> point_emitters(const scene::Scene& input, int side) {
+    const float size = scene_size(input);
     std::vector<igi::PointEmitter> lights;
     for (const auto& l : input.point_lights)
         lights.push_back({l.position, l.intensity, make_float3(0.0f)});
@@ -37,8 +40,10 @@ std::vector<igi::PointEmitter> point_emitters(const scene::Scene& input, int sid
             for (int i = 0; i < side; ++i) {
                 const float u = (float(i) + 0.5f) / float(side),
                             v = (float(j) + 0.5f) / float(side);
-                lights.push_back({sample_common::light_point(a, u, v),
-                                  a.emission * (area / cells), normal});
+                lights.push_back(
+                    {sample_common::offset_ray_origin(sample_common::light_point(a, u, v), normal,
+                                                      size),
+                     a.emission * (area / cells), normal});
             }
     }
     return lights;
@@ -119,13 +124,13 @@ struct IgiOptions {
 
 /// The visibility-only ray types, the recursion depth and the context-wide variables. The
 /// radiance and particle ray types follow with the graph they trace (add_graphs).
-void set_up_context(Context& ctx, const IgiOptions& o, float extent) {
+void set_up_context(Context& ctx, const IgiOptions& o, float size) {
     ctx.set_ray_type<igi::ShadowPayload>(igi::kShadowRay, "shadow", /*expects_closest_hit=*/false);
     ctx.set_ray_type<igi::ShadowPayload>(igi::kVplShadowRay, "vpl shadow",
                                          /*expects_closest_hit=*/false);
     ctx.set_max_recursion_depth(unsigned(o.max_depth) + 1);
-    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
-    ctx["min_d"] = o.min_d_fraction * extent;
+    ctx["scene_size"] = size;
+    ctx["min_d"] = o.min_d_fraction * size;
     ctx["max_depth"] = unsigned(o.max_depth);
     ctx["bounces"] = o.config.bounces;
     ctx["downsample"] = o.config.downsample;
@@ -271,7 +276,7 @@ struct IgiScene {
                                 "' has no lights; IGI traces its particles from point and area "
                                 "lights and emissive triangles (try --scene cornell, give a "
                                 "material Ke in its MTL, or add a light to a JSON scene)");
-        set_up_context(ctx, options, scene_extent(input));
+        set_up_context(ctx, options, scene_size(input));
         add_lights(ctx, lights, options.config);
         add_graphs(ctx, input, options.imperfect == igi::kBoxGraphVisibility, aovs);
         images = create_igi_images(ctx, options.config);

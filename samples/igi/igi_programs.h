@@ -141,10 +141,10 @@ struct GenerateRecord {
     lucent::BufferView<const LightPath> light_paths;  // one per path
     lucent::BufferView<Vpl> vpls;  // paths x bounces slots; unused ones have zero radiance
     unsigned bounces;
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
 };
-LUCENT_RECORD(GenerateRecord, lights, light_paths, vpls, bounces, scene_epsilon, top_object)
+LUCENT_RECORD(GenerateRecord, lights, light_paths, vpls, bounces, scene_size, top_object)
 
 /// The full-resolution G-buffer of the direct stage (IGI paper, Fig. 3): position (w: the distance
 /// along the eye path, < 0: no hit), normal and the irradiance's weight, each image width x
@@ -163,7 +163,7 @@ LUCENT_RECORD(CameraRecord, camera, direct, gbuffer_position, gbuffer_normal, gb
 struct IndirectParams {
     lucent::BufferView<const Vpl> vpls;
     float min_d;  // Eq. (1)'s bounding distance
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
     unsigned imperfect_visibility;  // kExactVisibility, kLeafBoxVisibility or kBoxGraphVisibility
     lucent::Handle vpl_shadow_object;
@@ -177,13 +177,13 @@ struct SurfaceRecord {
     lucent::BufferView<const Vpl> vpls;
     float min_d;
     unsigned max_depth;
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
     unsigned imperfect_visibility;
     lucent::Handle vpl_shadow_object;
     unsigned reflection_layer;  // 1: the first reflected hit is G-buffer layer 1
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, ior, lights, vpls, min_d, max_depth, scene_epsilon, top_object,
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, ior, lights, vpls, min_d, max_depth, scene_size, top_object,
               imperfect_visibility, vpl_shadow_object, reflection_layer)
 
 // The passes below run over launch_index().z, the G-buffer layer; their images have as many.
@@ -196,13 +196,13 @@ struct IndirectRecord {
     lucent::BufferView<const Vpl> vpls;
     unsigned downsample, interleave, slices;
     float min_d;
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
     unsigned imperfect_visibility;
     lucent::Handle vpl_shadow_object;
 };
 LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, downsample,
-              interleave, slices, min_d, scene_epsilon, top_object, imperfect_visibility,
+              interleave, slices, min_d, scene_size, top_object, imperfect_visibility,
               vpl_shadow_object)
 
 struct IndirectSumRecord {
@@ -257,17 +257,18 @@ template <class Record>
 LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
     return IndirectParams{rec.vpls,
                           rec.min_d,
-                          rec.scene_epsilon,
+                          rec.scene_size,
                           rec.top_object,
                           rec.imperfect_visibility,
                           rec.vpl_shadow_object};
 }
 
-/// Nothing opaque between `from` and just short of `to`: an occlusion query, no programs.
-LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float epsilon, float3 from,
-                              float3 to, lucent::Occlusion test = lucent::Occlusion::kExact) {
-    return !lucent::occluded(root, lucent::make_ray(from, to - from, ray_type, epsilon, 0.999f),
-                             test);
+/// Nothing opaque between `from` and just short of `to`, both off their surfaces
+/// (sample_common::offset_ray_origin: hit points, VPLs and area lights' emitters are): an
+/// occlusion query, no programs.
+LUCENT_HD inline bool visible(lucent::Handle root, unsigned ray_type, float3 from, float3 to,
+                              lucent::Occlusion test = lucent::Occlusion::kExact) {
+    return !lucent::occluded(root, sample_common::segment_ray(from, to, ray_type), test);
 }
 
 /// The imperfect_visibility option: how VPL shadow rays test the scene (IGI paper §4.1).
@@ -282,11 +283,10 @@ enum : unsigned {
 /// triangles' bounding boxes (a different root and ray type).
 LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 to) {
     if (p.imperfect_visibility == kLeafBoxVisibility)
-        return visible(p.top_object, kShadowRay, p.scene_epsilon, from, to,
-                       lucent::Occlusion::kLeafBoxes);
+        return visible(p.top_object, kShadowRay, from, to, lucent::Occlusion::kLeafBoxes);
     if (p.imperfect_visibility == kBoxGraphVisibility)
-        return visible(p.vpl_shadow_object, kVplShadowRay, p.scene_epsilon, from, to);
-    return visible(p.top_object, kShadowRay, p.scene_epsilon, from, to);
+        return visible(p.vpl_shadow_object, kVplShadowRay, from, to);
+    return visible(p.top_object, kShadowRay, from, to);
 }
 
 /// Eq. (1) at x with normal n over the VPLs first, first + stride, ...: the sum of
@@ -353,14 +353,16 @@ LUCENT_RAY_GENERATION(igi_generate_vpls, igi::GenerateRecord) {
     for (unsigned b = 0; b < rec.bounces; ++b) {
         igi::ParticlePayload hit{};
         lucent::trace(rec.top_object,
-                      lucent::make_ray(origin, direction, igi::kParticleRay, rec.scene_epsilon),
+                      lucent::make_ray(origin, direction, igi::kParticleRay, 0.0f),
                       hit);
         if (!hit.hit || max_component(hit.albedo) <= 0.0f) break;  // a VPL only where diffuse
         const float3 n = faceforward(hit.normal, direction);
+        // The VPL just off its surface, on the side the light came from: where the next
+        // bounce starts, and an end of the shadow rays that test it.
+        origin = sample_common::offset_ray_origin(hit.position, n, rec.scene_size);
         rec.vpls[path * rec.bounces + b] =
-            igi::Vpl{hit.position, n, flux * hit.albedo * (1.0f / 3.14159265f)};
+            igi::Vpl{origin, n, flux * hit.albedo * (1.0f / 3.14159265f)};
         flux = flux * hit.albedo;  // cosine sampling cancels the cosine and pi
-        origin = hit.position + rec.scene_epsilon * n;
         direction = igi::cosine_direction(n, igi::halton(i, primes[(2 * b) % 16]),
                                           igi::halton(i, primes[(2 * b + 1) % 16]));
     }
@@ -402,10 +404,15 @@ LUCENT_HD inline float3 dielectric(const SurfaceRecord& rec, int depth, float3 x
     const float eta = outside ? rec.ior : 1.0f / rec.ior;  // n_transmitted / n_incident
     const float f = sample_common::fresnel_dielectric(-dot(d, n), eta);
     float3 color = make_float3(0.0f);
-    if (f > 0.0f) color += f * inline_branch(rec, depth, x + rec.scene_epsilon * n, reflect(d, n));
+    if (f > 0.0f)
+        color += f * inline_branch(rec, depth,
+                                   sample_common::offset_ray_origin(x, n, rec.scene_size),
+                                   reflect(d, n));
     float3 t;
     if (f < 1.0f && refract(t, d, n, 1.0f / eta))
-        color += ((1.0f - f) / (eta * eta)) * inline_branch(rec, depth, x - rec.scene_epsilon * n, t);
+        color += ((1.0f - f) / (eta * eta)) *
+                 inline_branch(rec, depth, sample_common::offset_ray_origin(x, -n, rec.scene_size),
+                               t);
     return color;
 }
 
@@ -437,7 +444,7 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
     const float3 x = ray.origin + lucent::t_hit() * ray.direction;
     const float3 n = faceforward(normalize(lucent::object_to_world_normal(attr.geometric_normal)),
                                  ray.direction);
-    const float3 origin = x + rec.scene_epsilon * n;
+    const float3 origin = sample_common::offset_ray_origin(x, n, rec.scene_size);
     float3 color = rec.Ke;
     const float3 rho = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
     const float3 albedo = rho * (1.0f / 3.14159265f);
@@ -449,8 +456,7 @@ LUCENT_CLOSEST_HIT(igi_surface, igi::SurfaceRecord, igi::RadiancePayload, igi::H
             if (c <= 0.0f) continue;
             const float3 intensity = igi::intensity_towards(light, -to / d);
             if (max_component(intensity) > 0.0f &&
-                igi::visible(rec.top_object, igi::kShadowRay, rec.scene_epsilon, origin,
-                             light.position))
+                igi::visible(rec.top_object, igi::kShadowRay, origin, light.position))
                 color += albedo * intensity * (c / d2);
         }
     }

@@ -82,9 +82,10 @@ constexpr unsigned kGBufferRay = 2, kGBufferEntry = 1;
 PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions& options,
                 const CameraBuffer& camera, AovPasses* aovs = nullptr) {
     scene::Scene input = load_render_scene(settings);
-    const float extent = scene_extent(input);
-    const float epsilon = std::max(1e-4f, 1e-4f * extent);
-    add_light_geometry(input, 10 * epsilon);
+    const float size = scene_size(input);
+    // A light within a thousandth of the scene's size of emitting triangles has its geometry
+    // (scene::emitter_lights' tolerance).
+    add_light_geometry(input, 1e-3f * size);
 
     ctx.set_ray_type<pathtracer::PathPayload>(pathtracer::kRadianceRay, "radiance");
     ctx.set_ray_type<pathtracer::ShadowPayload>(pathtracer::kShadowRay, "shadow",
@@ -92,7 +93,7 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     ctx.set_max_recursion_depth(2);  // the path loop's rays, then shadow rays from hits
 
     bind_lights(ctx, input);
-    ctx["scene_epsilon"] = epsilon;
+    ctx["scene_size"] = size;
     report_if_unlit(input, "pathtracer", "only the environment option lights it");
 
     std::shared_ptr<Program> closest_hits[] = {

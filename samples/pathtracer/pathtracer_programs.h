@@ -73,7 +73,8 @@ LUCENT_HD inline float area_light_pdf(lucent::BufferView<AreaLight> lights,
     for (unsigned l = 0; l < lights.count(); ++l) {
         const AreaLight light = lights[l];
         const float tl = sample_common::light_hit_distance(light, origin, direction);
-        if (tl <= 0.0f || fabsf(tl - t) > 1e-3f * t + 1e-6f) continue;  // not on this light
+        // Not on this light: relative, as the rounding of both distances is at any scale.
+        if (tl <= 0.0f || fabsf(tl - t) > 1e-3f * t) continue;
         const float cos_light = -dot(sample_common::light_normal(light), direction);
         pdf += sample_common::light_probability(cdf, l) * tl * tl /
                (cos_light * sample_common::light_area(light));
@@ -103,24 +104,22 @@ struct SurfaceRecord {
     lucent::BufferView<AreaLight> area_lights;
     lucent::BufferView<const float> area_light_cdf;  // next-event estimation picks by power
     lucent::BufferView<PointLight> point_lights;
-    float scene_epsilon;
+    float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
 };
 LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, alpha, ior, area_lights, area_light_cdf,
-              point_lights, scene_epsilon, top_object)
+              point_lights, scene_size, top_object)
 
 struct MissRecord {
     float3 environment;  // uniform radiance from every direction
 };
 LUCENT_RECORD(MissRecord, environment)
 
-/// Nothing between `from` and `distance` along `direction`: an occlusion query (every
+/// Nothing between `from` and `to`, both moved off their surfaces
+/// (sample_common::offset_ray_origin) or `to` a point light: an occlusion query (every
 /// surface opaque, no programs run).
-LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 direction,
-                                 float distance) {
-    return !lucent::occluded(
-        rec.top_object,
-        lucent::make_ray(from, direction, kShadowRay, 0.0f, distance - 2.0f * rec.scene_epsilon));
+LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 to) {
+    return !lucent::occluded(rec.top_object, sample_common::segment_ray(from, to, kShadowRay));
 }
 
 /// Next-event estimation at p: one area light chosen in proportion to its power, a uniform
@@ -139,14 +138,17 @@ LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, c
         const float3 to = q - p;
         const float d2 = dot(to, to), d = sqrtf(d2);
         const float3 wi = to / d;
-        const float cos_light = -dot(sample_common::light_normal(light), wi);  // > 0: emitting side
+        const float3 light_normal = sample_common::light_normal(light);
+        const float cos_light = -dot(light_normal, wi);  // > 0: emitting side
         const float3 wi_local = to_local(frame, wi);
         const float chosen = sample_common::light_probability(rec.area_light_cdf, l);
         if (cos_light > 0.0f && wi_local.z > 0.0f && chosen > 0.0f) {
             // The area pdf p(l) / A as a solid-angle pdf: times d^2 / cos(theta_light).
             const float pdf_light = chosen * d2 / (cos_light * area);
             const float3 f = bsdf_eval(bsdf, wo, wi_local);
-            if (max_component(f) > 0.0f && unoccluded(rec, p, wi, d)) {
+            if (max_component(f) > 0.0f &&
+                unoccluded(rec, p,
+                           sample_common::offset_ray_origin(q, light_normal, rec.scene_size))) {
                 const float w = power_heuristic(pdf_light, bsdf_pdf(bsdf, wo, wi_local));
                 sum += f * light.emission * (wi_local.z * w / pdf_light);
             }
@@ -159,7 +161,7 @@ LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, c
         const float3 wi = to / d, wi_local = to_local(frame, wi);
         if (wi_local.z <= 0.0f) continue;
         const float3 f = bsdf_eval(bsdf, wo, wi_local);
-        if (max_component(f) > 0.0f && unoccluded(rec, p, wi, d))
+        if (max_component(f) > 0.0f && unoccluded(rec, p, light.position))
             sum += f * light.intensity * (wi_local.z / d2);
     }
     return sum;
@@ -187,7 +189,7 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
                     Kind == kDielectric && !outside ? 1.0f / rec.ior : rec.ior};
     const Frame frame = make_frame(n);
     const float3 wo = to_local(frame, -ray.direction);
-    const float3 above = x + rec.scene_epsilon * n;
+    const float3 above = sample_common::offset_ray_origin(x, n, rec.scene_size);
     prd.direct = make_float3(0.0f);
     if (prd.nee && !is_delta(bsdf)) prd.direct = next_event(rec, bsdf, frame, wo, above, prd.rng);
 
@@ -201,7 +203,7 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
     prd.pdf = s.pdf;
     prd.delta = s.delta ? 1u : 0u;
     prd.direction = normalize(to_world(frame, s.wi));
-    prd.origin = s.wi.z > 0.0f ? above : x - rec.scene_epsilon * n;
+    prd.origin = s.wi.z > 0.0f ? above : sample_common::offset_ray_origin(x, -n, rec.scene_size);
 }
 
 // ---- the path loop (CACM Figure 8) -----------------------------------------------------------

@@ -65,10 +65,10 @@ void set_up_context(Context& ctx, const scene::Scene& input, const Options& opti
     ctx.set_ray_type<radiosity::SurfacePayload>(radiosity::kPhotonRay, "photon");
     ctx.set_max_recursion_depth(2);
 
-    const float extent = scene_extent(input);
-    ctx["scene_epsilon"] = std::max(1e-4f, 1e-4f * extent);
-    ctx["vpl_offset"] = 1e-3f * extent;
-    ctx["clamp_distance"] = options.clamp * extent;
+    const float size = scene_size(input);
+    ctx["scene_size"] = size;
+    ctx["vpl_offset"] = 1e-3f * size;
+    ctx["clamp_distance"] = options.clamp * size;
     ctx["bounces"] = options.bounces;
     ctx["roulette"] = options.roulette;
     ctx["area_samples"] = options.area_samples;

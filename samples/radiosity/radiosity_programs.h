@@ -66,10 +66,10 @@ struct PhotonRecord {
     unsigned bounces;
     unsigned roulette;  // 1: Russian roulette after the first bounce
     float vpl_offset;   // how far back along the ray a VPL sits from its hit
-    float scene_epsilon;
+    float scene_size;   // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
 };
-LUCENT_RECORD(PhotonRecord, area_lights, area_light_cdf, vpls, bounces, roulette, vpl_offset, scene_epsilon,
+LUCENT_RECORD(PhotonRecord, area_lights, area_light_cdf, vpls, bounces, roulette, vpl_offset, scene_size,
               top_object)
 
 struct GBufferRecord {
@@ -95,17 +95,17 @@ struct ShadeRecord {
     unsigned show_vpls;    // 1: draw each VPL as a dot
     float clamp_distance;  // VPL distances below it count as it (bounds the 1/d^2 spike)
     float dot_radius;      // show_vpls: angular radius of a dot, radians
-    float scene_epsilon;
+    float scene_size;      // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
 };
 LUCENT_RECORD(ShadeRecord, camera, gbuffer_position, gbuffer_normal, gbuffer_albedo, gbuffer_emission,
               output, area_lights, area_samples, vpls, gi, vpl_shadows, show_vpls, clamp_distance,
-              dot_radius, scene_epsilon, top_object)
+              dot_radius, scene_size, top_object)
 
-/// Nothing between `from` and just short of `to`: an occlusion query, no programs.
+/// Nothing between `from` and just short of `to`, both off their surfaces
+/// (sample_common::offset_ray_origin; a VPL is, by vpl_offset): an occlusion query, no programs.
 LUCENT_HD inline bool visible(const ShadeRecord& rec, float3 from, float3 to) {
-    return !lucent::occluded(
-        rec.top_object, lucent::make_ray(from, to - from, kShadowRay, rec.scene_epsilon, 0.999f));
+    return !lucent::occluded(rec.top_object, sample_common::segment_ray(from, to, kShadowRay));
 }
 
 LUCENT_HD inline float3 xyz(float4 v) {
@@ -130,7 +130,8 @@ LUCENT_HD inline float3 direct_irradiance(const ShadeRecord& rec, float3 x, floa
             const float3 to = q - x;
             const float d2 = dot(to, to), d = sqrtf(d2);
             const float cos_x = dot(n, to) / d, cos_light = -dot(light_normal, to) / d;
-            if (cos_x > 0.0f && cos_light > 0.0f && visible(rec, x, q))
+            if (cos_x > 0.0f && cos_light > 0.0f &&
+                visible(rec, x, sample_common::offset_ray_origin(q, light_normal, rec.scene_size)))
                 sum += light.emission * (cos_x * cos_light / d2 * area / float(side * side));
         }
     }
@@ -174,7 +175,8 @@ LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
     // cosine-distributed hemisphere, as the blog's generateHemisphereLightPhoton.
     const float2 at = radiosity::random2(photon, 0x51u);
     const float2 jitter = radiosity::random2(photon, 0x52u);
-    float3 origin = sample_common::light_point(light, at.x, at.y);
+    float3 origin = sample_common::offset_ray_origin(sample_common::light_point(light, at.x, at.y),
+                                                     light_normal, rec.scene_size);
     float3 direction = radiosity::cosine_direction(
         light_normal, (float(i.x) + jitter.x) / float(n.x), (float(i.y) + jitter.y) / float(n.y));
     // The light's flux pi L A over the expected number of its photons, n.x n.y p(l).
@@ -185,7 +187,7 @@ LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
         radiosity::SurfacePayload hit{};
         hit.distance = -1.0f;
         lucent::trace(rec.top_object,
-                      lucent::make_ray(origin, direction, radiosity::kPhotonRay, rec.scene_epsilon),
+                      lucent::make_ray(origin, direction, radiosity::kPhotonRay, 0.0f),
                       hit);
         if (hit.distance < 0.0f || max_component(hit.albedo) <= 0.0f) break;
         // The VPL: a little back along the ray, so it lies in front of its surface.
@@ -202,7 +204,7 @@ LUCENT_RAY_GENERATION(radiosity_photons, radiosity::PhotonRecord) {
             if (radiosity::random2(photon, 0x200u + b).x >= survive) break;
             flux = flux * (1.0f / survive);
         }
-        origin = hit.position + rec.scene_epsilon * hit.normal;
+        origin = sample_common::offset_ray_origin(hit.position, hit.normal, rec.scene_size);
         direction = radiosity::cosine_direction(hit.normal, r.x, r.y);
     }
 }
@@ -244,7 +246,7 @@ LUCENT_RAY_GENERATION(radiosity_shade, radiosity::ShadeRecord) {
     float3 color = make_float3(0.0f);
     if (position.w >= 0.0f) {
         const float3 x = radiosity::xyz(position), nx = radiosity::xyz(rec.gbuffer_normal[pixel]);
-        const float3 origin = x + rec.scene_epsilon * nx;
+        const float3 origin = sample_common::offset_ray_origin(x, nx, rec.scene_size);
         float3 irradiance = radiosity::direct_irradiance(rec, origin, nx, p.y * n.x + p.x);
         if (rec.gi) irradiance += radiosity::vpl_irradiance(rec, origin, nx);
         color = radiosity::xyz(rec.gbuffer_emission[pixel]) +
