@@ -237,18 +237,20 @@ void read_instances(const JsonReader& r, const json& list,
 }  // namespace
 
 namespace detail {
-Scene read_json_scene(const std::string& path, const nlohmann::json& root);
+Scene read_json_scene(const std::string& path, const nlohmann::json& root,
+                      const LoadProgress& progress);
 }
 
-Scene load_json_scene(const std::string& path) {
+Scene load_json_scene(const std::string& path, const LoadProgress& progress) {
     try {
-        return detail::read_json_scene(path, parse_file(path));
+        return detail::read_json_scene(path, parse_file(path), progress);
     } catch (const json::exception& e) {  // a value of a type the checks above did not expect
         throw Error(path + ": " + e.what());
     }
 }
 
-Scene detail::read_json_scene(const std::string& path, const nlohmann::json& root) {
+Scene detail::read_json_scene(const std::string& path, const nlohmann::json& root,
+                              const LoadProgress& progress) {
     JsonReader r(path);
     if (!root.is_object())
         r.fail("/", "a scene is a JSON object with camera, materials, meshes, lights");
@@ -341,11 +343,11 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
             const fs::path file = r.resolve(m["file"].get<std::string>());
             Scene part;
             if (file.extension() == ".ply") {
-                part.meshes.push_back(load_ply_mesh(file.string()));
+                part.meshes.push_back(load_ply_mesh(file.string(), progress));
                 part.materials.push_back(
                     Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
             } else {
-                part = load_obj_scene(file.string());
+                part = load_obj_scene(file.string(), progress);
             }
             const unsigned base = unsigned(scene.materials.size());
             scene.materials.insert(scene.materials.end(), part.materials.begin(),
