@@ -13,7 +13,8 @@ scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$roo
                "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp" "$root/scene/cornell_materials.cpp"
                "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp" "$root/scene/input_file.cpp"
                "$root/scene/line_reader.cpp" "$root/scene/progress_stream.cpp"
-               "$root/scene/gltf_scene.cpp" "$root/scene/texture_image.cpp" "$root/scene/exr_encoder.cpp")
+               "$root/scene/gltf_scene.cpp" "$root/scene/texture_image.cpp" "$root/scene/exr_encoder.cpp"
+               "$root/scene/exr_header_check.cpp")
 defines=()
 case $name in
   obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"
