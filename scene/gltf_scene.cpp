@@ -678,6 +678,14 @@ Scene load_gltf_scene(const std::string& path) {
         const std::string base = fs::path(path).parent_path().string();
         // By content, not by extension: a .gltf that is a GLB container reads as one.
         const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+        // JSON text holds no NUL byte, and the JSON parser ends its input at one: what
+        // follows it would be ignored without a word.
+        if (!binary)
+            if (const void* nul = std::memchr(bytes.data(), 0, bytes.size()))
+                throw Error(path + ": a NUL byte at byte " +
+                            std::to_string(static_cast<const unsigned char*>(nul) - bytes.data()) +
+                            ": a .gltf file is JSON text (this one is damaged, sparse or not "
+                            "glTF)");
         const bool ok =
             binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                                  unsigned(bytes.size()), base)

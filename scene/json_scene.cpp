@@ -3,6 +3,7 @@
 // errors name the file and the JSON location ("/lights/1/position") and what is expected.
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -143,9 +144,24 @@ json parse_file(const std::string& path) {
     require_regular_file(path, "scene file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open the scene file (check the path)");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    const std::string text = buffer.str();
+    // Read in 1 MiB blocks, each checked for a NUL byte: nlohmann-json ends its input at
+    // one, so a scene followed by binary data was accepted without it, and a sparse file
+    // was read whole (a 1 GB one took 2 GB) before failing at its first byte.
+    std::string text;
+    text.reserve(size_t(file_size(path)));
+    std::vector<char> block(size_t(1) << 20);
+    while (in.read(block.data(), std::streamsize(block.size())) || in.gcount() > 0) {
+        const size_t n = size_t(in.gcount());
+        if (const void* nul = std::memchr(block.data(), '\0', n)) {
+            text.append(block.data(), size_t(static_cast<const char*>(nul) - block.data()));
+            size_t line = 1, column = 1;
+            for (char c : text) c == '\n' ? (++line, column = 1) : ++column;
+            throw Error(path + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                        ": a NUL byte: a scene file is JSON text (this one is damaged, sparse "
+                        "or not JSON)");
+        }
+        text.append(block.data(), n);
+    }
     try {
         return json::parse(text, DuplicateKeyCheck(path));
     } catch (const json::parse_error& e) {

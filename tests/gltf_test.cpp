@@ -276,6 +276,9 @@ TEST_F(GltfScenes, NamedFilesThatAreFifosOrDevicesAreRefusedByName) {
                                   "file; Lucent reads scenes, meshes and textures only from "
                                   "regular files (copy the data into one)");
     fs::remove(dir / "buffer.bin");
+    // A .gltf followed by binary data: the JSON parser stopped at the NUL byte.
+    const std::string padded = write("padded.gltf", gltf(kSquareMesh) + std::string(8, '\0') + "x");
+    EXPECT_EQ(error_of(padded).rfind(padded + ": a NUL byte at byte ", 0), 0u) << error_of(padded);
     fs::create_symlink("/dev/zero", dir / "buffer.bin");
     EXPECT_NE(error_of(path).find("buffer.bin: this file named by the glTF is a device"),
               std::string::npos)

@@ -154,6 +154,11 @@ TEST_F(SceneFiles, BinaryDataAndEndlessLinesInTextFilesAreRefusedByLine) {
     const std::string endless = write("endless.obj", tri + "# " + std::string(2u << 20, 'x'));
     EXPECT_EQ(error_of(endless), endless + ":5: a line longer than 1048576 bytes; the OBJ file "
                                            "is damaged or not text");
+    // JSON: nlohmann-json ended its input at a NUL byte, so what followed was ignored.
+    const std::string json = write("s.json", std::string(R"({"meshes": [{"file": "tri.obj"}]})") +
+                                                 "\n" + std::string(64, '\0') + "garbage");
+    EXPECT_EQ(error_of(json), json + ":2:1: a NUL byte: a scene file is JSON text (this one is "
+                                     "damaged, sparse or not JSON)");
     write("zeros.mtl", std::string("newmtl a\n") + std::string(100, '\0'));
     const std::string with_mtl = write("m.obj", "mtllib zeros.mtl\n" + tri);
     EXPECT_NE(error_of(with_mtl).find("zeros.mtl:2: a NUL byte: this MTL file"), std::string::npos)
