@@ -6,10 +6,12 @@
 
 namespace lucent::cli {
 
-ProgressBar::ProgressBar(std::string label, std::string unit)
+ProgressBar::ProgressBar(std::string label, std::string unit,
+                         std::chrono::milliseconds show_after)
     : m_label(std::move(label)),
       m_unit(std::move(unit)),
       m_enabled(::isatty(STDERR_FILENO) != 0),
+      m_show_after(show_after),
       m_start(std::chrono::steady_clock::now()),
       m_last(m_start) {}
 
@@ -20,12 +22,17 @@ ProgressBar::~ProgressBar() {
 void ProgressBar::update(unsigned long long done, unsigned long long total) {
     if (!m_enabled || total == 0) return;
     const auto now = std::chrono::steady_clock::now();
+    if (!m_updated) {
+        m_updated = true;
+        m_first = now;
+    }
     if (!m_started || done < m_last_done) {
         m_started = true;
         m_start = now;
         m_first_done = done;
     }
     m_last_done = done;
+    if (now - m_first < m_show_after) return;
     if (m_drawn && done < total && now - m_last < std::chrono::milliseconds(100)) return;
     m_last = now;
     const double elapsed = std::chrono::duration<double>(now - m_start).count();

@@ -105,14 +105,23 @@ class RenderProgress {
     void launches(unsigned done, unsigned total) {
         if (!m_wanted) return;
         m_several = m_several || total > 1;
+        m_load.finish();
         m_rows.finish();
         m_launches.update(done, total);
     }
+    /// A scene file being read: shown for loads over a second, in MB (10^6 bytes).
+    void load(const std::string& stage, uint64_t done, uint64_t total) {
+        if (!m_wanted) return;
+        m_load.set_label(stage);
+        m_load.update(done / 1000000, total / 1000000);
+    }
     void rows(const LaunchProgress& p) {
         if (!m_wanted || m_several) return;
+        m_load.finish();
         m_rows.update(p.rows_done, p.rows);
     }
     void finish() {
+        m_load.finish();
         m_rows.finish();
         m_launches.finish();
     }
@@ -121,6 +130,7 @@ class RenderProgress {
     bool m_wanted;
     bool m_several = false;
     ProgressBar m_rows{"render", "rows"}, m_launches{"render", "launches"};
+    ProgressBar m_load{"load", "MB", std::chrono::seconds(1)};
 };
 
 /// `render --json`: the settings asked for, where it ran, and the stages' times.
@@ -308,8 +318,11 @@ int run_render(const RenderArgs& args) {
     RenderProgress progress(talk);
     samples::RenderSettings run = settings;
     run.progress = [&progress](unsigned done, unsigned total) { progress.launches(done, total); };
-    if (progress.shown())
+    if (progress.shown()) {
         run.on_launch_progress = [&progress](const LaunchProgress& p) { progress.rows(p); };
+        run.on_load_progress = [&progress](const std::string& stage, uint64_t done,
+                                           uint64_t total) { progress.load(stage, done, total); };
+    }
     const Clock::time_point start = Clock::now();
     samples::RenderResult result = sample.render(run);
     progress.finish();

@@ -53,6 +53,9 @@ struct RenderSettings {
     /// Called as bands of rows of a launch finish on the CPU (ContextOptions::on_progress),
     /// e.g. for a viewer showing partial results; may be empty.
     std::function<void(const LaunchProgress&)> on_launch_progress;
+    /// Called as a large scene file is read (scene::LoadProgress), e.g. for a progress bar;
+    /// may be empty.
+    scene::LoadProgress on_load_progress;
 
     /// The image's width / height, for the pinhole camera.
     float aspect() const { return float(width) / float(height); }

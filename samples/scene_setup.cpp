@@ -10,7 +10,8 @@
 namespace lucent::samples {
 
 scene::Scene load_render_scene(const RenderSettings& settings) {
-    scene::Scene scene = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene);
+    scene::Scene scene = scene::load_scene(settings.scene.empty() ? "cornell" : settings.scene,
+                                             settings.on_load_progress);
     if (settings.scene_camera) {
         const unsigned n = *settings.scene_camera;
         const size_t count = scene.cameras.size();

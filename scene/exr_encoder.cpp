@@ -13,6 +13,9 @@
 
 #include <cstring>
 #include <set>
+
+#include "scene/exr_header_check.h"
+#include "scene/input_file.h"
 #endif
 
 namespace lucent::scene {
@@ -88,8 +91,10 @@ std::vector<unsigned char> encode_exr(const std::string& path, const Image& imag
 }
 
 ExrFile read_exr_file(const std::string& path) {
+    require_regular_file(path, "OpenEXR image");  // a FIFO would block OpenEXR's open
     try {
         Imf::InputFile file(path.c_str());
+        check_exr_header(path, file.header(), file_size(path));
         const Imath::Box2i window = file.header().dataWindow();
         ExrFile out;
         Image& image = out.image;
@@ -120,6 +125,8 @@ ExrFile read_exr_file(const std::string& path) {
             if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&a.attribute()))
                 out.attributes[a.name()] = text->value();
         return out;
+    } catch (const Error&) {
+        throw;
     } catch (const std::exception& e) {
         throw Error("cannot read '" + path + "': " + e.what());
     }

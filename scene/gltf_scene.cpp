@@ -75,6 +75,25 @@ bool load_image(tinygltf::Image* image, const int index, std::string* err, std::
     return true;
 }
 
+/// The files a .gltf names (buffers, images) are found and read by tinygltf, which opens
+/// them to see whether they exist (waiting for ever on a FIFO) and would read a device on
+/// and on: existence is asked of the file system, and each must be a regular file.
+bool named_file_exists(const std::string& path, void*) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+}
+
+/// `gltf_path` is the .gltf's path (the callbacks' user data), named first in the error.
+bool read_named_file(std::vector<unsigned char>* out, std::string* err,
+                     const std::string& path, void* gltf_path) {
+    try {
+        require_regular_file(path, "file named by the glTF");
+    } catch (const Error& e) {
+        throw Error(*static_cast<const std::string*>(gltf_path) + ": " + e.what());
+    }
+    return tinygltf::ReadWholeFile(out, err, path, nullptr);
+}
+
 class GltfReader {
   public:
     GltfReader(std::string path, const tinygltf::Model& model)
@@ -651,11 +670,22 @@ Scene load_gltf_scene(const std::string& path) {
         if (bytes.size() > 0xffffffffu) throw Error(path + ": larger than 4 GiB, glTF's limit");
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(load_image, nullptr);
+        loader.SetFsCallbacks({&named_file_exists, &tinygltf::ExpandFilePath, &read_named_file,
+                               &tinygltf::WriteWholeFile,
+                               const_cast<std::string*>(&path)});
         tinygltf::Model model;
         std::string err, warn;
         const std::string base = fs::path(path).parent_path().string();
         // By content, not by extension: a .gltf that is a GLB container reads as one.
         const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+        // JSON text holds no NUL byte, and the JSON parser ends its input at one: what
+        // follows it would be ignored without a word.
+        if (!binary)
+            if (const void* nul = std::memchr(bytes.data(), 0, bytes.size()))
+                throw Error(path + ": a NUL byte at byte " +
+                            std::to_string(static_cast<const unsigned char*>(nul) - bytes.data()) +
+                            ": a .gltf file is JSON text (this one is damaged, sparse or not "
+                            "glTF)");
         const bool ok =
             binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                                  unsigned(bytes.size()), base)

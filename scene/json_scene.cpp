@@ -3,6 +3,7 @@
 // errors name the file and the JSON location ("/lights/1/position") and what is expected.
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -143,9 +144,24 @@ json parse_file(const std::string& path) {
     require_regular_file(path, "scene file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open the scene file (check the path)");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    const std::string text = buffer.str();
+    // Read in 1 MiB blocks, each checked for a NUL byte: nlohmann-json ends its input at
+    // one, so a scene followed by binary data was accepted without it, and a sparse file
+    // was read whole (a 1 GB one took 2 GB) before failing at its first byte.
+    std::string text;
+    text.reserve(size_t(file_size(path)));
+    std::vector<char> block(size_t(1) << 20);
+    while (in.read(block.data(), std::streamsize(block.size())) || in.gcount() > 0) {
+        const size_t n = size_t(in.gcount());
+        if (const void* nul = std::memchr(block.data(), '\0', n)) {
+            text.append(block.data(), size_t(static_cast<const char*>(nul) - block.data()));
+            size_t line = 1, column = 1;
+            for (char c : text) c == '\n' ? (++line, column = 1) : ++column;
+            throw Error(path + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                        ": a NUL byte: a scene file is JSON text (this one is damaged, sparse "
+                        "or not JSON)");
+        }
+        text.append(block.data(), n);
+    }
     try {
         return json::parse(text, DuplicateKeyCheck(path));
     } catch (const json::parse_error& e) {
@@ -237,18 +253,20 @@ void read_instances(const JsonReader& r, const json& list,
 }  // namespace
 
 namespace detail {
-Scene read_json_scene(const std::string& path, const nlohmann::json& root);
+Scene read_json_scene(const std::string& path, const nlohmann::json& root,
+                      const LoadProgress& progress);
 }
 
-Scene load_json_scene(const std::string& path) {
+Scene load_json_scene(const std::string& path, const LoadProgress& progress) {
     try {
-        return detail::read_json_scene(path, parse_file(path));
+        return detail::read_json_scene(path, parse_file(path), progress);
     } catch (const json::exception& e) {  // a value of a type the checks above did not expect
         throw Error(path + ": " + e.what());
     }
 }
 
-Scene detail::read_json_scene(const std::string& path, const nlohmann::json& root) {
+Scene detail::read_json_scene(const std::string& path, const nlohmann::json& root,
+                              const LoadProgress& progress) {
     JsonReader r(path);
     if (!root.is_object())
         r.fail("/", "a scene is a JSON object with camera, materials, meshes, lights");
@@ -341,11 +359,11 @@ Scene detail::read_json_scene(const std::string& path, const nlohmann::json& roo
             const fs::path file = r.resolve(m["file"].get<std::string>());
             Scene part;
             if (file.extension() == ".ply") {
-                part.meshes.push_back(load_ply_mesh(file.string()));
+                part.meshes.push_back(load_ply_mesh(file.string(), progress));
                 part.materials.push_back(
                     Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
             } else {
-                part = load_obj_scene(file.string());
+                part = load_obj_scene(file.string(), progress);
             }
             const unsigned base = unsigned(scene.materials.size());
             scene.materials.insert(scene.materials.end(), part.materials.begin(),

@@ -12,10 +12,10 @@
 namespace lucent::scene {
 
 ObjMesh load_obj_mesh(const std::string& path) {
-    tinyobj::ObjReader reader = read_obj(path, /*with_materials=*/false);
+    const ObjData obj = read_obj(path, /*with_materials=*/false);
 
     ObjMesh mesh;
-    const std::vector<float>& v = reader.GetAttrib().vertices;
+    const std::vector<float>& v = obj.attrib.vertices;
     const size_t vertex_count = v.size() / 3;
     mesh.positions.resize(vertex_count);
     for (size_t i = 0; i < vertex_count; ++i) {
@@ -27,7 +27,7 @@ ObjMesh load_obj_mesh(const std::string& path) {
     }
 
     size_t face = 0;  // faces in file order, across shapes
-    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    for (const tinyobj::shape_t& shape : obj.shapes) {
         const tinyobj::mesh_t& m = shape.mesh;
         size_t offset = 0;
         for (size_t f = 0; f < m.num_face_vertices.size(); ++f, ++face) {

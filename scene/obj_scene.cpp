@@ -3,13 +3,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <tuple>
 
 #include "lucent/error.h"
 #include "scene/input_file.h"
 #include "scene/obj_reader.h"
 #include "scene/scene.h"
+#include "scene/vertex_unifier.h"
 
 namespace lucent::scene {
 
@@ -29,43 +28,25 @@ std::string locate(const std::vector<std::string>& files, const std::string& key
     return files.empty() ? std::string("(no MTL file)") : files.front() + ":0";
 }
 
-/// The MTL files the OBJ names (mtllib), with the line of each.
-std::vector<std::pair<std::string, size_t>> mtllibs(const std::string& path) {
-    std::vector<std::pair<std::string, size_t>> out;
-    std::ifstream in(path);
-    std::string line;
-    for (size_t n = 1; std::getline(in, line); ++n) {
-        size_t s = line.find_first_not_of(" \t");
-        if (s == std::string::npos || line.compare(s, 6, "mtllib") != 0) continue;
-        std::string name = line.substr(s + 6);
-        name.erase(0, name.find_first_not_of(" \t"));
-        while (!name.empty() && (name.back() == '\r' || name.back() == ' ')) name.pop_back();
-        out.emplace_back((fs::path(path).parent_path() / name).string(), n);
-    }
-    return out;
-}
-
 float3 to_float3(const tinyobj::real_t v[3]) {
     return make_float3(v[0], v[1], v[2]);
 }
 }  // namespace
 
-Scene load_obj_scene(const std::string& path) {
+Scene load_obj_scene(const std::string& path, const LoadProgress& progress) {
     require_regular_file(path, "OBJ file");
-    const auto libs = mtllibs(path);
-    for (const auto& [file, line] : libs) require_regular_file(file, "MTL file");
-    for (const auto& [file, line] : libs)
+    const ObjData obj = read_obj(path, /*with_materials=*/true, progress);
+    for (const auto& [file, line] : obj.mtllibs)
         if (!fs::exists(file))
             fail(path, line,
                  "material library '" + fs::path(file).filename().string() +
                      "' not found next to the OBJ file");
-    tinyobj::ObjReader reader = read_obj(path, /*with_materials=*/true);
     std::vector<std::string> mtl_files;
-    for (const auto& lib : libs) mtl_files.push_back(lib.first);
+    for (const auto& lib : obj.mtllibs) mtl_files.push_back(lib.first);
 
     Scene scene;
     scene.name = fs::path(path).stem().string();
-    for (const tinyobj::material_t& m : reader.GetMaterials()) {
+    for (const tinyobj::material_t& m : obj.materials) {
         Material material;
         material.name = m.name;
         material.diffuse = to_float3(m.diffuse);
@@ -87,13 +68,14 @@ Scene load_obj_scene(const std::string& path) {
     const unsigned fallback = unsigned(scene.materials.size());  // faces without usemtl
     scene.materials.push_back(Material{"default", {0.8f, 0.8f, 0.8f}, {0, 0, 0}, 0, {0, 0, 0}, ""});
 
-    const tinyobj::attrib_t& attrib = reader.GetAttrib();
+    const tinyobj::attrib_t& attrib = obj.attrib;
     const size_t vertex_count = attrib.vertices.size() / 3;
     size_t face = 0;
-    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    VertexUnifier unified(vertex_count);
+    for (const tinyobj::shape_t& shape : obj.shapes) {
         Mesh mesh;
         mesh.name = shape.name;
-        std::map<std::tuple<int, int, int>, unsigned> unified;
+        unified.next_mesh();
         bool has_normals = !attrib.normals.empty(), has_uvs = !attrib.texcoords.empty();
         auto vertex = [&](const tinyobj::index_t& i) -> unsigned {
             if (i.vertex_index < 0 || size_t(i.vertex_index) >= vertex_count)
@@ -104,8 +86,9 @@ Scene load_obj_scene(const std::string& path) {
                 (i.texcoord_index >= 0 && size_t(i.texcoord_index) >= attrib.texcoords.size() / 2))
                 fail(path, line_of_statement(path, "f", face),
                      "face refers to a normal or texture coordinate the file does not have");
-            auto key = std::make_tuple(i.vertex_index, i.normal_index, i.texcoord_index);
-            auto [it, inserted] = unified.emplace(key, unsigned(mesh.positions.size()));
+            const auto [index, inserted] = unified.find(i.vertex_index, i.normal_index,
+                                                        i.texcoord_index,
+                                                        unsigned(mesh.positions.size()));
             if (inserted) {
                 const float* p = &attrib.vertices[3 * size_t(i.vertex_index)];
                 mesh.positions.push_back(make_float3(p[0], p[1], p[2]));
@@ -122,7 +105,7 @@ Scene load_obj_scene(const std::string& path) {
                     mesh.uvs.push_back(t ? make_float2(t[0], t[1]) : make_float2(0, 0));
                 }
             }
-            return it->second;
+            return index;
         };
         size_t offset = 0;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++face) {

@@ -10,6 +10,7 @@
 
 #include "lucent/device/types.h"
 #include "lucent/device/vector_math.h"
+#include "scene/load_progress.h"
 #include "scene/texture_image.h"
 
 namespace lucent::scene {
@@ -149,8 +150,9 @@ std::vector<std::string> builtin_scene_names();
 
 /// A built-in scene by name, or a file: .obj (with its .mtl), .ply, .json, .gltf or .glb.
 /// Throws lucent::Error naming the file (and line, or JSON location) and the fix for
-/// anything malformed.
-Scene load_scene(const std::string& name_or_path);
+/// anything malformed. `progress` hears of the bytes read of large OBJ, PLY and JSON-named
+/// mesh files (docs/scenes.md gives the rates).
+Scene load_scene(const std::string& name_or_path, const LoadProgress& progress = {});
 
 /// The Cornell box with its two blocks (Goral et al. 1984, measured data of the Cornell
 /// Program of Computer Graphics), in millimetres; lit by its ceiling light as an area light,
@@ -162,14 +164,14 @@ Scene cornell_box(bool area_light);
 Scene cornell_materials_box();
 
 /// OBJ + MTL through tinyobjloader (polygons fanned into triangles).
-Scene load_obj_scene(const std::string& path);
+Scene load_obj_scene(const std::string& path, const LoadProgress& progress = {});
 
 /// A PLY mesh (ASCII or binary): positions, optional normals and uvs, faces fanned into
 /// triangles, all with material 0.
-Mesh load_ply_mesh(const std::string& path);
+Mesh load_ply_mesh(const std::string& path, const LoadProgress& progress = {});
 
 /// A JSON scene description; see docs/scenes.md.
-Scene load_json_scene(const std::string& path);
+Scene load_json_scene(const std::string& path, const LoadProgress& progress = {});
 
 /// A glTF 2.0 scene (.gltf with its buffers and images, or .glb) through tinygltf: its node
 /// hierarchy flattened into instances, metallic-roughness materials, base-colour textures,

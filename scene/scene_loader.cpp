@@ -88,16 +88,16 @@ Scene single_mesh_scene(Mesh mesh) {
 }
 }  // namespace
 
-Scene load_scene(const std::string& name_or_path) {
+Scene load_scene(const std::string& name_or_path, const LoadProgress& progress) {
     if (name_or_path == "cornell") return cornell_box(/*area_light=*/true);
     if (name_or_path == "cornell-point") return cornell_box(/*area_light=*/false);
     if (name_or_path == "cornell-materials") return cornell_materials_box();
     std::string ext = std::filesystem::path(name_or_path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".obj") return load_obj_scene(name_or_path);
-    if (ext == ".json") return load_json_scene(name_or_path);
-    if (ext == ".ply") return single_mesh_scene(load_ply_mesh(name_or_path));
+    if (ext == ".obj") return load_obj_scene(name_or_path, progress);
+    if (ext == ".json") return load_json_scene(name_or_path, progress);
+    if (ext == ".ply") return single_mesh_scene(load_ply_mesh(name_or_path, progress));
     if (ext == ".gltf" || ext == ".glb") return load_gltf_scene(name_or_path);
     std::string names;
     for (const std::string& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;

@@ -1,8 +1,15 @@
-// OpenEXR output: float pixels survive the round trip exactly (no 8-bit or half rounding).
+// OpenEXR output: float pixels survive the round trip exactly (no 8-bit or half rounding);
+// input: files that are not regular or whose header claims more than they hold are refused.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+
+#include "test_support.h"
 
 #include "lucent/error.h"
 #include "scene/exr_encoder.h"
@@ -86,4 +93,84 @@ TEST(Exr, ExtrasNeedAnExrAndChannelsOfThePixelCount) {
     EXPECT_THROW(lucent::scene::encode_exr("x.exr", image, extras), lucent::Error);
 }
 
+/// An uncompressed scanline OpenEXR file of float R, G, B (OpenEXR's file layout: magic,
+/// version, attributes, offset table, chunks) declaring `width` x `height` pixels but
+/// holding only `lines` of them: what a damaged or hostile file looks like.
+std::string exr_claiming(int width, int height, int lines) {
+    std::string out("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+    auto put = [&](const void* p, size_t n) { out.append(static_cast<const char*>(p), n); };
+    auto i32 = [&](int32_t v) { put(&v, 4); };
+    auto attribute = [&](const char* name, const char* type, const std::string& value) {
+        put(name, std::strlen(name) + 1);
+        put(type, std::strlen(type) + 1);
+        i32(int32_t(value.size()));
+        out += value;
+    };
+    std::string channels;
+    for (const char* c : {"B", "G", "R"}) {
+        channels.append(c, 2);
+        const int32_t fields[4] = {2 /* FLOAT */, 0 /* pLinear and reserved */, 1, 1};
+        channels.append(reinterpret_cast<const char*>(fields), sizeof fields);
+    }
+    channels += '\0';
+    const int32_t window[4] = {0, 0, width - 1, height - 1};
+    const std::string box(reinterpret_cast<const char*>(window), sizeof window);
+    const float one = 1, centre[2] = {0, 0};
+    attribute("channels", "chlist", channels);
+    attribute("compression", "compression", std::string(1, '\0'));
+    attribute("dataWindow", "box2i", box);
+    attribute("displayWindow", "box2i", box);
+    attribute("lineOrder", "lineOrder", std::string(1, '\0'));
+    attribute("pixelAspectRatio", "float", std::string(reinterpret_cast<const char*>(&one), 4));
+    attribute("screenWindowCenter", "v2f", std::string(reinterpret_cast<const char*>(centre), 8));
+    attribute("screenWindowWidth", "float", std::string(reinterpret_cast<const char*>(&one), 4));
+    out += '\0';
+    const uint64_t row = uint64_t(width) * 12, first = out.size() + 8 * uint64_t(height);
+    for (int y = 0; y < height; ++y) {
+        const uint64_t at = first + uint64_t(y) * (8 + row);
+        put(&at, 8);
+    }
+    for (int y = 0; y < lines; ++y) {
+        i32(y);
+        i32(int32_t(row));
+        out += std::string(row, '\0');
+    }
+    return out;
+}
+
+class ExrInput : public lucent_tests::TempDirTest {
+  protected:
+    static std::string error_of(const std::string& path) {
+        try {
+            lucent::scene::read_exr(path);
+        } catch (const lucent::Error& e) {
+            return e.what();
+        }
+        return "";
+    }
+};
+
+TEST_F(ExrInput, HeadersThatClaimMoreThanTheFileHoldsAreRefusedBeforeReading) {
+    if (!lucent::scene::exr_supported()) GTEST_SKIP() << "built without OpenEXR";
+    // The writer is right: a whole 4 x 2 file reads.
+    const std::string whole = write("whole.exr", exr_claiming(4, 2, 2));
+    EXPECT_EQ(error_of(whole), "");
+    EXPECT_EQ(lucent::scene::read_exr(whole).width, 4u);
+    // 10^10 pixels in 1.2 MB asked for 120 GB (std::bad_alloc); 11,000 x 11,000 in 132 KB
+    // took 1.4 GB before OpenEXR found the lines missing.
+    const std::string huge = write("huge.exr", exr_claiming(100000, 100000, 1));
+    EXPECT_EQ(error_of(huge), "cannot read '" + huge + "': it declares 100000 x 100000 pixels, "
+                              "more than the 134217728 an image may have; resize it (or check "
+                              "that the file is not damaged)");
+    const std::string short_file = write("short.exr", exr_claiming(11000, 11000, 1));
+    EXPECT_NE(error_of(short_file).find("it declares 11000 x 11000 pixels, which need at least "
+                                        "1452176000 bytes, but the file has"),
+              std::string::npos)
+        << error_of(short_file);
+    ASSERT_EQ(::mkfifo((dir / "pipe.exr").c_str(), 0600), 0);
+    EXPECT_NE(error_of((dir / "pipe.exr").string()).find("this OpenEXR image is a FIFO"),
+              std::string::npos);
+}
+
 }  // namespace
+

@@ -14,6 +14,9 @@
 #include <unistd.h>
 
 #include "lucent/context.h"
+#include <sys/stat.h>
+
+#include "test_support.h"
 #include "lucent/error.h"
 #include "samples/sample.h"
 #include "samples/scene_setup.h"
@@ -103,17 +106,8 @@ std::string glb(std::string json, std::string bin) {
     return out;
 }
 
-class GltfScenes : public ::testing::Test {
+class GltfScenes : public lucent_tests::TempDirTest {
   protected:
-    void SetUp() override {
-        dir = fs::temp_directory_path() / ("lucent-gltf-test-" + std::to_string(::getpid()));
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-    std::string write(const std::string& name, const std::string& bytes) {
-        std::ofstream(dir / name, std::ios::binary) << bytes;
-        return (dir / name).string();
-    }
     static std::string error_of(const std::string& path) {
         try {
             lucent::scene::load_scene(path);
@@ -122,18 +116,9 @@ class GltfScenes : public ::testing::Test {
         }
         return "";
     }
-    fs::path dir;
 };
 
 float3 world(const lucent::scene::Instance& i, float3 p) { return transform_point(i.transform, p); }
-
-#define EXPECT_FLOAT3_NEAR(a, b, eps)       \
-    do {                                    \
-        const float3 a_ = (a), b_ = (b);    \
-        EXPECT_NEAR(a_.x, b_.x, eps) << #a; \
-        EXPECT_NEAR(a_.y, b_.y, eps) << #a; \
-        EXPECT_NEAR(a_.z, b_.z, eps) << #a; \
-    } while (0)
 
 // Node 0 draws the square moved by +2 in x; node 1 is a parent rotated 90 degrees about z
 // and scaled 2x, with node 2 (the square again, moved +1 in x in its parent's frame).
@@ -275,6 +260,29 @@ TEST_F(GltfScenes, ExternalBufferAndImageFilesAreReadBesideTheGltfFile) {
     testing::internal::GetCapturedStderr();
     EXPECT_EQ(error.rfind((dir / "external.gltf").string() + ": ", 0), 0u) << error;
     EXPECT_NE(error.find("images[0]: 'green.png' was not loaded"), std::string::npos) << error;
+}
+
+TEST_F(GltfScenes, NamedFilesThatAreFifosOrDevicesAreRefusedByName) {
+    // tinygltf opened a named file to see whether it exists: a FIFO nobody writes to
+    // blocked it for ever; /dev/zero was "empty". Each is now an error naming both files.
+    std::string text = gltf(std::string(kSquareMesh));
+    const size_t b = text.find("\"uri\": \"data:");
+    ASSERT_NE(b, std::string::npos);
+    text.replace(b, text.find('"', b + 8) + 1 - b, "\"uri\": \"buffer.bin\"");
+    const std::string path = write("named.gltf", text);
+    ASSERT_EQ(::mkfifo((dir / "buffer.bin").c_str(), 0600), 0);
+    EXPECT_EQ(error_of(path), path + ": " + (dir / "buffer.bin").string() +
+                                  ": this file named by the glTF is a FIFO (named pipe), not a "
+                                  "file; Lucent reads scenes, meshes and textures only from "
+                                  "regular files (copy the data into one)");
+    fs::remove(dir / "buffer.bin");
+    // A .gltf followed by binary data: the JSON parser stopped at the NUL byte.
+    const std::string padded = write("padded.gltf", gltf(kSquareMesh) + std::string(8, '\0') + "x");
+    EXPECT_EQ(error_of(padded).rfind(padded + ": a NUL byte at byte ", 0), 0u) << error_of(padded);
+    fs::create_symlink("/dev/zero", dir / "buffer.bin");
+    EXPECT_NE(error_of(path).find("buffer.bin: this file named by the glTF is a device"),
+              std::string::npos)
+        << error_of(path);
 }
 
 const char* kCameras = R"(,

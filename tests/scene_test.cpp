@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "test_support.h"
 #include "lucent/error.h"
 #include "scene/scene.h"
 #include "scene/texture_image.h"
@@ -17,17 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 using lucent::scene::load_scene;
 
-class SceneFiles : public ::testing::Test {
+class SceneFiles : public lucent_tests::TempDirTest {
   protected:
-    void SetUp() override {
-        dir = fs::temp_directory_path() / ("lucent-scene-test-" + std::to_string(::getpid()));
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-    std::string write(const std::string& name, const std::string& text) {
-        std::ofstream(dir / name) << text;
-        return (dir / name).string();
-    }
     /// The message of the lucent::Error that loading `path` throws ("" if none).
     static std::string error_of(const std::string& path) {
         try {
@@ -37,7 +30,6 @@ class SceneFiles : public ::testing::Test {
         }
         return "";
     }
-    fs::path dir;
 };
 
 TEST_F(SceneFiles, JsonFindsMeshFilesOnTheScenePath) {
@@ -149,6 +141,70 @@ TEST_F(SceneFiles, FifosDevicesAndFoldersAreRefusedNotReadForEver) {
     ASSERT_EQ(::mkfifo((dir / "m.mtl").c_str(), 0600), 0);
     const std::string obj = write("lib.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     EXPECT_NE(error_of(obj).find("MTL file is a FIFO"), std::string::npos) << error_of(obj);
+}
+
+TEST_F(SceneFiles, BinaryDataAndEndlessLinesInTextFilesAreRefusedByLine) {
+    // A sparse OBJ (64 MiB of NUL bytes here; the issue's 1 GB one ran past 60 s at 2 GB)
+    // is refused at its first line; so is one line longer than 1 MiB, and an MTL of zeros.
+    const std::string sparse = write("sparse.obj", "");
+    fs::resize_file(sparse, 64u << 20);
+    EXPECT_EQ(error_of(sparse), sparse + ":1: a NUL byte: this OBJ file holds binary data, not "
+                                         "text (a damaged, sparse or misnamed file)");
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const std::string endless = write("endless.obj", tri + "# " + std::string(2u << 20, 'x'));
+    EXPECT_EQ(error_of(endless), endless + ":5: a line longer than 1048576 bytes; the OBJ file "
+                                           "is damaged or not text");
+    // JSON: nlohmann-json ended its input at a NUL byte, so what followed was ignored.
+    const std::string json = write("s.json", std::string(R"({"meshes": [{"file": "tri.obj"}]})") +
+                                                 "\n" + std::string(64, '\0') + "garbage");
+    EXPECT_EQ(error_of(json), json + ":2:1: a NUL byte: a scene file is JSON text (this one is "
+                                     "damaged, sparse or not JSON)");
+    write("zeros.mtl", std::string("newmtl a\n") + std::string(100, '\0'));
+    const std::string with_mtl = write("m.obj", "mtllib zeros.mtl\n" + tri);
+    EXPECT_NE(error_of(with_mtl).find("zeros.mtl:2: a NUL byte: this MTL file"), std::string::npos)
+        << error_of(with_mtl);
+}
+
+TEST_F(SceneFiles, AnObjLoadReportsItsBytesAndGivesTheSameMesh) {
+    // 80,000 vertices and 40,000 faces (about 2 MB): each pass over the file (the check,
+    // then tinyobjloader's) reports its bytes, increasing, ending at the file's size.
+    std::string text;
+    for (int i = 0; i < 80000; ++i)
+        text += "v " + std::to_string(i % 200) + " " + std::to_string(i / 200) + " 0.125\n";
+    for (int f = 0; f < 40000; ++f)
+        text += "f " + std::to_string(2 * f + 1) + " " + std::to_string(2 * f + 2) + " " +
+                std::to_string((2 * f + 200) % 80000 + 1) + "\n";
+    const std::string path = write("big.obj", text);
+    std::map<std::string, std::vector<std::pair<uint64_t, uint64_t>>> stages;
+    const auto scene = load_scene(path, [&](const std::string& stage, uint64_t done, uint64_t total) {
+        stages[stage].emplace_back(done, total);
+    });
+    ASSERT_EQ(stages.size(), 2u);
+    for (const char* stage : {"checking big.obj", "reading big.obj"}) {
+        const auto& calls = stages[stage];
+        ASSERT_GE(calls.size(), 2u) << stage;  // 1 MiB blocks: at least two of them
+        for (size_t i = 1; i < calls.size(); ++i) EXPECT_GE(calls[i].first, calls[i - 1].first);
+        EXPECT_EQ(calls.back().first, text.size()) << stage;
+        EXPECT_EQ(calls.back().second, text.size()) << stage;
+    }
+    ASSERT_GT(text.size(), 1u << 20) << "two 1 MiB blocks at least";
+    EXPECT_EQ(scene.triangle_count(), 40000u);
+    EXPECT_EQ(load_scene(path).meshes[0].positions.size(), scene.meshes[0].positions.size());
+}
+
+TEST_F(SceneFiles, VerticesAreUnifiedPerPositionNormalAndUv) {
+    // Position 1 with normal 1 in both faces is one vertex; position 2 with normals 1 and 2
+    // is two; the quad's fan shares its first vertex.
+    const auto scene = load_scene(write(
+        "u.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 1 0\n"
+                 "f 1//1 2//1 3//1\nf 1//1 2//2 4//1\nf 1//1 3//1 4//1 2//1\n"));
+    const auto& mesh = scene.meshes.at(0);
+    ASSERT_EQ(mesh.indices.size(), 4u);
+    EXPECT_EQ(mesh.positions.size(), 5u);  // 1/1, 2/1, 3/1, 2/2, 4/1
+    EXPECT_EQ(mesh.indices[0].x, mesh.indices[1].x);
+    EXPECT_NE(mesh.indices[0].y, mesh.indices[1].y);  // 2//1 against 2//2
+    EXPECT_EQ(mesh.indices[0].y, mesh.indices[3].z);  // 2//1 again
+    EXPECT_FLOAT_EQ(mesh.normals[mesh.indices[1].y].y, 1.0f);
 }
 
 TEST_F(SceneFiles, ATextureThatClaimsAHugeSizeIsRefusedFromItsHeader) {

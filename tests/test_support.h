@@ -14,6 +14,10 @@
 #include <vector>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 #include "lucent.h"
 #include "tests/programs/common.h"
@@ -166,6 +170,28 @@ inline Matrix4x3 scaling(float x, float y, float z) {
 inline CastRay cast_ray(float3 origin, float3 direction) {
     return CastRay{origin, direction};
 }
+
+/// A folder of the running test's own (under the system's temporary folder, named by suite,
+/// test and process, so parallel ctest runs do not share one), removed at the end; the
+/// scene and image loaders' tests write their files into it.
+class TempDirTest : public testing::Test {
+  protected:
+    void SetUp() override {
+        const testing::TestInfo* test = testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = std::string("lucent-") + test->test_suite_name() + "-" + test->name() +
+                           "-" + std::to_string(::getpid());
+        std::replace(name.begin(), name.end(), '/', '_');  // parameterised tests' names
+        dir = std::filesystem::temp_directory_path() / name;
+        std::filesystem::create_directories(dir);
+    }
+    void TearDown() override { std::filesystem::remove_all(dir); }
+    /// Writes `bytes` to the file `name` in the folder; returns its path.
+    std::string write(const std::string& name, const std::string& bytes) const {
+        std::ofstream(dir / name, std::ios::binary) << bytes;
+        return (dir / name).string();
+    }
+    std::filesystem::path dir;
+};
 
 /// A CPU context with one entry point (the shared caster), ray type 0 carrying
 /// TestPayload, and the shared miss program: cast(top, rays) traces and returns payloads.

@@ -12,11 +12,13 @@ exe="$build/${name}_fuzzer"
 scene_sources=("$root/scene/scene_loader.cpp" "$root/scene/json_scene.cpp" "$root/scene/obj_scene.cpp"
                "$root/scene/obj_reader.cpp" "$root/scene/cornell_box.cpp" "$root/scene/cornell_materials.cpp"
                "$root/scene/ply_mesh.cpp" "$root/scene/scene_framing.cpp" "$root/scene/input_file.cpp"
-               "$root/scene/gltf_scene.cpp" "$root/scene/texture_image.cpp" "$root/scene/exr_encoder.cpp")
+               "$root/scene/line_reader.cpp" "$root/scene/progress_stream.cpp"
+               "$root/scene/gltf_scene.cpp" "$root/scene/texture_image.cpp" "$root/scene/exr_encoder.cpp"
+               "$root/scene/exr_header_check.cpp")
 defines=()
 case $name in
   obj_mesh) sources=("$here/obj_mesh_fuzzer.cpp" "$root/scene/obj_mesh.cpp" "$root/scene/obj_reader.cpp"
-                    "$root/scene/input_file.cpp")
+                    "$root/scene/input_file.cpp" "$root/scene/line_reader.cpp" "$root/scene/progress_stream.cpp")
             corpus_name=obj ;;
   scene_obj) sources=("$here/scene_fuzzer.cpp" "${scene_sources[@]}"); defines=(-DLUCENT_FUZZ_EXTENSION='".obj"')
              corpus_name=obj ;;
