@@ -1,16 +1,17 @@
 #include "camera_flags.h"
 
-#include <cstdio>
+#include <charconv>
 
 #include "cli_parse.h"
 
 namespace lucent::cli {
 namespace {
 
+/// The shortest text that reads back as exactly `v` (std::to_chars' guarantee).
 std::string number(float v) {
     char text[32];
-    std::snprintf(text, sizeof text, "%.9g", double(v));
-    return text;
+    const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+    return std::string(text, end);
 }
 
 std::string vec(float3 v) {

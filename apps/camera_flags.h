@@ -21,8 +21,8 @@ void add_camera_flags(CLI::App* cmd, CameraFlags& flags);
 /// The given flags, checked (UsageError naming the flag and the expected form).
 samples::CameraOverride parse_camera_flags(const CameraFlags& flags);
 
-/// "--eye 1,2,3 --look 0,0,0 --up 0,1,0 --fov 45", each number with 9 significant digits
-/// (enough for any float to read back exactly).
+/// "--eye 1,2,3 --look 0,0,0 --up 0,1,0 --fov 45", each number the shortest text that
+/// reads back as the same float.
 std::string camera_flags(const scene::Camera& camera);
 
 }  // namespace lucent::cli

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "scene/exr_encoder.h"
+#include "scene/image_io.h"
 
 #include <algorithm>
 #include <charconv>
@@ -119,27 +120,14 @@ std::pair<std::string, std::string> parse_set(const std::string& flag, const std
     return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
-std::span<const ImageFormat> image_formats() {
-    // What scene::write_image writes, by extension.
-    static constexpr ImageFormat kFormats[] = {
-        {".png", "8-bit sRGB"}, {".exr", "OpenEXR, float"}, {".pfm", "32-bit float"}};
-    return kFormats;
-}
-
 void check_image_path(const std::string& flag, const std::string& path) {
     namespace fs = std::filesystem;
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    const auto formats = image_formats();
-    if (std::none_of(formats.begin(), formats.end(),
-                     [&](const ImageFormat& f) { return ext == f.extension; })) {
-        std::string names;
-        for (size_t i = 0; i < formats.size(); ++i)
-            names += std::string(i == 0 ? "" : i + 1 == formats.size() ? " or " : ", ") +
-                     formats[i].extension + " (" + formats[i].what + ")";
-        throw UsageError(flag + " " + quoted(path) + ": the file name must end in " + names);
-    }
+    if (!scene::has_image_extension(path))
+        throw UsageError(flag + " " + quoted(path) + ": the file name " +
+                         scene::image_formats_text());
     if (ext == ".exr" && !scene::exr_supported())
         throw UsageError(flag + " " + quoted(path) +
                          ": this build has no OpenEXR (install libopenexr-dev); use .pfm");

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <stdexcept>
-#include <span>
 #include <string>
 #include <utility>
 
@@ -28,14 +27,6 @@ struct Size {
 
 constexpr unsigned kMaxImageSide = 16384;
 
-/// An image file type the writers support (scene::write_image): its extension, lower case.
-struct ImageFormat {
-    const char* extension;
-    const char* what;  // "8-bit sRGB"
-};
-/// Every one, in the order the errors list them: .png, .exr, .pfm.
-std::span<const ImageFormat> image_formats();
-
 /// "1024x768" → {1024, 768}; each side in [1, kMaxImageSide].
 Size parse_size(const std::string& flag, const std::string& text);
 /// "1,2.5,-3" → float3; three finite numbers.
@@ -55,7 +46,7 @@ std::string quoted(const std::string& text);
 int parse_sm(const std::string& flag, const std::string& text);
 /// "name=value" → {name, value}; the name is non-empty, the value may be empty.
 std::pair<std::string, std::string> parse_set(const std::string& flag, const std::string& text);
-/// An image path whose extension is one of image_formats() (and .exr only in a build with
+/// An image path whose extension is one of scene::image_formats() (and .exr only in a build with
 /// OpenEXR) in a directory that exists.
 void check_image_path(const std::string& flag, const std::string& path);
 
