@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <random>
 #include <vector>
@@ -48,6 +49,25 @@ TEST(Svgf, ARestingCameraConvergesTowardTheReferenceFasterThanWithoutHistory) {
     double last4 = 0;
     for (int f = 12; f < 16; ++f) last4 += error[size_t(f)] / 4;
     EXPECT_LT(last4, error[0] / 8) << error[0] << " -> " << last4;
+}
+
+TEST(Svgf, TheViewersDenoisedMegakernelCompilesForSm90) {
+#if !LUCENT_HAVE_CUDA
+    GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
+#else
+    ::setenv("LUCENT_CACHE_DIR", "off", 1);  // a real NVRTC compile, not a cache hit
+    RenderSettings settings = cornell(8, 0);
+    settings.jit_check_sm = 90;
+    auto session = lucent::samples::find_sample("pathtracer").open(settings);
+    for (auto d : {lucent::samples::ViewDenoiser::kSvgf, lucent::samples::ViewDenoiser::kAtrous}) {
+        session->set_denoiser(d);
+        lucent::samples::FrameResult frame;
+        ASSERT_NO_THROW(frame = session->frame()) << lucent::samples::view_denoiser_name(d);
+        EXPECT_EQ(frame.image.pixels.size(), 64u);
+        // The first switch added the G-buffer and both denoisers: a megakernel with them.
+        if (d == lucent::samples::ViewDenoiser::kSvgf) EXPECT_GT(frame.report.jit_ms, 0.0);
+    }
+#endif
 }
 
 // A synthetic scene the test ray-casts itself: a wall at z = -10 and, in front of it, a
