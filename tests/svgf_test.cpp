@@ -16,6 +16,7 @@
 #include "samples/sample.h"
 #include "samples/svgf_denoiser.h"
 #include "scene/image_compare.h"
+#include "test_support.h"
 
 namespace {
 
@@ -24,7 +25,7 @@ using lucent::samples::RenderSettings;
 RenderSettings cornell(unsigned size, unsigned spp) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.threads = 2;
     settings.spp = spp;
     return settings;
@@ -57,6 +58,7 @@ TEST(Svgf, TheViewersDenoisedMegakernelCompilesForSm90) {
 #else
     ::setenv("LUCENT_CACHE_DIR", "off", 1);  // a real NVRTC compile, not a cache hit
     RenderSettings settings = cornell(8, 0);
+    settings.backend = lucent::BackendKind::kCpu;  // the CPU runs it; NVRTC compiles it too
     settings.jit_check_sm = 90;
     auto session = lucent::samples::find_sample("pathtracer").open(settings);
     for (auto d : {lucent::samples::ViewDenoiser::kSvgf, lucent::samples::ViewDenoiser::kAtrous}) {
@@ -102,8 +104,7 @@ Hit pixel_hit(const sample_common::PinholeCamera& c, unsigned x, unsigned y) {
 }
 
 TEST(Svgf, ACameraMoveKeepsTheHistoryOfSurfacesSeenInBothFramesAndRestartsUncoveredOnes) {
-    lucent::ContextOptions options{lucent::BackendKind::kCpu, 2};
-    lucent::Context ctx(options);
+    lucent::Context ctx(lucent_tests::test_context_options());
     auto image = [&] { return ctx.create_buffer<float4>(lucent::BufferType::kInputOutput, kW, kH); };
     lucent::samples::AtrousDenoiser::Guides guides{image(), image(), image()};
     auto colour = image();
