@@ -24,8 +24,7 @@ void add_camera_flags(CLI::App* cmd, CameraFlags& flags) {
     cmd->add_option("--eye", flags.eye, "Camera position, over the scene's")->type_name("X,Y,Z");
     cmd->add_option("--look", flags.look, "Point the camera looks at, over the scene's")
         ->type_name("X,Y,Z");
-    cmd->add_option("--up", flags.up, "Camera up direction, over the scene's")
-        ->type_name("X,Y,Z");
+    cmd->add_option("--up", flags.up, "Camera up direction, over the scene's")->type_name("X,Y,Z");
     cmd->add_option("--fov", flags.fov,
                     "Vertical field of view in degrees, (0, 180), over the scene's")
         ->type_name("DEG");
@@ -41,8 +40,8 @@ samples::CameraOverride parse_camera_flags(const CameraFlags& flags) {
 }
 
 std::string camera_flags(const scene::Camera& camera) {
-    return "--eye " + vec(camera.eye) + " --look " + vec(camera.look) + " --up " +
-           vec(camera.up) + " --fov " + number(camera.fov_degrees);
+    return "--eye " + vec(camera.eye) + " --look " + vec(camera.look) + " --up " + vec(camera.up) +
+           " --fov " + number(camera.fov_degrees);
 }
 
 }  // namespace lucent::cli

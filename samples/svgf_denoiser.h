@@ -17,9 +17,9 @@ struct SvgfOptions {
     unsigned iterations = 5;
     float alpha_colour = 0.2f, alpha_moments = 0.2f;
     float sigma_z = 1.0f, sigma_n = 128.0f, sigma_l = 4.0f;
-    float normal_cos = 0.9f;        // reprojection: normals within about 25 degrees
-    float plane_tolerance = 4.0f;   // ... points within 4 pixel footprints of the plane
-    bool temporal = true;           // false: every frame restarts its history (for tests)
+    float normal_cos = 0.9f;       // reprojection: normals within about 25 degrees
+    float plane_tolerance = 4.0f;  // ... points within 4 pixel footprints of the plane
+    bool temporal = true;          // false: every frame restarts its history (for tests)
 };
 
 class SvgfDenoiser {

@@ -29,10 +29,8 @@ ViewDenoisers::ViewDenoisers(Context& ctx, const RenderSettings& settings, unsig
                              std::shared_ptr<Buffer> colour,
                              const std::vector<std::shared_ptr<Material>>& materials)
     : m_gbuffer(ctx, ray_type, first_entry, std::move(camera), settings.width, settings.height),
-      m_atrous(ctx, first_entry + 1, guides_of(m_gbuffer), colour, settings.width,
-               settings.height),
-      m_svgf(ctx, first_entry + 4, guides_of(m_gbuffer), colour, settings.width,
-             settings.height),
+      m_atrous(ctx, first_entry + 1, guides_of(m_gbuffer), colour, settings.width, settings.height),
+      m_svgf(ctx, first_entry + 4, guides_of(m_gbuffer), colour, settings.width, settings.height),
       m_atrous_options(settings.denoise_options),
       m_height(settings.height) {
     for (const auto& material : materials) m_gbuffer.add_to(*material);

@@ -155,18 +155,18 @@ std::vector<unsigned char> to_srgb8(const Image& image) {
 }
 
 std::span<const ImageFormat> image_formats() {
-    static constexpr ImageFormat kFormats[] = {{".png", "8-bit sRGB"},
-                                               {".exr", "OpenEXR, float"},
-                                               {".pfm", "32-bit float, linear"}};
+    static constexpr ImageFormat kFormats[] = {
+        {".png", "8-bit sRGB"}, {".exr", "OpenEXR, float"}, {".pfm", "32-bit float, linear"}};
     return kFormats;
 }
 
 std::string image_formats_text() {
     const auto formats = image_formats();
     std::string text = "must end in ";
-    for (size_t i = 0; i < formats.size(); ++i)
-        text += std::string(i == 0 ? "" : i + 1 == formats.size() ? " or " : ", ") +
-                formats[i].extension + " (" + formats[i].what + ")";
+    for (size_t i = 0; i < formats.size(); ++i) {
+        if (i > 0) text += i + 1 == formats.size() ? " or " : ", ";
+        text += std::string(formats[i].extension) + " (" + formats[i].what + ")";
+    }
     return text;
 }
 

@@ -94,18 +94,19 @@ constexpr unsigned kW = 40, kH = 32;
 constexpr float kTan = 0.5f;  // half the image's height at depth 1
 
 sample_common::PinholeCamera camera_at(float3 eye) {
-    return {eye, make_float3(kTan * kW / kH, 0, 0), make_float3(0, kTan, 0),
-            make_float3(0, 0, -1)};
+    return {eye, make_float3(kTan * kW / kH, 0, 0), make_float3(0, kTan, 0), make_float3(0, 0, -1)};
 }
 
 Hit pixel_hit(const sample_common::PinholeCamera& c, unsigned x, unsigned y) {
-    return cast(c.eye,
-                sample_common::pixel_centre_direction(c, make_uint3(x, y, 0), make_uint3(kW, kH, 1)));
+    return cast(c.eye, sample_common::pixel_centre_direction(c, make_uint3(x, y, 0),
+                                                             make_uint3(kW, kH, 1)));
 }
 
 TEST(Svgf, ACameraMoveKeepsTheHistoryOfSurfacesSeenInBothFramesAndRestartsUncoveredOnes) {
     lucent::Context ctx(lucent_tests::test_context_options());
-    auto image = [&] { return ctx.create_buffer<float4>(lucent::BufferType::kInputOutput, kW, kH); };
+    auto image = [&] {
+        return ctx.create_buffer<float4>(lucent::BufferType::kInputOutput, kW, kH);
+    };
     lucent::samples::AtrousDenoiser::Guides guides{image(), image(), image()};
     auto colour = image();
     lucent::samples::SvgfDenoiser svgf(ctx, 0, guides, colour, kW, kH);

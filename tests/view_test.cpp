@@ -188,7 +188,8 @@ TEST_F(ViewTest, PanelCoversLessThanAQuarterOfAnImageAtEveryScale) {
     for (const char* scale : {"1", "1.5"}) {
         const CliRun r = run(xvfb_lucent() +
                              "view --sample pathtracer --size 800x600 --backend cpu --threads 1 "
-                             "--frames 1 --verbose --ui-scale " + scale);
+                             "--frames 1 --verbose --ui-scale " +
+                             scale);
         ASSERT_EQ(r.exit_code, 0) << r.output;
         unsigned w = 0, h = 0;
         ASSERT_EQ(std::sscanf(line_after(r.output, "panel ").c_str(), "%ux%u", &w, &h), 2)
@@ -205,9 +206,10 @@ TEST_F(ViewTest, CameraAsFlagsReproducesTheViewInRender) {
     // A unit up: the viewer keeps its up normalised, and prints what it keeps.
     const std::string given = "--eye 1.25,2.5,9.75 --look 0.5,1,0 --up 0.6,0.8,0 --fov 41.5";
     const std::string shot = path("view.png"), rendered = path("render.png");
-    const CliRun view = run(xvfb_lucent() + "view --sample whitted --size 160x120 --backend cpu "
-                            "--frames 3 --no-panel --verbose " + given + " --screenshot '" + shot +
-                            "'");
+    const CliRun view = run(xvfb_lucent() +
+                            "view --sample whitted --size 160x120 --backend cpu "
+                            "--frames 3 --no-panel --verbose " +
+                            given + " --screenshot '" + shot + "'");
     ASSERT_EQ(view.exit_code, 0) << view.output;
     // What the viewer prints (and copies) for its camera: the flags it was given.
     const std::string flags = line_after(view.output, "lucent view: camera ");
@@ -225,9 +227,9 @@ TEST_F(ViewTest, CameraAsFlagsReproducesTheViewInRender) {
     const CliRun plain = lucent("render --sample whitted --size 160x120 --backend cpu --out '" +
                                 path("plain.png") + "'");
     ASSERT_EQ(plain.exit_code, 0) << plain.output;
-    EXPECT_GT(lucent::scene::count_differing_pixels(a, lucent::scene::read_png8(path("plain.png")),
-                                                    10),
-              1000u);
+    EXPECT_GT(
+        lucent::scene::count_differing_pixels(a, lucent::scene::read_png8(path("plain.png")), 10),
+        1000u);
 }
 
 TEST_F(ViewTest, ScreenshotWritesEveryListedFormat) {
@@ -235,7 +237,8 @@ TEST_F(ViewTest, ScreenshotWritesEveryListedFormat) {
     for (const char* name : {"v.png", "v.pfm", "v.exr"}) {
         const CliRun r = run(xvfb_lucent() +
                              "view --sample whitted --size 64x48 --backend cpu --frames 1 "
-                             "--no-panel --screenshot '" + path(name) + "'");
+                             "--no-panel --screenshot '" +
+                             path(name) + "'");
         if (std::string(name) == "v.exr" && r.output.find("no OpenEXR") != std::string::npos)
             continue;  // a build without OpenEXR refuses it, by name
         ASSERT_EQ(r.exit_code, 0) << name << ": " << r.output;
@@ -262,6 +265,36 @@ TEST_F(ViewTest, ScreenshotWritesEveryListedFormat) {
     const float c = red / 255.0f;
     const float linear = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
     EXPECT_NEAR(rgb[0], linear, 1e-5f) << int(red);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(ViewTest, DenoisersRunInTheWindowAndASampleWithoutThemSaysSo) {
+    if (!has_xvfb_viewer()) GTEST_SKIP() << "needs xvfb-run and a build with the viewer";
+    const std::string common =
+        "view --sample pathtracer --size 64x48 --backend cpu --threads 1 --frames 2 --no-panel ";
+    const CliRun off = run(xvfb_lucent() + common + "--screenshot '" + path("off.png") + "'");
+    ASSERT_EQ(off.exit_code, 0) << off.output;
+    for (const char* d : {"a-trous", "svgf"}) {
+        const std::string shot = path(std::string(d) + ".png");
+        const CliRun r =
+            run(xvfb_lucent() + common + "--denoiser " + d + " --screenshot '" + shot + "'");
+        ASSERT_EQ(r.exit_code, 0) << d << ": " << r.output;
+        // Filtered: the noisy image's pixels change.
+        EXPECT_GT(lucent::scene::count_differing_pixels(lucent::scene::read_png8(path("off.png")),
+                                                        lucent::scene::read_png8(shot), 10),
+                  100u)
+            << d;
+    }
+    const CliRun whitted = run(xvfb_lucent() +
+                               "view --sample whitted --size 64x48 --backend cpu --frames 1 "
+                               "--denoiser svgf");
+    EXPECT_EQ(whitted.exit_code, 1) << whitted.output;
+    EXPECT_NE(whitted.output.find("--denoiser svgf: the whitted sample has no denoiser switch"),
+              std::string::npos)
+        << whitted.output;
 }
 
 }  // namespace

@@ -8,7 +8,7 @@ namespace lucent::viewer {
 
 /// What a key press does (the viewer's loop switches on it).
 enum class KeyAction {
-    kNone,        // a held key or a mouse binding, read by Input::move_camera
+    kNone,  // a held key or a mouse binding, read by Input::move_camera
     kQuit,
     kTogglePanel,
     kToggleKeys,  // the F1 list

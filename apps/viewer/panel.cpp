@@ -79,8 +79,8 @@ std::optional<samples::ViewDenoiser> denoiser_switch(samples::ViewDenoiser curre
 
 void draw_key_list() {
     const ImGuiViewport* screen = ImGui::GetMainViewport();
-    ImGui::SetNextWindowPos(ImVec2(screen->Size.x * 0.5f, screen->Size.y * 0.5f),
-                            ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+    ImGui::SetNextWindowPos(ImVec2(screen->Size.x * 0.5f, screen->Size.y * 0.5f), ImGuiCond_Always,
+                            ImVec2(0.5f, 0.5f));
     ImGui::SetNextWindowBgAlpha(0.9f);
     ImGui::Begin("keys (F1)", nullptr,
                  ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse);

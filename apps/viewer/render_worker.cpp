@@ -155,6 +155,15 @@ void RenderWorker::run() {
         m_status.error = e.what();
         return;  // the window stays up and shows why
     }
+    {
+        std::lock_guard lock(m_mutex);
+        if (!m_status.denoises && m_status.denoiser != samples::ViewDenoiser::kOff) {
+            m_status.error = std::string("--denoiser ") +
+                             samples::view_denoiser_name(m_status.denoiser) + ": the " +
+                             m_sample.name + " sample has no denoiser switch (pathtracer has)";
+            return;
+        }
+    }
     scene::Camera camera = m_status.initial_camera;
     while (true) {
         std::optional<scene::Camera> new_camera;

@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "present/gl.h"
 #include "lucent/error.h"
+#include "present/gl.h"
 #include "scene/image_io.h"
 
 namespace lucent::viewer {
@@ -55,9 +55,9 @@ void save_framebuffer(const std::string& path, int width, int height) {
     image.height = unsigned(height);
     image.pixels.resize(size_t(width) * height);
     for (size_t i = 0; i < image.pixels.size(); ++i)
-        image.pixels[i] = make_float3(linear_from_srgb8(flipped[3 * i]),
-                                      linear_from_srgb8(flipped[3 * i + 1]),
-                                      linear_from_srgb8(flipped[3 * i + 2]));
+        image.pixels[i] =
+            make_float3(linear_from_srgb8(flipped[3 * i]), linear_from_srgb8(flipped[3 * i + 1]),
+                        linear_from_srgb8(flipped[3 * i + 2]));
     scene::write_image(path, image);  // .exr or .pfm: the command checked the name
 }
 

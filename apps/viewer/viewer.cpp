@@ -13,12 +13,12 @@
 #include <filesystem>
 #include <optional>
 
-#include "present/gl.h"
-#include "present/image_view.h"
 #include "camera_flags.h"
 #include "input.h"
 #include "key_bindings.h"
 #include "panel.h"
+#include "present/gl.h"
+#include "present/image_view.h"
 #include "render_worker.h"
 #include "screenshot.h"
 #include "window.h"
@@ -48,7 +48,7 @@ const char* toggled_option(KeyAction action) {
 
 samples::ViewDenoiser next_denoiser(samples::ViewDenoiser d) {
     using samples::ViewDenoiser;
-    return d == ViewDenoiser::kOff ? ViewDenoiser::kAtrous
+    return d == ViewDenoiser::kOff      ? ViewDenoiser::kAtrous
            : d == ViewDenoiser::kAtrous ? ViewDenoiser::kSvgf
                                         : ViewDenoiser::kOff;
 }
@@ -153,11 +153,13 @@ int run_viewer(const ViewerConfig& config) {
                     break;
                 case KeyAction::kNextDenoiser:
                     if (!status.denoises) {
-                        panel.message = "the " + sample.name + " sample has no denoiser (pathtracer has)";
+                        panel.message =
+                            "the " + sample.name + " sample has no denoiser (pathtracer has)";
                     } else {
                         const auto next = next_denoiser(status.denoiser);
                         worker.set_denoiser(next);
-                        panel.message = std::string("denoiser ") + samples::view_denoiser_name(next);
+                        panel.message =
+                            std::string("denoiser ") + samples::view_denoiser_name(next);
                     }
                     break;
                 case KeyAction::kSavePng:
@@ -275,9 +277,9 @@ int run_viewer(const ViewerConfig& config) {
             double(ui_frames) / std::max(elapsed, 1e-9), at(0.5), at(0.95), ui_frame_ms.back(),
             (unsigned long long)shown.number, (unsigned long long)partial_uploads);
         std::printf("lucent view: panel %.0fx%.0f of a %dx%d window (ui scale %.3g)\n",
-                    panel_size[0], panel_size[1], last_fb_width, last_fb_height,
-                    window.ui_scale());
-        if (camera) std::printf("lucent view: camera %s\n", cli::camera_flags(camera->camera()).c_str());
+                    panel_size[0], panel_size[1], last_fb_width, last_fb_height, window.ui_scale());
+        if (camera)
+            std::printf("lucent view: camera %s\n", cli::camera_flags(camera->camera()).c_str());
     }
     if (exit_code == 0 && !config.screenshot.empty())
         std::printf("wrote %s\n", config.screenshot.c_str());

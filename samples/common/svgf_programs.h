@@ -40,8 +40,8 @@ LUCENT_MODULE(sample_svgf)
 /// The frame's parameters: a 1-element buffer uploaded before the frame's launches.
 struct SvgfFrame {
     sample_common::PinholeCamera previous;  // the camera of the history
-    float footprint;        // a pixel's width at depth 1 in this frame: 2 |V| / height
-    float alpha_colour;     // the blend's floor while the camera moves (the paper's 0.2)
+    float footprint;     // a pixel's width at depth 1 in this frame: 2 |V| / height
+    float alpha_colour;  // the blend's floor while the camera moves (the paper's 0.2)
     float alpha_moments;
     float normal_cos;       // reprojection: the history's normal within this angle's cosine
     float plane_tolerance;  // ... and its point this many footprints from the tangent plane
@@ -95,8 +95,8 @@ struct TemporalRecord {
     lucent::BufferView<float4> integrated_moments;     // as history_moments
 };
 LUCENT_RECORD(TemporalRecord, svgf_frame, svgf_colour, aov_albedo, aov_normal, aov_position,
-              history_normal, history_position, history_colour, history_moments,
-              integrated_colour, integrated_moments)
+              history_normal, history_position, history_colour, history_moments, integrated_colour,
+              integrated_moments)
 
 /// §4.1 at pixel p: the history at p's surface point in the previous frame, a bilinear blend
 /// of the four pixels around it that pass the consistency test, then the exponential
@@ -107,8 +107,7 @@ LUCENT_HD inline void temporal_pixel(const TemporalRecord& rec) {
     const SvgfFrame frame = rec.svgf_frame[0u];
     const float4 ap = rec.aov_albedo[p], np4 = rec.aov_normal[p], xp4 = rec.aov_position[p];
     const bool covered = ap.w > 0.5f;
-    const float3 illumination =
-        rgb(rec.svgf_colour[p]) / sample_atrous::demodulation(ap);
+    const float3 illumination = rgb(rec.svgf_colour[p]) / sample_atrous::demodulation(ap);
     const float l = luminance(illumination);
 
     float3 colour = make_float3(0.0f);
@@ -128,8 +127,8 @@ LUCENT_HD inline void temporal_pixel(const TemporalRecord& rec) {
             if (dot(np, rgb(nq)) < frame.normal_cos) continue;
             if (plane_distance(np, xp, unit, rec.history_position[q]) > frame.plane_tolerance)
                 continue;
-            const float w = ((t & 1) ? px - fx : 1.0f - (px - fx)) *
-                            ((t >> 1) ? py - fy : 1.0f - (py - fy));
+            const float w =
+                ((t & 1) ? px - fx : 1.0f - (px - fx)) * ((t >> 1) ? py - fy : 1.0f - (py - fy));
             const float4 c = rec.history_colour[q], m = rec.history_moments[q];
             colour += w * rgb(c);
             length += w * c.w;
@@ -179,8 +178,8 @@ struct VarianceRecord {
     lucent::BufferView<const float4> integrated_colour, integrated_moments;
     lucent::BufferView<float4> svgf_output;  // illumination; w = variance
 };
-LUCENT_RECORD(VarianceRecord, svgf_frame, aov_albedo, aov_normal, aov_position,
-              integrated_colour, integrated_moments, svgf_output)
+LUCENT_RECORD(VarianceRecord, svgf_frame, aov_albedo, aov_normal, aov_position, integrated_colour,
+              integrated_moments, svgf_output)
 
 /// §4.2 at pixel p: the variance of the integrated luminance, from the temporal moments once
 /// 4 frames are integrated, else from the moments over a 7x7 neighbourhood of the same
@@ -298,8 +297,7 @@ LUCENT_RAY_GENERATION(svgf_atrous, sample_svgf::AtrousRecord) {
 struct KeepRecord {
     lucent::BufferView<const float4> aov_normal, aov_position;
     lucent::BufferView<const float4> integrated_colour, integrated_moments;
-    lucent::BufferView<float4> history_normal, history_position, history_colour,
-        history_moments;
+    lucent::BufferView<float4> history_normal, history_position, history_colour, history_moments;
 };
 LUCENT_RECORD(KeepRecord, aov_normal, aov_position, integrated_colour, integrated_moments,
               history_normal, history_position, history_colour, history_moments)
