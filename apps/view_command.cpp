@@ -8,6 +8,7 @@
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "samples/sample.h"
+#include "scene/image_io.h"
 #ifdef LUCENT_HAVE_VIEWER
 #include "viewer/viewer.h"
 #endif
@@ -67,9 +68,12 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
                     "Render this many frames, then exit (with --screenshot: a headless check)")
         ->type_name("N")
         ->check(CLI::Range(1u, 1000000u).description(""));
+    std::string formats;  // the writers' list, as the error names it
+    for (const scene::ImageFormat& f : scene::image_formats())
+        formats += std::string(formats.empty() ? "" : " ") + f.extension;
     cmd->add_option("--screenshot", args.screenshot,
-                    "With --frames: save what the window shows before exiting, as .png, .exr "
-                    "or .pfm (the 8-bit window pixels; the float files hold them linear)")
+                    "With --frames: save what the window shows before exiting: " + formats +
+                        " (the 8-bit window pixels; the float files hold them linear)")
         ->type_name("FILE");
     cmd->add_flag("--no-panel", args.no_panel, "Hide the control panel (Tab or H toggles it)");
     cmd->add_option("--ui-scale", args.ui_scale,
@@ -91,6 +95,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
         "every key and mouse binding; F copies the camera as --eye --look --up --fov.\n"
         "\nExamples:\n"
         "  lucent view --sample pathtracer --scene cornell-materials\n"
+        "  lucent view --sample pathtracer --denoiser svgf          # denoised while it moves\n"
         "  lucent view --sample whitted --backend cpu --size 640x480\n"
         "  lucent view --sample fog --set step=0.1\n"
         "  lucent view --sample radiosity --set show_vpls=1     # then M, I and L toggle\n"
