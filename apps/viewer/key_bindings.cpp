@@ -10,8 +10,12 @@ constexpr Binding kBindings[] = {
     {0, "left drag", "orbit around the target", KeyAction::kNone},
     {0, "right or middle drag", "pan", KeyAction::kNone},
     {0, "wheel", "zoom towards the target", KeyAction::kNone},
-    {0, "W A S D (held)", "fly forward, left, back, right", KeyAction::kNone},
-    {0, "Q E (held)", "fly down, up", KeyAction::kNone},
+    {GLFW_KEY_W, "W (held)", "fly forward", KeyAction::kFlyForward},
+    {GLFW_KEY_S, "S (held)", "fly back", KeyAction::kFlyBack},
+    {GLFW_KEY_A, "A (held)", "fly left", KeyAction::kFlyLeft},
+    {GLFW_KEY_D, "D (held)", "fly right", KeyAction::kFlyRight},
+    {GLFW_KEY_Q, "Q (held)", "fly down", KeyAction::kFlyDown},
+    {GLFW_KEY_E, "E (held)", "fly up", KeyAction::kFlyUp},
     {0, "Shift (held)", "fly 4x faster", KeyAction::kNone},
     {GLFW_KEY_F1, "F1", "show or hide this list", KeyAction::kToggleKeys},
     {GLFW_KEY_TAB, "Tab", "show or hide the panel", KeyAction::kTogglePanel},
@@ -37,6 +41,12 @@ KeyAction action_of_key(int key) {
     for (const Binding& b : kBindings)
         if (b.key != 0 && b.key == key) return b.action;
     return KeyAction::kNone;
+}
+
+int key_of(KeyAction action) {
+    for (const Binding& b : kBindings)
+        if (b.key != 0 && b.action == action) return b.key;
+    return 0;
 }
 
 }  // namespace lucent::viewer

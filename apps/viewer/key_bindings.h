@@ -6,9 +6,15 @@
 
 namespace lucent::viewer {
 
-/// What a key press does (the viewer's loop switches on it).
+/// What a key does (the viewer's loop switches on a press's; Input reads the held ones).
 enum class KeyAction {
-    kNone,  // a held key or a mouse binding, read by Input::move_camera
+    kNone,        // a mouse binding or Shift, read by Input::move_camera
+    kFlyForward,  // held keys, read by Input::move_camera through key_of()
+    kFlyBack,
+    kFlyLeft,
+    kFlyRight,
+    kFlyDown,
+    kFlyUp,
     kQuit,
     kTogglePanel,
     kToggleKeys,  // the F1 list
@@ -33,5 +39,7 @@ struct Binding {
 std::span<const Binding> bindings();
 /// The action of a pressed GLFW key; kNone when no binding has it.
 KeyAction action_of_key(int key);
+/// The GLFW key of an action (its first binding); 0 when none has one.
+int key_of(KeyAction action);
 
 }  // namespace lucent::viewer
