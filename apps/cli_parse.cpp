@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "scene/exr_encoder.h"
+#include "scene/image_io.h"
 
 #include <algorithm>
 #include <charconv>
@@ -124,10 +125,9 @@ void check_image_path(const std::string& flag, const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-        throw UsageError(flag + " " + quoted(path) +
-                         ": the file name must end in .png (8-bit sRGB), .exr (OpenEXR, float) "
-                         "or .pfm (32-bit float)");
+    if (!scene::has_image_extension(path))
+        throw UsageError(flag + " " + quoted(path) + ": the file name " +
+                         scene::image_formats_text());
     if (ext == ".exr" && !scene::exr_supported())
         throw UsageError(flag + " " + quoted(path) +
                          ": this build has no OpenEXR (install libopenexr-dev); use .pfm");

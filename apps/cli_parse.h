@@ -46,7 +46,8 @@ std::string quoted(const std::string& text);
 int parse_sm(const std::string& flag, const std::string& text);
 /// "name=value" → {name, value}; the name is non-empty, the value may be empty.
 std::pair<std::string, std::string> parse_set(const std::string& flag, const std::string& text);
-/// An image path that write_image accepts (.png or .pfm) in a directory that exists.
+/// An image path whose extension is one of scene::image_formats() (and .exr only in a build with
+/// OpenEXR) in a directory that exists.
 void check_image_path(const std::string& flag, const std::string& path);
 
 }  // namespace lucent::cli

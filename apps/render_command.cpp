@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera_flags.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
 #include "samples/sample.h"
@@ -79,10 +80,7 @@ samples::RenderSettings settings_from(const RenderArgs& args) {
     s.verbose = args.verbose;
     if (!args.jit_check.empty()) s.jit_check_sm = parse_sm("--jit-check", args.jit_check);
     if (args.camera >= 0) s.scene_camera = unsigned(args.camera);
-    if (!args.eye.empty()) s.camera.eye = parse_vec3("--eye", args.eye);
-    if (!args.look.empty()) s.camera.look = parse_vec3("--look", args.look);
-    if (!args.up.empty()) s.camera.up = parse_vec3("--up", args.up);
-    if (!args.fov.empty()) s.camera.fov_degrees = parse_float("--fov", args.fov, 0, 180, true);
+    s.camera = parse_camera_flags(args.camera_flags);
     s.repeat = args.repeat;
     s.spp = args.spp;
     if (!args.aov.empty() || args.aov_given) s.aovs = samples::parse_aovs("--aov", args.aov);
@@ -237,13 +235,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                     "The scene file's camera N (glTF's cameras, from 0); default: its first")
         ->type_name("N")
         ->check(CLI::Range(0, 1 << 30).description(""));
-    cmd->add_option("--eye", args.eye, "Camera position, over the scene's")->type_name("X,Y,Z");
-    cmd->add_option("--look", args.look, "Point the camera looks at, over the scene's")
-        ->type_name("X,Y,Z");
-    cmd->add_option("--up", args.up, "Camera up direction, over the scene's")->type_name("X,Y,Z");
-    cmd->add_option("--fov", args.fov, "Vertical field of view in degrees, (0, 180), over the "
-                                       "scene's")
-        ->type_name("DEG");
+    add_camera_flags(cmd, args.camera_flags);
     cmd->add_option("--aov", args.aov,
                     "Also write these G-buffer layers into the .exr output beside RGBA: any of "
                     "albedo, normal, depth, position, instance (comma-separated)")

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "camera_flags.h"
+
 namespace lucent::cli {
 
 /// The render options as typed; parsed and checked by run_render.
@@ -22,7 +24,7 @@ struct RenderArgs {
     unsigned spp = 0;       // samples per pixel of progressive samples; 0 = the sample's default
     std::string jit_check;  // e.g. "sm_90": also compile the CUDA megakernel (no GPU needed)
     int camera = -1;                 // --camera N: the scene file's camera N; -1 = its first
-    std::string eye, look, up, fov;  // the camera, over the scene's (each optional)
+    CameraFlags camera_flags;        // --eye --look --up --fov, over the scene's camera
     bool quiet = false;  // no header, progress or timings: only errors
     bool json = false;   // the settings and timings as one JSON object on stdout
     std::string aov;     // --aov albedo,normal,...: G-buffer layers in the EXR

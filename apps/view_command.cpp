@@ -4,14 +4,26 @@
 
 #include <thread>
 
+#include "camera_flags.h"
 #include "cli_parse.h"
 #include "lucent/error.h"
 #include "samples/sample.h"
+#include "scene/image_io.h"
 #ifdef LUCENT_HAVE_VIEWER
 #include "viewer/viewer.h"
 #endif
 
 namespace lucent::cli {
+namespace {
+
+samples::ViewDenoiser parse_view_denoiser(const std::string& flag, const std::string& text) {
+    for (auto d : {samples::ViewDenoiser::kOff, samples::ViewDenoiser::kAtrous,
+                   samples::ViewDenoiser::kSvgf})
+        if (text == samples::view_denoiser_name(d)) return d;
+    throw UsageError(flag + " " + quoted(text) + ": expected off, a-trous or svgf");
+}
+
+}  // namespace
 
 CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
 #ifdef LUCENT_HAVE_VIEWER
@@ -39,6 +51,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
                     "Start from the scene file's camera N (glTF's cameras, from 0)")
         ->type_name("N")
         ->check(CLI::Range(0, 1 << 30).description(""));
+    add_camera_flags(cmd, args.camera_flags);
     cmd->add_option("--set", args.sets, "Sample option (repeatable)")->type_name("NAME=VALUE");
     cmd->add_option("--threads", args.threads,
                     "CPU worker threads, 0 = one per core but one (left to the window)")
@@ -55,19 +68,34 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
                     "Render this many frames, then exit (with --screenshot: a headless check)")
         ->type_name("N")
         ->check(CLI::Range(1u, 1000000u).description(""));
+    std::string formats;  // the writers' list, as the error names it
+    for (const scene::ImageFormat& f : scene::image_formats())
+        formats += std::string(formats.empty() ? "" : " ") + f.extension;
     cmd->add_option("--screenshot", args.screenshot,
-                    "With --frames: save what the window shows, as a .png, before exiting")
+                    "With --frames: save what the window shows before exiting: " + formats +
+                        " (the 8-bit window pixels; the float files hold them linear)")
         ->type_name("FILE");
-    cmd->add_flag("--no-panel", args.no_panel, "Hide the control panel (H toggles it)");
+    cmd->add_flag("--no-panel", args.no_panel, "Hide the control panel (Tab or H toggles it)");
+    cmd->add_option("--ui-scale", args.ui_scale,
+                    "Scale of the panel's text and controls; 0 = the window's content scale "
+                    "(the desktop's)")
+        ->type_name("S")
+        ->check(CLI::Range(0.0f, 8.0f).description(""))
+        ->capture_default_str();
+    cmd->add_option("--denoiser", args.denoiser,
+                    "Start with this denoiser: off, a-trous (the progressive image) or svgf "
+                    "(temporal, for a moving camera); N cycles them. The path tracer has them")
+        ->type_name("NAME")
+        ->capture_default_str();
     cmd->add_flag("-v,--verbose", args.verbose,
-                  "Print the backend, and UI and render frames/s at exit");
+                  "Print the backend, UI and render frames/s, the panel's size and the camera "
+                  "as flags at exit");
     cmd->footer(
-        "Mouse: left-drag orbit, right- or middle-drag pan, wheel zoom.\n"
-        "Keys: W A S D fly, Q E down/up (Shift: faster); R reset accumulation; C camera back\n"
-        "      to the start; P save a PNG of the render; L show VPLs, I GI on/off, M merging\n"
-        "      on/off (the samples with those options: radiosity); H panel; Esc quit.\n"
+        "Mouse: left-drag orbit, right- or middle-drag pan, wheel zoom. F1 in the window lists\n"
+        "every key and mouse binding; F copies the camera as --eye --look --up --fov.\n"
         "\nExamples:\n"
         "  lucent view --sample pathtracer --scene cornell-materials\n"
+        "  lucent view --sample pathtracer --denoiser svgf          # denoised while it moves\n"
         "  lucent view --sample whitted --backend cpu --size 640x480\n"
         "  lucent view --sample fog --set step=0.1\n"
         "  lucent view --sample radiosity --set show_vpls=1     # then M, I and L toggle\n"
@@ -92,6 +120,7 @@ int run_view(const ViewArgs& args) {
     }
     settings.scene = args.scene;
     if (args.camera >= 0) settings.scene_camera = unsigned(args.camera);
+    settings.camera = parse_camera_flags(args.camera_flags);
     settings.spp = args.spp;
     for (const std::string& text : args.sets) {
         auto [name, value] = parse_set("--set", text);
@@ -102,10 +131,8 @@ int run_view(const ViewArgs& args) {
             throw UsageError("--screenshot " + quoted(args.screenshot) +
                              ": needs --frames N (the frame to save)");
         check_image_path("--screenshot", args.screenshot);
-        if (!args.screenshot.ends_with(".png"))
-            throw UsageError("--screenshot " + quoted(args.screenshot) +
-                             ": the window is saved as 8-bit sRGB; the name must end in .png");
     }
+    const samples::ViewDenoiser denoiser = parse_view_denoiser("--denoiser", args.denoiser);
     const samples::Sample& sample = samples::find_sample(args.sample);
     sample.read_options(settings);  // every --set checked before the window opens
 #ifdef LUCENT_HAVE_VIEWER
@@ -115,6 +142,8 @@ int run_view(const ViewArgs& args) {
     config.frames = args.frames;
     config.screenshot = args.screenshot;
     config.panel = !args.no_panel;
+    config.ui_scale = args.ui_scale;
+    config.denoiser = denoiser;
     config.verbose = args.verbose;
     return viewer::run_viewer(config);
 #else

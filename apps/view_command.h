@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "camera_flags.h"
+
 namespace lucent::cli {
 
 /// The view options as typed; parsed and checked by run_view.
@@ -21,6 +23,9 @@ struct ViewArgs {
     unsigned frames = 0;     // >0: render this many frames, then exit (headless checks)
     std::string screenshot;  // with --frames: save what the window shows here
     bool no_panel = false;   // hide the ImGui panel (screenshots of the image alone)
+    float ui_scale = 0;      // the panel's scale; 0 = the window's content scale
+    std::string denoiser = "off";
+    CameraFlags camera_flags;  // --eye --look --up --fov: the camera to start from
     bool verbose = false;
 };
 

@@ -100,6 +100,12 @@ struct FrameResult {
     LaunchReport report;              // exceptions of this frame's last launch
 };
 
+/// The viewer's denoiser switch: none, the à-trous filter on the progressive image, or its
+/// temporal variant (SVGF), which keeps a history across camera moves.
+enum class ViewDenoiser { kOff, kAtrous, kSvgf };
+/// "off", "a-trous", "svgf": what the panel and the messages call them.
+const char* view_denoiser_name(ViewDenoiser denoiser);
+
 /// A sample's scene built once and rendered many times from a moving camera (`lucent view`).
 /// Not thread-safe: one thread opens it and calls everything.
 class InteractiveSession {
@@ -119,6 +125,11 @@ class InteractiveSession {
     virtual void reset() {}
     /// True when frame() refines the image further while nothing changes.
     virtual bool progressive() const { return false; }
+    /// True when set_denoiser() takes effect (the sample has a G-buffer pass).
+    virtual bool denoises() const { return false; }
+    /// Denoises the following frames so; the first switch on builds the passes (and the
+    /// next frame recompiles).
+    virtual void set_denoiser(ViewDenoiser) {}
     /// Renders one frame (a progressive session: one more sample per pixel).
     virtual FrameResult frame() = 0;
 };

@@ -154,18 +154,40 @@ std::vector<unsigned char> to_srgb8(const Image& image) {
     return rgb;
 }
 
+std::span<const ImageFormat> image_formats() {
+    static constexpr ImageFormat kFormats[] = {
+        {".png", "8-bit sRGB"}, {".exr", "OpenEXR, float"}, {".pfm", "32-bit float, linear"}};
+    return kFormats;
+}
+
+std::string image_formats_text() {
+    const auto formats = image_formats();
+    std::string text = "must end in ";
+    for (size_t i = 0; i < formats.size(); ++i) {
+        if (i > 0) text += i + 1 == formats.size() ? " or " : ", ";
+        text += std::string(formats[i].extension) + " (" + formats[i].what + ")";
+    }
+    return text;
+}
+
+bool has_image_extension(const std::string& path) {
+    const std::string ext = lower_extension(path);
+    for (const ImageFormat& f : image_formats())
+        if (ext == f.extension) return true;
+    return false;
+}
+
 void write_image(const std::string& path, const Image& image) {
     write_image(path, image, ExrExtras{});
 }
 
 void write_image(const std::string& path, const Image& image, const ExrExtras& extras) {
     const std::string ext = lower_extension(path);
-    if (ext != ".png" && ext != ".pfm" && ext != ".exr")
-        throw Error(
-            "cannot write '" + path + "': " +
-            (ext.empty() ? std::string("no file extension")
-                         : "unknown image extension '" + ext + "'") +
-            "; use .png (8-bit sRGB), .exr (OpenEXR, float) or .pfm (32-bit float, linear)");
+    if (!has_image_extension(path))
+        throw Error("cannot write '" + path + "': " +
+                    (ext.empty() ? std::string("no file extension")
+                                 : "unknown image extension '" + ext + "'") +
+                    "; the name " + image_formats_text());
     if (ext != ".exr" && !extras.empty())
         throw Error("cannot write '" + path + "': alpha, AOV layers and metadata need an .exr "
                     "file (OpenEXR holds extra channels; " + ext + " does not)");

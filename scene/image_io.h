@@ -1,6 +1,7 @@
-// Images in and out: PNG (8-bit sRGB) and PFM (float), chosen by file extension.
+// Images in and out: PNG (8-bit sRGB), OpenEXR and PFM (float), chosen by file extension.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,18 @@ struct Image {
 /// Linear [0,1] to 8-bit sRGB (clamped; lucent::srgb8_from_linear), RGB interleaved, row 0
 /// first.
 std::vector<unsigned char> to_srgb8(const Image& image);
+
+/// An image file type write_image writes: its extension, lower case, and what it holds.
+struct ImageFormat {
+    const char* extension;
+    const char* what;  // "8-bit sRGB"
+};
+/// Every one, in the order errors list them: .png, .exr, .pfm.
+std::span<const ImageFormat> image_formats();
+/// "must end in .png (8-bit sRGB), .exr (OpenEXR, float) or .pfm (32-bit float, linear)".
+std::string image_formats_text();
+/// Whether `path`'s extension (any case) is one of image_formats().
+bool has_image_extension(const std::string& path);
 
 /// Writes .png (8-bit sRGB) or .pfm (32-bit float, linear) by extension. Writes to a
 /// temporary file beside `path` and renames it, so a failure never leaves a partial file.

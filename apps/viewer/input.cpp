@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "key_bindings.h"
+
 namespace lucent::viewer {
 namespace {
 
@@ -68,9 +70,11 @@ bool Input::move_camera(scene::CameraController& camera, float dt, bool ui_mouse
     }
     if (!ui_keys) {
         auto held = [&](int key) { return glfwGetKey(m_window, key) == GLFW_PRESS ? 1.0f : 0.0f; };
-        const float forward = held(GLFW_KEY_W) - held(GLFW_KEY_S);
-        const float right = held(GLFW_KEY_D) - held(GLFW_KEY_A);
-        const float up = held(GLFW_KEY_E) - held(GLFW_KEY_Q);
+        // The fly keys from the bindings table (key_bindings.cpp), which F1 lists.
+        auto flying = [&](KeyAction a) { return held(key_of(a)); };
+        const float forward = flying(KeyAction::kFlyForward) - flying(KeyAction::kFlyBack);
+        const float right = flying(KeyAction::kFlyRight) - flying(KeyAction::kFlyLeft);
+        const float up = flying(KeyAction::kFlyUp) - flying(KeyAction::kFlyDown);
         if (forward != 0 || right != 0 || up != 0) {
             const bool fast = held(GLFW_KEY_LEFT_SHIFT) + held(GLFW_KEY_RIGHT_SHIFT) > 0;
             // Speed in proportion to the distance to the target: the same feel at any scale.

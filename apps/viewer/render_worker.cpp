@@ -9,8 +9,9 @@
 namespace lucent::viewer {
 
 RenderWorker::RenderWorker(const samples::Sample& sample, samples::RenderSettings settings,
-                           uint64_t frame_limit)
+                           uint64_t frame_limit, samples::ViewDenoiser denoiser)
     : m_sample(sample), m_settings(std::move(settings)), m_frame_limit(frame_limit) {
+    m_status.denoiser = denoiser;
     m_settings.repeat = 1;
     m_settings.display_frames = true;  // GPU frames stay on the GPU until shown
     m_settings.progress = nullptr;
@@ -102,6 +103,15 @@ void RenderWorker::set_spp_limit(unsigned spp) {
     m_wake.notify_all();
 }
 
+void RenderWorker::set_denoiser(samples::ViewDenoiser denoiser) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_status.denoiser = denoiser;
+        m_pending_denoiser = true;
+    }
+    m_wake.notify_all();
+}
+
 std::optional<ShownFrame> RenderWorker::frame_after(uint64_t after) {
     std::lock_guard lock(m_mutex);
     if (m_latest.number <= after) return std::nullopt;
@@ -119,7 +129,8 @@ uint64_t RenderWorker::frames_done() {
 }
 
 bool RenderWorker::has_work() const {
-    if (m_pending_camera || !m_pending_sets.empty() || m_pending_reset) return true;
+    if (m_pending_camera || !m_pending_sets.empty() || m_pending_reset || m_pending_denoiser)
+        return true;
     if (m_frame_limit > 0) return m_latest.number < m_frame_limit && m_status.error.empty();
     return !m_converged;
 }
@@ -132,6 +143,8 @@ void RenderWorker::open_session() {
     m_status.backend = m_session->backend();
     m_status.backend_notice = m_session->backend_notice();
     m_status.initial_camera = m_session->initial_camera();
+    m_status.denoises = m_session->denoises();
+    m_pending_denoiser = m_status.denoiser != samples::ViewDenoiser::kOff;  // a rebuilt one
 }
 
 void RenderWorker::run() {
@@ -142,11 +155,21 @@ void RenderWorker::run() {
         m_status.error = e.what();
         return;  // the window stays up and shows why
     }
+    {
+        std::lock_guard lock(m_mutex);
+        if (!m_status.denoises && m_status.denoiser != samples::ViewDenoiser::kOff) {
+            m_status.error = std::string("--denoiser ") +
+                             samples::view_denoiser_name(m_status.denoiser) + ": the " +
+                             m_sample.name + " sample has no denoiser switch (pathtracer has)";
+            return;
+        }
+    }
     scene::Camera camera = m_status.initial_camera;
     while (true) {
         std::optional<scene::Camera> new_camera;
         std::map<std::string, std::string> new_sets;
         bool reset = false;
+        std::optional<samples::ViewDenoiser> new_denoiser;
         {
             std::unique_lock lock(m_mutex);
             m_wake.wait(lock, [this] { return m_stop || has_work(); });
@@ -155,6 +178,8 @@ void RenderWorker::run() {
             new_sets.swap(m_pending_sets);
             reset = m_pending_reset;
             m_pending_reset = false;
+            if (m_pending_denoiser) new_denoiser = m_status.denoiser;
+            m_pending_denoiser = false;
             m_status.busy = true;
         }
         const auto start = std::chrono::steady_clock::now();
@@ -179,6 +204,15 @@ void RenderWorker::run() {
                 m_session->set_camera(camera);
             }
             if (reset) m_session->reset();
+            samples::ViewDenoiser denoiser = samples::ViewDenoiser::kOff;
+            {
+                // A rebuilt session above asks for the denoiser again (m_pending_denoiser).
+                std::lock_guard lock(m_mutex);
+                if (m_pending_denoiser) new_denoiser = m_status.denoiser;
+                m_pending_denoiser = false;
+                denoiser = m_status.denoiser;
+            }
+            if (new_denoiser) m_session->set_denoiser(denoiser);
             samples::FrameResult frame = m_session->frame();
             shown.width = frame.display->width();
             shown.height = frame.display->height();

@@ -47,14 +47,17 @@ struct WorkerStatus {
     scene::Camera initial_camera;
     std::map<std::string, std::string> sets;  // the options in effect
     unsigned spp_limit = 0;                   // progressive: stop refining here; 0 = never
+    bool denoises = false;                    // the session has the denoiser switch
+    samples::ViewDenoiser denoiser = samples::ViewDenoiser::kOff;
 };
 
 class RenderWorker {
   public:
-    /// Opens the sample's session on the worker thread. `frame_limit` > 0: render frames
-    /// until that many finished even when nothing changes (headless checks), then stop.
+    /// Opens the sample's session on the worker thread, denoised by `denoiser` where it has
+    /// the switch. `frame_limit` > 0: render frames until that many finished even when
+    /// nothing changes (headless checks), then stop.
     RenderWorker(const samples::Sample& sample, samples::RenderSettings settings,
-                 uint64_t frame_limit);
+                 uint64_t frame_limit, samples::ViewDenoiser denoiser);
     ~RenderWorker();
     RenderWorker(const RenderWorker&) = delete;
     RenderWorker& operator=(const RenderWorker&) = delete;
@@ -64,6 +67,8 @@ class RenderWorker {
     void reset();
     /// Progressive sessions stop refining at this many samples per pixel; 0 = never.
     void set_spp_limit(unsigned spp);
+    /// The denoiser of the following frames (sessions that have one: status().denoises).
+    void set_denoiser(samples::ViewDenoiser denoiser);
 
     /// The newest finished frame when it is newer than `after`.
     std::optional<ShownFrame> frame_after(uint64_t after);
@@ -91,6 +96,7 @@ class RenderWorker {
     std::optional<scene::Camera> m_pending_camera;
     std::map<std::string, std::string> m_pending_sets;
     bool m_pending_reset = false;
+    bool m_pending_denoiser = false;
     bool m_converged = false;  // a still image is up to date, or the spp limit was reached
     ShownFrame m_latest;
     PartialFrame m_partial;

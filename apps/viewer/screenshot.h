@@ -5,8 +5,10 @@
 
 namespace lucent::viewer {
 
-/// Reads the current framebuffer (glReadPixels) and writes it as an 8-bit RGB PNG, atomically
-/// (a temporary file renamed). Throws lucent::Error naming the path.
-void save_framebuffer_png(const std::string& path, int width, int height);
+/// Reads the current framebuffer (glReadPixels) and writes it by the path's extension: an
+/// 8-bit RGB PNG as it is, or .exr / .pfm (scene::write_image) with the 8-bit sRGB pixels
+/// decoded to linear floats; atomically (a temporary file renamed). Throws lucent::Error
+/// naming the path.
+void save_framebuffer(const std::string& path, int width, int height);
 
 }  // namespace lucent::viewer

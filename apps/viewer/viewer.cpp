@@ -13,10 +13,12 @@
 #include <filesystem>
 #include <optional>
 
+#include "camera_flags.h"
+#include "input.h"
+#include "key_bindings.h"
+#include "panel.h"
 #include "present/gl.h"
 #include "present/image_view.h"
-#include "input.h"
-#include "panel.h"
 #include "render_worker.h"
 #include "screenshot.h"
 #include "window.h"
@@ -31,17 +33,24 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
 }
 
 /// The blog's toggles (Radiosity demo): L show VPLs, I GI, M merging.
-const char* toggled_option(int key) {
-    switch (key) {
-        case GLFW_KEY_L:
+const char* toggled_option(KeyAction action) {
+    switch (action) {
+        case KeyAction::kToggleVpls:
             return "show_vpls";
-        case GLFW_KEY_I:
+        case KeyAction::kToggleGi:
             return "gi";
-        case GLFW_KEY_M:
+        case KeyAction::kToggleMerge:
             return "merge";
         default:
             return nullptr;
     }
+}
+
+samples::ViewDenoiser next_denoiser(samples::ViewDenoiser d) {
+    using samples::ViewDenoiser;
+    return d == ViewDenoiser::kOff      ? ViewDenoiser::kAtrous
+           : d == ViewDenoiser::kAtrous ? ViewDenoiser::kSvgf
+                                        : ViewDenoiser::kOff;
 }
 
 /// A file name in the working directory that does not exist yet.
@@ -78,14 +87,17 @@ int run_viewer(const ViewerConfig& config) {
     Window window("lucent view: " + sample.name, int(config.settings.width),
                   int(config.settings.height), /*exact=*/headless_check);
     Input input(window.handle());
-    window.start_ui();
+    window.start_ui(config.ui_scale);
     ImageView view;
-    RenderWorker worker(sample, config.settings, config.frames);
+    RenderWorker worker(sample, config.settings, config.frames, config.denoiser);
 
     std::optional<scene::CameraController> camera;
     ShownFrame shown;
     PanelState panel;
     bool show_panel = config.panel;
+    bool show_keys = false;   // the F1 list
+    bool copy_flags = false;  // the panel's button, applied in the next frame's key handling
+    float panel_size[2] = {0, 0};
     RateMeter ui_rate, render_rate;
     const Clock::time_point start = Clock::now();
     Clock::time_point last = start;
@@ -95,6 +107,7 @@ int run_viewer(const ViewerConfig& config) {
     constexpr double kPartialInterval = 0.1;  // seconds
     std::vector<double> ui_frame_ms;  // intervals between window frames, for --verbose
     int exit_code = 0;
+    int last_fb_width = 0, last_fb_height = 0;
 
     while (!window.should_close()) {
         // Up to 60 window frames/s while idle; input wakes it at once.
@@ -114,32 +127,60 @@ int run_viewer(const ViewerConfig& config) {
 
         for (int key : input.take_presses()) {
             if (io.WantCaptureKeyboard) break;
-            if (key == GLFW_KEY_ESCAPE) window.close();
-            if (key == GLFW_KEY_H) show_panel = !show_panel;
-            if (key == GLFW_KEY_R) {
-                worker.reset();
-                panel.message = "accumulation reset";
-            }
-            if (key == GLFW_KEY_C && camera) {
-                camera->reset();
-                worker.set_camera(camera->camera());
-            }
-            if (key == GLFW_KEY_P) {
-                if (shown.number == 0) {
-                    panel.message = "nothing rendered yet to save";
-                } else {
-                    const std::string name = next_screenshot_name(sample.name);
-                    try {
-                        scene::write_png_rgba8(name, shown.width, shown.height,
-                                               shown.display->rgba());
-                        panel.message = "saved " + name;
-                    } catch (const std::exception& e) {
-                        panel.message = e.what();
+            const KeyAction action = action_of_key(key);
+            switch (action) {
+                case KeyAction::kQuit:
+                    window.close();
+                    break;
+                case KeyAction::kTogglePanel:
+                    show_panel = !show_panel;
+                    break;
+                case KeyAction::kToggleKeys:
+                    show_keys = !show_keys;
+                    break;
+                case KeyAction::kReset:
+                    worker.reset();
+                    panel.message = "accumulation reset";
+                    break;
+                case KeyAction::kCameraBack:
+                    if (camera) {
+                        camera->reset();
+                        worker.set_camera(camera->camera());
                     }
-                }
-                std::printf("%s\n", panel.message.c_str());
+                    break;
+                case KeyAction::kCopyFlags:
+                    copy_flags = true;
+                    break;
+                case KeyAction::kNextDenoiser:
+                    if (!status.denoises) {
+                        panel.message =
+                            "the " + sample.name + " sample has no denoiser (pathtracer has)";
+                    } else {
+                        const auto next = next_denoiser(status.denoiser);
+                        worker.set_denoiser(next);
+                        panel.message =
+                            std::string("denoiser ") + samples::view_denoiser_name(next);
+                    }
+                    break;
+                case KeyAction::kSavePng:
+                    if (shown.number == 0) {
+                        panel.message = "nothing rendered yet to save";
+                    } else {
+                        const std::string name = next_screenshot_name(sample.name);
+                        try {
+                            scene::write_png_rgba8(name, shown.width, shown.height,
+                                                   shown.display->rgba());
+                            panel.message = "saved " + name;
+                        } catch (const std::exception& e) {
+                            panel.message = e.what();
+                        }
+                    }
+                    std::printf("%s\n", panel.message.c_str());
+                    break;
+                default:
+                    break;
             }
-            if (const char* option = toggled_option(key)) {
+            if (const char* option = toggled_option(action)) {
                 const bool has = std::any_of(sample.options.begin(), sample.options.end(),
                                              [&](const auto& o) { return o.name == option; });
                 if (!has) {
@@ -157,6 +198,15 @@ int run_viewer(const ViewerConfig& config) {
                 }
             }
         }
+        if (copy_flags && camera) {
+            // On the clipboard and stdout: pasted after `lucent render`, it renders this view.
+            const std::string flags = cli::camera_flags(camera->camera());
+            glfwSetClipboardString(window.handle(), flags.c_str());
+            std::printf("%s\n", flags.c_str());
+            std::fflush(stdout);
+            panel.message = "copied the camera as flags";
+        }
+        copy_flags = false;
 
         if (std::optional<ShownFrame> frame = worker.frame_after(shown.number)) {
             shown = std::move(*frame);
@@ -182,6 +232,8 @@ int run_viewer(const ViewerConfig& config) {
 
         int fb_width = 0, fb_height = 0;
         window.framebuffer_size(fb_width, fb_height);
+        last_fb_width = fb_width;
+        last_fb_height = fb_height;
         glViewport(0, 0, fb_width, fb_height);
         glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
@@ -191,16 +243,20 @@ int run_viewer(const ViewerConfig& config) {
             panel.ui_fps = ui_rate.rate(now);
             panel.render_fps = render_rate.rate(now);
             panel.frame = &shown;
-            const PanelChanges changes = draw_panel(sample, status, panel);
+            panel.camera = camera ? &camera->camera() : nullptr;
+            const PanelChanges changes = draw_panel(sample, status, panel, panel_size);
             for (const auto& [name, value] : changes.options) worker.set_option(name, value);
             if (changes.spp_limit) worker.set_spp_limit(*changes.spp_limit);
+            if (changes.denoiser) worker.set_denoiser(*changes.denoiser);
+            copy_flags = changes.copy_flags;
         }
+        if (show_keys) draw_key_list();
         window.end_ui_frame();
 
         if (headless_check && shown.number >= config.frames) {
             // What the window shows now, before the swap: the back buffer just drawn.
             if (!config.screenshot.empty())
-                save_framebuffer_png(config.screenshot, fb_width, fb_height);
+                save_framebuffer(config.screenshot, fb_width, fb_height);
             break;
         }
         window.swap();
@@ -220,6 +276,10 @@ int run_viewer(const ViewerConfig& config) {
             sample.name.c_str(), status.backend.c_str(), (unsigned long long)ui_frames, elapsed,
             double(ui_frames) / std::max(elapsed, 1e-9), at(0.5), at(0.95), ui_frame_ms.back(),
             (unsigned long long)shown.number, (unsigned long long)partial_uploads);
+        std::printf("lucent view: panel %.0fx%.0f of a %dx%d window (ui scale %.3g)\n",
+                    panel_size[0], panel_size[1], last_fb_width, last_fb_height, window.ui_scale());
+        if (camera)
+            std::printf("lucent view: camera %s\n", cli::camera_flags(camera->camera()).c_str());
     }
     if (exit_code == 0 && !config.screenshot.empty())
         std::printf("wrote %s\n", config.screenshot.c_str());

@@ -12,8 +12,10 @@ struct ViewerConfig {
     const samples::Sample* sample = nullptr;
     samples::RenderSettings settings;
     unsigned frames = 0;     // >0: exit after this many rendered frames were shown
-    std::string screenshot;  // with frames: save the window's pixels here (.png)
+    std::string screenshot;  // with frames: save the window's pixels here (.png .exr .pfm)
     bool panel = true;
+    float ui_scale = 0;  // 0: the window's content scale
+    samples::ViewDenoiser denoiser = samples::ViewDenoiser::kOff;
     bool verbose = false;
 };
 

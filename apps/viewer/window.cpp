@@ -60,11 +60,20 @@ Window::~Window() {
     glfwTerminate();
 }
 
-void Window::start_ui() {
+void Window::start_ui(float scale) {
+    if (scale <= 0) {
+        float x = 1, y = 1;
+        glfwGetWindowContentScale(m_window, &x, &y);
+        scale = std::clamp(std::max(x, y), 0.5f, 8.0f);
+    }
+    m_ui_scale = scale;
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the user's directory
     ImGui::StyleColorsDark();
+    // The default font is a 13-pixel bitmap: scaled, it stays legible, if soft.
+    ImGui::GetStyle().ScaleAllSizes(scale);
+    ImGui::GetIO().FontGlobalScale = scale;
     ImGui_ImplGlfw_InitForOpenGL(m_window, /*install_callbacks=*/true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
     m_ui = true;

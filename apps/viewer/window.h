@@ -18,8 +18,11 @@ class Window {
 
     GLFWwindow* handle() const { return m_window; }
     /// Sets up ImGui's GLFW and OpenGL3 backends (after the app's own GLFW callbacks, which
-    /// ImGui then chains to).
-    void start_ui();
+    /// ImGui then chains to), its text and controls scaled by `scale` (0: the window's
+    /// content scale, which the desktop sets for high-DPI screens).
+    void start_ui(float scale);
+    /// The scale start_ui chose.
+    float ui_scale() const { return m_ui_scale; }
     bool should_close() const;
     void close();
     /// Waits up to `seconds` for input, so an idle viewer does not spin a core.
@@ -32,6 +35,7 @@ class Window {
   private:
     GLFWwindow* m_window = nullptr;
     bool m_ui = false;
+    float m_ui_scale = 1;
 };
 
 }  // namespace lucent::viewer

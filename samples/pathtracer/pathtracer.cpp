@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "samples/aov_passes.h"
@@ -14,6 +15,7 @@
 #include "samples/pathtracer/pathtracer_programs.h"
 #include "samples/scene_setup.h"
 #include "samples/stages.h"
+#include "samples/view_denoiser.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
@@ -70,7 +72,9 @@ void set_variables(Program& camera, Program& miss, const PathOptions& o) {
 struct PathScene {
     scene::Camera camera;                   // the scene's own camera
     std::shared_ptr<Buffer> accum, output;  // width x height float4
+    std::shared_ptr<Buffer> stream_offset;  // one unsigned: PathSession's SVGF frames
     std::shared_ptr<Program> camera_program, miss;
+    std::vector<std::shared_ptr<Material>> materials;
     std::string note;                       // "cornell, 32 triangles"
 };
 
@@ -130,15 +134,19 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     out.accum =
         ctx.create_buffer<float4>(BufferType::kInputOutput, settings.width, settings.height);
     out.output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    out.stream_offset = ctx.create_buffer<unsigned>(BufferType::kInput, 1);
+    out.stream_offset->upload(std::vector<unsigned>{0});
     out.miss = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_miss));
     ctx.set_miss_program(pathtracer::kRadianceRay, out.miss);
     out.camera_program = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_camera));
     (*out.camera_program)["camera"] = camera.buffer();
     (*out.camera_program)["accum"] = out.accum;
     (*out.camera_program)["output"] = out.output;
+    (*out.camera_program)["stream_offset"] = out.stream_offset;
     set_variables(*out.camera_program, *out.miss, options);
     ctx.set_ray_generation_program(0, out.camera_program);
     out.note = scene_note(input);
+    out.materials = std::move(materials);
     return out;
 }
 
@@ -179,30 +187,62 @@ void render_frames(Context& ctx, const RenderSettings& settings, RenderResult& o
 }
 
 /// `lucent view`: progressive. Each frame adds one sample per pixel to the accumulation
-/// buffer, whose w counts them; moving the camera or an option clears it.
+/// buffer, whose w counts them; moving the camera or an option clears it. With SVGF on,
+/// every frame renders one new sample per pixel (the accumulation restarts, the random
+/// streams go on) and SVGF's history does the accumulating, across camera moves too.
 class PathSession final : public CameraSession {
   public:
     PathSession(const Sample& sample, const RenderSettings& settings, const PathOptions& options)
         : CameraSession(sample, settings) {
         m_scene = build(context(), settings, options, camera());
         set_output(m_scene.output);
-        start_at(m_scene.camera, pinhole_camera(m_scene.camera, settings.aspect()));
+        m_pinhole = pinhole_camera(m_scene.camera, settings.aspect());
+        start_at(m_scene.camera, m_pinhole);
         reset();
     }
 
     bool progressive() const override { return true; }
+    bool denoises() const override { return true; }
+
+    void set_denoiser(ViewDenoiser denoiser) override {
+        if (denoiser != ViewDenoiser::kOff && !m_denoisers)
+            m_denoisers.emplace(context(), settings(), kGBufferRay, kGBufferEntry,
+                                camera().buffer(), m_scene.output, m_scene.materials);
+        if (denoiser == m_denoiser) return;
+        m_denoiser = denoiser;
+        reset();
+    }
+
+    void set_camera(const scene::Camera& camera) override {
+        m_pinhole = pinhole_camera(camera, settings().aspect());
+        this->camera().set(m_pinhole);
+        clear_accumulation();  // SVGF keeps its history: it reprojects it
+        m_resting = 0;
+    }
 
     void reset() override {
-        // The sample count is the accumulation's w: zero restarts the average (and the
-        // random streams, so a resting camera converges to the sample's own render).
-        const size_t pixels = size_t(settings().width) * settings().height;
-        m_scene.accum->upload(std::vector<float4>(pixels, make_float4(0.0f, 0.0f, 0.0f, 0.0f)));
-        m_samples = 0;
+        clear_accumulation();
+        m_resting = 0;
+        if (m_denoisers) m_denoisers->reset_history();
     }
 
     FrameResult frame() override {
-        FrameResult out = CameraSession::frame();
-        out.samples = ++m_samples;
+        if (m_denoiser == ViewDenoiser::kOff) {
+            FrameResult out = CameraSession::frame();
+            out.samples = ++m_samples;
+            return out;
+        }
+        // SVGF: a new sample per pixel, on streams of its own, for SVGF to integrate.
+        if (m_denoiser == ViewDenoiser::kSvgf && m_samples > 0) clear_accumulation();
+        RenderResult passes;
+        context().launch(0, settings().width, settings().height);
+        passes.report = context().last_launch();
+        add_launch_stages(passes.report, passes.stages);
+        const Buffer& filtered = m_denoisers->run(m_denoiser, m_pinhole, passes);
+        FrameResult out = frame_of(std::move(passes), filtered);
+        ++m_samples;
+        // SVGF: the frames since the camera last moved, which its resting history averages.
+        out.samples = m_denoiser == ViewDenoiser::kSvgf ? ++m_resting : m_samples;
         return out;
     }
 
@@ -212,8 +252,27 @@ class PathSession final : public CameraSession {
         return true;
     }
 
+    void clear_accumulation() {
+        // The sample count is the accumulation's w: zero restarts the average (and the
+        // random streams, so a resting camera converges to the sample's own render).
+        // SVGF's frames go on from the streams used so far instead.
+        const unsigned streams = m_denoiser == ViewDenoiser::kSvgf ? m_streams + m_samples : 0;
+        if (streams != m_streams) {
+            m_streams = streams;
+            m_scene.stream_offset->upload(std::vector<unsigned>{m_streams});
+        }
+        const size_t pixels = size_t(settings().width) * settings().height;
+        m_scene.accum->upload(std::vector<float4>(pixels, make_float4(0.0f, 0.0f, 0.0f, 0.0f)));
+        m_samples = 0;
+    }
+
     PathScene m_scene;
-    unsigned m_samples = 0;
+    sample_common::PinholeCamera m_pinhole{};
+    unsigned m_samples = 0;  // in the accumulation buffer
+    unsigned m_streams = 0;  // SVGF: sample streams used before the accumulation's
+    unsigned m_resting = 0;  // SVGF: frames since the camera moved
+    ViewDenoiser m_denoiser = ViewDenoiser::kOff;
+    std::optional<ViewDenoisers> m_denoisers;
 };
 
 class PathtracerSample final : public Sample {

@@ -86,6 +86,9 @@ struct CameraRecord {
     lucent::BufferView<sample_common::PinholeCamera> camera;  // one element
     lucent::BufferView<float4> accum;   // running sums; w counts the samples (the frame)
     lucent::BufferView<float4> output;  // the average, exposed and tone mapped
+    /// One element added to the frame's random streams: the viewer's temporal denoiser
+    /// restarts the accumulation every frame and must not restart the streams with it.
+    lucent::BufferView<const unsigned> stream_offset;
     lucent::Handle top_object;
     unsigned max_depth;  // path segments from the eye
     unsigned rr_depth;   // bounces before Russian roulette starts
@@ -94,8 +97,8 @@ struct CameraRecord {
     float exposure;
     unsigned reinhard;  // 1: L / (1 + L) per channel after the exposure
 };
-LUCENT_RECORD(CameraRecord, camera, accum, output, top_object, max_depth, rr_depth, nee, seed,
-              exposure, reinhard)
+LUCENT_RECORD(CameraRecord, camera, accum, output, stream_offset, top_object, max_depth, rr_depth,
+              nee, seed, exposure, reinhard)
 
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
@@ -213,7 +216,7 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     const uint3 i = lucent::launch_index(), n = lucent::launch_size();
     const uint2 pixel = make_uint2(i.x, i.y);
     float4 accum = rec.accum[pixel];
-    unsigned rng = path_seed(i.y * n.x + i.x, unsigned(accum.w), rec.seed);
+    unsigned rng = path_seed(i.y * n.x + i.x, unsigned(accum.w) + rec.stream_offset[0u], rec.seed);
     // A uniformly jittered position in the pixel: the box filter's antialiasing.
     const float sx = 2.0f * (float(i.x) + next_random(rng)) / float(n.x) - 1.0f;
     const float sy = 1.0f - 2.0f * (float(i.y) + next_random(rng)) / float(n.y);
