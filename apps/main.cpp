@@ -8,6 +8,7 @@
 #include "bench_fog_command.h"
 #include "bench_igi_command.h"
 #include "bench_present_command.h"
+#include "bench_spheres_command.h"
 #include "cli_errors.h"
 #include "cli_parse.h"
 #include "compare_command.h"
@@ -63,6 +64,7 @@ int main(int argc, char** argv) {
     BenchIgiArgs bench_igi_args;
     BenchFogArgs bench_fog_args;
     BenchPresentArgs bench_present_args;
+    BenchSpheresArgs bench_spheres_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     CompareArgs compare_args;
@@ -74,6 +76,7 @@ int main(int argc, char** argv) {
         CLI::App* bench_igi = add_bench_igi_command(bench.bench, bench_igi_args);
         CLI::App* bench_fog = add_bench_fog_command(bench.bench, bench_fog_args);
         CLI::App* bench_present = add_bench_present_command(bench.bench, bench_present_args);
+        CLI::App* bench_spheres = add_bench_spheres_command(bench.bench, bench_spheres_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         CLI::App* compare = add_compare_command(app, compare_args);
@@ -113,6 +116,10 @@ int main(int argc, char** argv) {
         if (bench_present->parsed()) {
             where = "lucent bench present";
             return run_bench_present_command(bench_present_args);
+        }
+        if (bench_spheres->parsed()) {
+            where = "lucent bench spheres";
+            return run_bench_spheres_command(bench_spheres_args);
         }
         if (bench_igi->parsed()) {
             where = "lucent bench igi";

@@ -680,7 +680,7 @@ Scene load_gltf_scene(const std::string& path) {
         const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
         // JSON text holds no NUL byte, and the JSON parser ends its input at one: what
         // follows it would be ignored without a word.
-        if (!binary)
+        if (!binary && !bytes.empty())  // an empty vector's data() may be null
             if (const void* nul = std::memchr(bytes.data(), 0, bytes.size()))
                 throw Error(path + ": a NUL byte at byte " +
                             std::to_string(static_cast<const unsigned char*>(nul) - bytes.data()) +

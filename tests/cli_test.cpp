@@ -598,3 +598,16 @@ TEST_F(CliTest, MalformedGltfIsOneLineNamingTheJsonPathAndWritesNothing) {
 }
 
 }  // namespace
+
+// `bench spheres` times the built-in spheres against the same spheres as a custom program:
+// both paths must give every pixel the same sphere, and rays must hit (a field, not a void).
+TEST(CliBenchJson, SpheresBenchComparesTheSameWork) {
+    CliRun run = run_cli("bench spheres --count 5000 --size 64x48 --repeat 2 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json result = nlohmann::json::parse(run.output);
+    EXPECT_EQ(result["spheres"], 5000);
+    EXPECT_EQ(result["pixels_that_differ"], 0);
+    EXPECT_GT(result["hit_fraction"].get<double>(), 0.5);
+    EXPECT_GT(result["builtin_mrays"]["mrays"].get<double>(), 0.0);
+    EXPECT_GT(result["custom_mrays"]["mrays"].get<double>(), 0.0);
+}

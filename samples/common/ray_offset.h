@@ -52,15 +52,18 @@ LUCENT_HD inline float3 offset_ray_origin(float3 p, float3 n, float scene_size) 
                        offset_coordinate(p.z, n.z, near_zero, near_offset));
 }
 
-/// The end of a ray between two points, as a fraction of the way (the direction is `to -
-/// from`): both ends are offset points, so the ray may end just short of `to` and still
-/// test everything between them; relative, so it is the same share of the way at any scale.
-constexpr float kSegmentEnd = 0.9999f;
+/// The interval of a ray between two points, as fractions of the way (the direction is `to -
+/// from`): both ends are offset points, so the ray need not reach them; relative, so it is
+/// the same share of the way at any scale. Not 0 and 1: the surfaces at either end then lie
+/// outside the interval and their BVH boxes are culled, not entered and their triangles
+/// tested (IGI's VPL shadow rays on Sponza: 6 % of the frame rate with 0 and 0.9999, H200).
+/// An occluder within a thousandth of the way of either end casts no shadow.
+constexpr float kSegmentStart = 0.001f, kSegmentEnd = 0.999f;
 
 /// A shadow (visibility) ray from `from` to just short of `to`, both offset off their
 /// surfaces (offset_ray_origin), or `to` a point light.
 LUCENT_HD inline lucent::Ray segment_ray(float3 from, float3 to, unsigned ray_type) {
-    return lucent::make_ray(from, to - from, ray_type, 0.0f, kSegmentEnd);
+    return lucent::make_ray(from, to - from, ray_type, kSegmentStart, kSegmentEnd);
 }
 
 }  // namespace sample_common
