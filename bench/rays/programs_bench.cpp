@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include "bench/common/input_buffer.h"
 #include "bench/rays/rays_programs.h"
 #include "lucent/lucent.h"
 
@@ -12,13 +13,6 @@ namespace {
 namespace programs = lucent_bench_rays;
 
 constexpr unsigned kPrimaryEntry = 0, kShadowEntry = 1, kDiffuseEntry = 2;
-
-template <class T>
-std::shared_ptr<Buffer> input_buffer(Context& ctx, const std::vector<T>& values) {
-    auto buffer = ctx.create_buffer<T>(BufferType::kInput, unsigned(values.size()));
-    buffer->upload(values);
-    return buffer;
-}
 
 /// A ray-generation program with its own ray set bound to it (its own variable scope).
 std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySet& rays) {

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "bench/common/input_buffer.h"
 #include "bench/common/rate.h"
 #include "bench/common/report.h"
 #include "bench/spheres/spheres_programs.h"
@@ -37,13 +38,6 @@ SphereField make_field(unsigned count) {
         f.radii.push_back(radius * scale(rng));
     }
     return f;
-}
-
-template <class T>
-std::shared_ptr<Buffer> input_buffer(Context& ctx, const std::vector<T>& values) {
-    auto buffer = ctx.create_buffer<T>(BufferType::kInput, unsigned(values.size()));
-    buffer->upload(values);
-    return buffer;
 }
 
 /// One path's Context: the camera's ray generation over `field` as built-in or custom spheres.

@@ -139,7 +139,6 @@ class Material;
 /// What a geometry's primitives are: programs of the user's (Geometry), or built into
 /// the engine's traversal with their own intersection code (OptiX's OptixPrimitiveType).
 enum class PrimitiveType { kCustom, kTriangles, kSpheres };
-const char* primitive_type_name(PrimitiveType type);
 
 /// Common base of Geometry (custom primitives) and the built-in GeometryTriangles and
 /// GeometrySpheres.

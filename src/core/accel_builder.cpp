@@ -46,7 +46,7 @@ uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
 
 Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
     Aabb box = empty_box();
-    if (inst.triangles) {
+    if (inst.triangles()) {
         uint3 t = triangle_of(inst, prim);
         grow(box, inst.vertices[t.x]);
         grow(box, inst.vertices[t.y]);
@@ -68,7 +68,7 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
 }
 
 const GeometryTriangles* triangles_of(const CompiledInstance& inst) {
-    return inst.triangles ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
+    return inst.triangles() ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
                           : nullptr;
 }
 }  // namespace

@@ -57,7 +57,6 @@ struct CompiledMaterial {
 struct CompiledInstance {
     const GeometryInstance* source = nullptr;
     PrimitiveType type = PrimitiveType::kCustom;
-    bool triangles = false;  // type == kTriangles
     unsigned primitive_count = 0;
     CompiledProgram intersection, bounding_box, attribute;
     std::vector<CompiledMaterial> materials;
@@ -74,6 +73,7 @@ struct CompiledInstance {
     const float* radii = nullptr;
     bool single_radius = false;  // radii[0] for every sphere
     float radius(unsigned prim) const { return radii[single_radius ? 0 : prim]; }
+    bool triangles() const { return type == PrimitiveType::kTriangles; }
 };
 
 /// Acceleration data of a GeometryGroup, kept across compiles while unchanged.

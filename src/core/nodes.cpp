@@ -38,6 +38,14 @@ void require_same_context(const std::shared_ptr<T>& p, const ContextObject& owne
         throw Error(owner.describe() + ": " + p->describe() +
                     " belongs to another Context; create it with this node's Context");
 }
+/// `buffer` is a 1D buffer of `element`; else Error "<owner>: <what> must be a 1D buffer of
+/// <type>, got ...".
+void require_1d_buffer_of(const Buffer& buffer, const TypeInfo& element, const ContextObject& owner,
+                          const char* what, const char* type) {
+    if (!same_type(buffer.element(), element) || buffer.dimensionality() != 1)
+        throw Error(owner.describe() + ": " + what + " must be a 1D buffer of " + type +
+                    ", got " + buffer.describe());
+}
 void require_visibility_mask(const ContextObject& owner, unsigned mask) {
     if (mask > kVisibilityMaskAll)
         throw Error(owner.describe() + ": visibility mask 0x" + hex(mask) +
@@ -186,9 +194,7 @@ std::string GeometryTriangles::describe() const {
 }
 void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     require(vertices, *this, "vertex buffer");
-    if (!same_type(vertices->element(), type_info_of<float3>()) || vertices->dimensionality() != 1)
-        throw Error(describe() + ": vertices must be a 1D buffer of float3, got " +
-                    vertices->describe());
+    require_1d_buffer_of(*vertices, type_info_of<float3>(), *this, "vertices", "float3");
     m_vertices = std::move(vertices);
     changed();
 }
@@ -202,10 +208,9 @@ void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
     changed();
 }
 void GeometryTriangles::set_material_indices(std::shared_ptr<Buffer> material_indices) {
-    if (material_indices && (material_indices->dimensionality() != 1 ||
-                             !same_type(material_indices->element(), type_info_of<unsigned>())))
-        throw Error(describe() + ": material indices must be a 1D buffer of unsigned, got " +
-                    material_indices->describe());
+    if (material_indices)
+        require_1d_buffer_of(*material_indices, type_info_of<unsigned>(), *this,
+                             "material indices", "unsigned");
     m_material_indices = std::move(material_indices);
     changed();
 }
@@ -221,42 +226,25 @@ unsigned GeometryTriangles::primitive_count() const {
     return m_vertices ? unsigned(m_vertices->count() / 3) : 0;
 }
 
-const char* primitive_type_name(PrimitiveType type) {
-    switch (type) {
-        case PrimitiveType::kCustom:
-            return "custom";
-        case PrimitiveType::kTriangles:
-            return "triangles";
-        case PrimitiveType::kSpheres:
-            return "spheres";
-    }
-    return "?";
-}
-
 std::string GeometrySpheres::describe() const {
     return "GeometrySpheres '" + name() + "'";
 }
 void GeometrySpheres::set_centers(std::shared_ptr<Buffer> centers) {
     require(centers, *this, "centre buffer");
-    if (!same_type(centers->element(), type_info_of<float3>()) || centers->dimensionality() != 1)
-        throw Error(describe() + ": centres must be a 1D buffer of float3, got " +
-                    centers->describe());
+    require_1d_buffer_of(*centers, type_info_of<float3>(), *this, "centres", "float3");
     m_centers = std::move(centers);
     changed();
 }
 void GeometrySpheres::set_radii(std::shared_ptr<Buffer> radii) {
     require(radii, *this, "radius buffer");
-    if (!same_type(radii->element(), type_info_of<float>()) || radii->dimensionality() != 1)
-        throw Error(describe() + ": radii must be a 1D buffer of float, got " +
-                    radii->describe());
+    require_1d_buffer_of(*radii, type_info_of<float>(), *this, "radii", "float");
     m_radii = std::move(radii);
     changed();
 }
 void GeometrySpheres::set_material_indices(std::shared_ptr<Buffer> material_indices) {
-    if (material_indices && (material_indices->dimensionality() != 1 ||
-                             !same_type(material_indices->element(), type_info_of<unsigned>())))
-        throw Error(describe() + ": material indices must be a 1D buffer of unsigned, got " +
-                    material_indices->describe());
+    if (material_indices)
+        require_1d_buffer_of(*material_indices, type_info_of<unsigned>(), *this,
+                             "material indices", "unsigned");
     m_material_indices = std::move(material_indices);
     changed();
 }

@@ -193,7 +193,6 @@ void SceneCompiler::compile_instance(unsigned index) {
     CompiledInstance out;
     out.source = &gi;
     out.type = geometry.primitive_type();
-    out.triangles = out.type == PrimitiveType::kTriangles;
     out.primitive_count = geometry.primitive_count();
     out.opaque = geometry.flags() & kGeometryFlagDisableAnyHit;
     out.visibility_mask = gi.visibility_mask();

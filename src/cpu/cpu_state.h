@@ -50,7 +50,7 @@ struct CpuPolicy {
 
     const Instance& instance(unsigned index) const { return scene().instances[index]; }
     unsigned material_count(const Instance& inst) const { return unsigned(inst.materials.size()); }
-    unsigned triangle_material(const Instance& inst, unsigned prim) const {
+    unsigned primitive_material(const Instance& inst, unsigned prim) const {
         return inst.material_indices ? inst.material_indices[prim] : 0u;
     }
     void triangle(const Instance& inst, unsigned prim, float3& p0, float3& p1, float3& p2) const {

@@ -109,7 +109,7 @@ class Traverser {
                        ga.prim_first.begin() - 1;
             unsigned local = ref - ga.prim_first[k];
             const CompiledInstance& inst = m_scene.instances[n.instances[k]];
-            if (inst.triangles) {
+            if (inst.triangles()) {
                 uint3 tri = CpuPolicy::triangle_of(inst, local);
                 float t, u, v;
                 if (intersect_triangle_watertight(wray, inst.vertices[tri.x], inst.vertices[tri.y],
@@ -169,7 +169,7 @@ class Traverser {
         locate_triangle(n, global, instance, local);
         runtime::commit_triangle<CpuPolicy>(
             m_frame, instance, local, t,
-            m_policy.triangle_material(m_scene.instances[instance], local), bary);
+            m_policy.primitive_material(m_scene.instances[instance], local), bary);
     }
 
     /// The closest triangle of a triangles-only group without any-hit programs, found by

@@ -14,7 +14,7 @@
 //   raise(code, detail)                        the CPU throws core::ProgramException; the
 //   exception_pending()                        GPU records it and the caller returns
 //   ray_type_count(), payload_matches(ray_type, tag), node_count(), max_depth(), no_ray()
-//   instance(i), material_count(inst), triangle_material(inst, prim), triangle(inst, prim,
+//   instance(i), material_count(inst), primitive_material(inst, prim), triangle(inst, prim,
 //   p0, p1, p2), any_hit(inst, material, ray_type), closest_hit(...), miss(ray_type),
 //   attribute(inst), bound(program)            the scene, and which programs are bound
 //   opaque(inst), visibility_mask(inst),
@@ -388,6 +388,18 @@ LUCENT_HD inline bool run_any_hit(const P& p, FrameOf<P>& f, typename P::Program
     return true;
 }
 
+/// In occluded(), any accepted intersection answers the query: it ends traversal.
+template <class P>
+LUCENT_HD inline bool answers_occlusion(FrameOf<P>& f) {
+    if constexpr (P::kOcclusion) {
+        if (f.occlusion) {
+            f.has_hit = f.terminated = true;
+            return true;
+        }
+    }
+    return false;
+}
+
 /// A triangle hit nearer than the closest so far: the instance's mask and the ray's culls,
 /// any-hit (unless opaque), then commit. True if accepted.
 template <class P>
@@ -402,13 +414,8 @@ LUCENT_HD inline bool triangle_candidate(const P& p, FrameOf<P>& f, unsigned ins
             return false;
         if (culled_by_opacity(f, opaque_for_ray(p, f, inst))) return false;
     }
-    if constexpr (P::kOcclusion) {
-        if (f.occlusion) {  // occluded(): any intersection answers the query
-            f.has_hit = f.terminated = true;
-            return true;
-        }
-    }
-    const unsigned material = p.triangle_material(inst, prim);
+    if (answers_occlusion<P>(f)) return true;
+    const unsigned material = p.primitive_material(inst, prim);
     const typename P::Program any = p.any_hit(inst, material, f.ray_type);
     if (p.bound(any) && !opaque_for_ray(p, f, inst)) {
         f.instance = instance_index;
@@ -448,13 +455,8 @@ LUCENT_HD inline bool primitive_candidate(const P& p, FrameOf<P>& f, unsigned in
     if ((f.ray_flags & (kRayFlagCullDisabledAnyHit | kRayFlagCullEnforcedAnyHit)) &&
         culled_by_opacity(f, opaque_for_ray(p, f, inst)))
         return false;
-    if constexpr (P::kOcclusion) {
-        if (f.occlusion) {  // occluded(): any intersection answers the query
-            f.has_hit = f.terminated = true;
-            return true;
-        }
-    }
-    const unsigned material = p.triangle_material(inst, prim);
+    if (answers_occlusion<P>(f)) return true;
+    const unsigned material = p.primitive_material(inst, prim);
     const typename P::Program any = p.any_hit(inst, material, f.ray_type);
     if (p.bound(any) && !opaque_for_ray(p, f, inst)) {
         f.instance = instance_index;
@@ -525,12 +527,7 @@ LUCENT_RUNTIME_INLINE bool report_intersection(const P& p, unsigned material) {
         p.raise(kExceptionMaterialIndexOutOfRange, material);
         return false;
     }
-    if constexpr (P::kOcclusion) {
-        if (f->occlusion) {  // occluded(): no any-hit, the first intersection ends traversal
-            f->has_hit = f->terminated = true;
-            return true;
-        }
-    }
+    if (answers_occlusion<P>(*f)) return true;  // occluded(): no any-hit runs
     if ((f->ray_flags & (kRayFlagCullDisabledAnyHit | kRayFlagCullEnforcedAnyHit)) &&
         culled_by_opacity(*f, opaque_for_ray(p, *f, inst)))
         return false;

@@ -26,7 +26,7 @@ static_assert(unsigned(PrimitiveType::kCustom) == gpu::kGpuCustom &&
               "GpuInstance::type holds lucent::PrimitiveType's values");
 
 const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
-    return inst.triangles ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
+    return inst.triangles() ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
                           : nullptr;
 }
 
@@ -189,7 +189,6 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
     const unsigned ray_types = unsigned(scene.ray_types.size());
     for (const core::CompiledInstance& inst : scene.instances) {
         gpu::GpuInstance g{};
-        g.triangles = inst.triangles;
         g.type = unsigned(inst.type);
         g.prim_count = inst.primitive_count;
         g.opaque = inst.opaque;

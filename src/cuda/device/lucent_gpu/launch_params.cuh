@@ -72,7 +72,6 @@ struct GpuGeometryAccel {
 enum GpuPrimitiveType : unsigned { kGpuCustom = 0, kGpuTriangles = 1, kGpuSpheres = 2 };
 
 struct GpuInstance {
-    unsigned triangles;
     unsigned type;  // GpuPrimitiveType
     unsigned prim_count;
     unsigned opaque;  // kGeometryFlagDisableAnyHit

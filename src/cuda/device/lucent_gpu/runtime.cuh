@@ -101,7 +101,7 @@ struct GpuPolicy {
     __device__ __forceinline__ unsigned material_count(const GpuInstance& inst) const {
         return inst.material_count;
     }
-    __device__ __forceinline__ unsigned triangle_material(const GpuInstance& inst,
+    __device__ __forceinline__ unsigned primitive_material(const GpuInstance& inst,
                                                           unsigned prim) const {
         return inst.material_indices ? inst.material_indices[prim] : 0u;
     }

@@ -116,7 +116,7 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
     WatertightRay wray = make_watertight_ray(origin, direction);
     auto visit_resolved = [&](unsigned instance_index, unsigned local) {
         const GpuInstance& inst = params.instances[instance_index];
-        if (inst.triangles) {
+        if (inst.type == kGpuTriangles) {
             uint3 t = GpuPolicy::triangle_of(inst, local);
             float th, u, v;
             if (intersect_triangle_watertight(wray, inst.vertices[t.x], inst.vertices[t.y],
