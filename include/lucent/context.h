@@ -209,6 +209,7 @@ class Context : public VariableScope {
     std::shared_ptr<Geometry> create_geometry();
     std::shared_ptr<GeometryTriangles> create_geometry_triangles();
     std::shared_ptr<GeometrySpheres> create_geometry_spheres();
+    std::shared_ptr<GeometryCurves> create_geometry_curves();
     std::shared_ptr<Material> create_material();
 
     // ---- compile and launch ---------------------------------------------------

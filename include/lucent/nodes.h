@@ -138,7 +138,7 @@ class Material;
 
 /// What a geometry's primitives are: programs of the user's (Geometry), or built into
 /// the engine's traversal with their own intersection code (OptiX's OptixPrimitiveType).
-enum class PrimitiveType { kCustom, kTriangles, kSpheres };
+enum class PrimitiveType { kCustom, kTriangles, kSpheres, kCurves };
 
 /// Common base of Geometry (custom primitives) and the built-in GeometryTriangles and
 /// GeometrySpheres.
@@ -222,6 +222,35 @@ class GeometrySpheres : public GeometryBase {
 
   private:
     std::shared_ptr<Buffer> m_centers, m_radii, m_material_indices;
+};
+
+/// Built-in curves (OptiX's OPTIX_PRIMITIVE_TYPE_ROUND_LINEAR, _QUADRATIC_BSPLINE,
+/// _CUBIC_BSPLINE and _CATMULLROM): round tubes along a centre line with a radius per
+/// control point. A float3 vertex buffer and a float radius buffer (one per vertex), and an
+/// unsigned segment index buffer: segment i reads curve_control_points(type) consecutive
+/// vertices from segment_indices[i] (2 for linear, 3 for quadratic, 4 for cubic and
+/// Catmull-Rom); an optional unsigned per-segment material index buffer. Hit programs read
+/// BuiltinCurveAttributes (normal, the segment's parameter u). Bounds come from the data.
+class GeometryCurves : public GeometryBase {
+  public:
+    using GeometryBase::GeometryBase;
+    std::string describe() const override;
+    PrimitiveType primitive_type() const override { return PrimitiveType::kCurves; }
+    void set_curve_type(CurveType type);
+    CurveType curve_type() const { return m_type; }
+    void set_vertices(std::shared_ptr<Buffer> vertices);
+    void set_radii(std::shared_ptr<Buffer> radii);
+    void set_segment_indices(std::shared_ptr<Buffer> segment_indices);
+    void set_material_indices(std::shared_ptr<Buffer> material_indices);
+    const std::shared_ptr<Buffer>& vertices() const { return m_vertices; }
+    const std::shared_ptr<Buffer>& radii() const { return m_radii; }
+    const std::shared_ptr<Buffer>& segment_indices() const { return m_segments; }
+    const std::shared_ptr<Buffer>& material_indices() const { return m_material_indices; }
+    unsigned primitive_count() const override;
+
+  private:
+    CurveType m_type = kCurveCubicBSpline;
+    std::shared_ptr<Buffer> m_vertices, m_radii, m_segments, m_material_indices;
 };
 
 /// Closest-hit and any-hit programs per ray type.

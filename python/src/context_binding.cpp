@@ -195,6 +195,7 @@ void bind_context(py::module_& m) {
         .def("create_geometry", &Context::create_geometry)
         .def("create_geometry_triangles", &Context::create_geometry_triangles)
         .def("create_geometry_spheres", &Context::create_geometry_spheres)
+        .def("create_geometry_curves", &Context::create_geometry_curves)
         .def("create_material", &Context::create_material)
         .def("validate", &Context::validate, py::call_guard<py::gil_scoped_release>(),
              "Checks everything a launch would, without launching; raises lucent.Error.")

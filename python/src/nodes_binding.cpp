@@ -77,6 +77,10 @@ void bind_nodes(py::module_& m) {
     m.attr("GEOMETRY_FLAG_NONE") = unsigned(kGeometryFlagNone);
     m.attr("GEOMETRY_FLAG_DISABLE_ANYHIT") = unsigned(kGeometryFlagDisableAnyHit);
     m.attr("VISIBILITY_MASK_ALL") = kVisibilityMaskAll;
+    m.attr("CURVE_LINEAR") = unsigned(kCurveLinear);
+    m.attr("CURVE_QUADRATIC_BSPLINE") = unsigned(kCurveQuadraticBSpline);
+    m.attr("CURVE_CUBIC_BSPLINE") = unsigned(kCurveCubicBSpline);
+    m.attr("CURVE_CATMULL_ROM") = unsigned(kCurveCatmullRom);
     m.attr("RAY_FLAG_NONE") = unsigned(kRayFlagNone);
     m.attr("RAY_FLAG_DISABLE_ANYHIT") = unsigned(kRayFlagDisableAnyHit);
     m.attr("RAY_FLAG_ENFORCE_ANYHIT") = unsigned(kRayFlagEnforceAnyHit);
@@ -173,6 +177,23 @@ void bind_nodes(py::module_& m) {
         .def_property("radii", &GeometrySpheres::radii, &GeometrySpheres::set_radii)
         .def_property("material_indices", &GeometrySpheres::material_indices,
                       &GeometrySpheres::set_material_indices);
+
+    py::class_<GeometryCurves, GeometryBase, std::shared_ptr<GeometryCurves>>(
+        m, "GeometryCurves",
+        "Built-in round curves: curve_type (CURVE_LINEAR, CURVE_QUADRATIC_BSPLINE, "
+        "CURVE_CUBIC_BSPLINE or CURVE_CATMULL_ROM, default cubic), a float3 vertex Buffer, a "
+        "float radius Buffer (one per vertex), a uint segment index Buffer (each segment's "
+        "first control point) and an optional uint per-segment material index Buffer. Hit "
+        "programs read BuiltinCurveAttributes (object-space normal, u, entering).")
+        .def_property(
+            "curve_type", [](const GeometryCurves& c) { return unsigned(c.curve_type()); },
+            [](GeometryCurves& c, unsigned type) { c.set_curve_type(CurveType(type)); })
+        .def_property("vertices", &GeometryCurves::vertices, &GeometryCurves::set_vertices)
+        .def_property("radii", &GeometryCurves::radii, &GeometryCurves::set_radii)
+        .def_property("segment_indices", &GeometryCurves::segment_indices,
+                      &GeometryCurves::set_segment_indices)
+        .def_property("material_indices", &GeometryCurves::material_indices,
+                      &GeometryCurves::set_material_indices);
 
     py::class_<Material, std::shared_ptr<Material>> material(
         m, "Material", "Closest-hit and any-hit programs per ray type.");

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/program_exception.h"
+#include "lucent/device/curve_intersect.h"
 #include "core/scene_compiler.h"
 
 namespace lucent::core {
@@ -54,6 +55,18 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
     } else if (inst.type == PrimitiveType::kSpheres) {
         const float3 c = inst.centers[prim], r = make_float3(inst.radius(prim));
         box = Aabb{c - r, c + r};
+    } else if (inst.type == PrimitiveType::kCurves) {
+        // The segment's Bezier points hold it (convex hull), each widened by the largest of
+        // their radii.
+        CurvePoint b[4];
+        load_curve_segment(inst.curve_type, inst.vertices, inst.radii, inst.segments[prim], b);
+        float radius = 0.0f;
+        for (const CurvePoint& q : b) {
+            grow(box, make_float3(q));
+            radius = std::max(radius, std::fabs(q.w));
+        }
+        box.lo = box.lo - make_float3(radius);
+        box.hi = box.hi + make_float3(radius);
     } else {
         try {
             inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
@@ -95,6 +108,15 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
             triangles_only = false;
             auto& spheres = static_cast<const GeometrySpheres&>(*inst.source->geometry());
             for (const Buffer* b : {spheres.centers().get(), spheres.radii().get()}) {
+                content.add(b).add(b->version());
+                m_rebuild_inputs.push_back(b);
+            }
+        } else if (inst.type == PrimitiveType::kCurves) {
+            triangles_only = false;
+            auto& curves = static_cast<const GeometryCurves&>(*inst.source->geometry());
+            content.add(unsigned(curves.curve_type()));
+            for (const Buffer* b : {curves.vertices().get(), curves.radii().get(),
+                                    curves.segment_indices().get()}) {
                 content.add(b).add(b->version());
                 m_rebuild_inputs.push_back(b);
             }

@@ -90,4 +90,42 @@ void bind_spheres(const GeometrySpheres& spheres, const GeometryInstance& instan
                                                  count, "sphere");
 }
 
+void bind_curves(const GeometryCurves& curves, const GeometryInstance& instance,
+                 CompiledInstance& out) {
+    if (!curves.vertices())
+        throw Error(curves.describe() + " has no vertex buffer; set one with set_vertices");
+    if (!curves.radii())
+        throw Error(curves.describe() + " has no radius buffer; set one with set_radii");
+    if (!curves.segment_indices())
+        throw Error(curves.describe() +
+                    " has no segment index buffer; set one with set_segment_indices");
+    const size_t vertex_count = curves.vertices()->count();
+    if (curves.radii()->count() != vertex_count)
+        throw Error(curves.describe() + ": the radius buffer has " +
+                    std::to_string(curves.radii()->count()) + " entries for " +
+                    std::to_string(vertex_count) + " vertices; give one radius per vertex");
+    out.vertices = curves.vertices()->data<float3>();
+    out.radii = curves.radii()->data<float>();
+    out.segments = curves.segment_indices()->data<unsigned>();
+    out.curve_type = curves.curve_type();
+    for (size_t i = 0; i < vertex_count; ++i) {
+        const float r = out.radii[i];
+        if (!finite(out.vertices[i]))
+            throw Error(curves.describe() + ": vertex " + std::to_string(i) +
+                        " is not finite; fix the vertex buffer");
+        if (!(r >= 0.0f) || !std::isfinite(r))
+            throw Error(curves.describe() + ": vertex " + std::to_string(i) + " has radius " +
+                        std::to_string(r) + "; radii must be finite and at least 0");
+    }
+    const unsigned points = curve_control_points(out.curve_type);
+    for (unsigned i = 0; i < out.primitive_count; ++i)
+        if (size_t(out.segments[i]) + points > vertex_count)
+            throw Error(curves.describe() + ": segment " + std::to_string(i) + " starts at vertex " +
+                        std::to_string(out.segments[i]) + " and needs " + std::to_string(points) +
+                        " control points, but there are " + std::to_string(vertex_count) +
+                        " vertices; fix the segment index buffer");
+    out.material_indices = bind_material_indices(curves, curves.material_indices(), instance,
+                                                 out.primitive_count, "segment");
+}
+
 }  // namespace lucent::core

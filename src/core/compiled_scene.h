@@ -73,6 +73,10 @@ struct CompiledInstance {
     const float* radii = nullptr;
     bool single_radius = false;  // radii[0] for every sphere
     float radius(unsigned prim) const { return radii[single_radius ? 0 : prim]; }
+    // Built-in curves: vertices and radii (one per vertex) above, and each segment's first
+    // control point.
+    const unsigned* segments = nullptr;
+    CurveType curve_type = kCurveCubicBSpline;
     bool triangles() const { return type == PrimitiveType::kTriangles; }
 };
 

@@ -363,6 +363,9 @@ std::shared_ptr<GeometryTriangles> Context::create_geometry_triangles() {
 std::shared_ptr<GeometrySpheres> Context::create_geometry_spheres() {
     return std::make_shared<GeometrySpheres>(m_impl->shared, m_impl->next_name("spheres"));
 }
+std::shared_ptr<GeometryCurves> Context::create_geometry_curves() {
+    return std::make_shared<GeometryCurves>(m_impl->shared, m_impl->next_name("curves"));
+}
 std::shared_ptr<Material> Context::create_material() {
     return std::make_shared<Material>(m_impl->shared, m_impl->next_name("material"));
 }

@@ -252,6 +252,47 @@ unsigned GeometrySpheres::primitive_count() const {
     return m_centers ? unsigned(m_centers->count()) : 0;
 }
 
+std::string GeometryCurves::describe() const {
+    return "GeometryCurves '" + name() + "'";
+}
+void GeometryCurves::set_curve_type(CurveType type) {
+    if (unsigned(type) >= kCurveTypeCount)
+        throw Error(describe() + ": curve type " + std::to_string(unsigned(type)) +
+                    " is not one of kCurveLinear, kCurveQuadraticBSpline, kCurveCubicBSpline "
+                    "and kCurveCatmullRom");
+    m_type = type;
+    changed();
+}
+void GeometryCurves::set_vertices(std::shared_ptr<Buffer> vertices) {
+    require(vertices, *this, "vertex buffer");
+    require_1d_buffer_of(*vertices, type_info_of<float3>(), *this, "vertices", "float3");
+    m_vertices = std::move(vertices);
+    changed();
+}
+void GeometryCurves::set_radii(std::shared_ptr<Buffer> radii) {
+    require(radii, *this, "radius buffer");
+    require_1d_buffer_of(*radii, type_info_of<float>(), *this, "radii", "float");
+    m_radii = std::move(radii);
+    changed();
+}
+void GeometryCurves::set_segment_indices(std::shared_ptr<Buffer> segment_indices) {
+    require(segment_indices, *this, "segment index buffer");
+    require_1d_buffer_of(*segment_indices, type_info_of<unsigned>(), *this, "segment indices",
+                         "unsigned");
+    m_segments = std::move(segment_indices);
+    changed();
+}
+void GeometryCurves::set_material_indices(std::shared_ptr<Buffer> material_indices) {
+    if (material_indices)
+        require_1d_buffer_of(*material_indices, type_info_of<unsigned>(), *this,
+                             "material indices", "unsigned");
+    m_material_indices = std::move(material_indices);
+    changed();
+}
+unsigned GeometryCurves::primitive_count() const {
+    return m_segments ? unsigned(m_segments->count()) : 0;
+}
+
 std::string Material::describe() const {
     return "Material '" + name() + "'";
 }

@@ -209,6 +209,9 @@ void SceneCompiler::compile_instance(unsigned index) {
     } else if (out.type == PrimitiveType::kSpheres) {
         bind_spheres(static_cast<const GeometrySpheres&>(geometry), gi, out);
         out.attributes = &type_info_of<BuiltinSphereAttributes>();
+    } else if (out.type == PrimitiveType::kCurves) {
+        bind_curves(static_cast<const GeometryCurves&>(geometry), gi, out);
+        out.attributes = &type_info_of<BuiltinCurveAttributes>();
     } else {
         auto& custom = static_cast<const Geometry&>(geometry);
         if (!custom.intersection_program())

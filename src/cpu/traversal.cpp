@@ -120,6 +120,12 @@ class Traverser {
             } else if (inst.type == PrimitiveType::kSpheres) {
                 runtime::sphere_candidates(m_policy, m_frame, n.instances[k], local, origin,
                                            direction, inst.centers[local], inst.radius(local));
+            } else if (inst.type == PrimitiveType::kCurves) {
+                CurvePoint bezier[4];
+                load_curve_segment(inst.curve_type, inst.vertices, inst.radii,
+                                   inst.segments[local], bezier);
+                runtime::curve_candidates(m_policy, m_frame, n.instances[k], local, origin,
+                                          direction, inst.curve_type, bezier);
             } else {
                 runtime::run_intersection(m_policy, m_frame, n.instances[k], inst, local);
             }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "lucent/device/api.h"
+#include "lucent/device/curve_intersect.h"
 #include "lucent/device/sphere_intersect.h"
 #include "runtime/trace_frame.h"
 
@@ -490,6 +491,26 @@ LUCENT_HD inline void sphere_candidates(const P& p, FrameOf<P>& f, unsigned inst
         a.normal = a.normal * (1.0f / length(a.normal));
         a.entering = side == 0 ? 1u : 0u;
         if (primitive_candidate(p, f, instance_index, prim, t, a) || f.terminated) return;
+    }
+}
+
+/// A built-in curve segment given by its Bezier points: each entry and exit inside the ray's
+/// interval, nearer first, until one is accepted (a ray from inside the tube gets its exit).
+template <class P>
+LUCENT_HD inline void curve_candidates(const P& p, FrameOf<P>& f, unsigned instance_index,
+                                       unsigned prim, float3 origin, float3 direction,
+                                       unsigned curve_type, const CurvePoint bezier[4]) {
+    CurveHit hits[4];
+    const int count =
+        intersect_curve(origin, direction, curve_type, bezier, f.world_ray.tmin, f.closest, hits);
+    for (int i = 0; i < count; ++i) {
+        if (!(hits[i].t < f.closest)) return;
+        BuiltinCurveAttributes a;
+        a.normal = hits[i].normal;
+        a.u = hits[i].u;
+        a.entering = hits[i].entering;
+        if (primitive_candidate(p, f, instance_index, prim, hits[i].t, a) || f.terminated)
+            return;
     }
 }
 

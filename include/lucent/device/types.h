@@ -153,6 +153,30 @@ struct BuiltinSphereAttributes {
     unsigned entering;
 };
 
+/// GeometryCurves' curve types (OptiX's OPTIX_PRIMITIVE_TYPE_ROUND_*). A segment reads
+/// curve_control_points(type) consecutive vertices and radii from its segment index.
+enum CurveType : unsigned {
+    kCurveLinear = 0,            // 2 points: a cone between two spheres
+    kCurveQuadraticBSpline = 1,  // 3 points, uniform quadratic B-spline
+    kCurveCubicBSpline = 2,      // 4 points, uniform cubic B-spline
+    kCurveCatmullRom = 3,        // 4 points, from the second to the third
+};
+constexpr unsigned kCurveTypeCount = 4;
+
+LUCENT_HD inline unsigned curve_control_points(unsigned type) {
+    return type == kCurveLinear ? 2u : type == kCurveQuadraticBSpline ? 3u : 4u;
+}
+
+/// Attributes of built-in curves (GeometryCurves): the object-space unit normal at the hit
+/// (from the centre line's sphere through the hit, pointing out of the tube), the segment's
+/// parameter u in [0, 1] (OptiX's optixGetCurveParameter), and whether the ray entered the
+/// tube there (1) or left it (0).
+struct BuiltinCurveAttributes {
+    float3 normal;
+    float u;
+    unsigned entering;
+};
+
 /// A record with no variables, for programs that need none.
 struct NoRecord {};
 

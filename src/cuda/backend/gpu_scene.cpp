@@ -22,7 +22,8 @@ void put(DeviceBuffer& memory, const std::vector<T>& values) {
 
 static_assert(unsigned(PrimitiveType::kCustom) == gpu::kGpuCustom &&
                   unsigned(PrimitiveType::kTriangles) == gpu::kGpuTriangles &&
-                  unsigned(PrimitiveType::kSpheres) == gpu::kGpuSpheres,
+                  unsigned(PrimitiveType::kSpheres) == gpu::kGpuSpheres &&
+                  unsigned(PrimitiveType::kCurves) == gpu::kGpuCurves,
               "GpuInstance::type holds lucent::PrimitiveType's values");
 
 const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
@@ -209,6 +210,16 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
             g.single_radius = inst.single_radius;
             g.material_indices =
                 reinterpret_cast<const unsigned*>(device_pointer(spheres.material_indices()));
+        }
+        if (inst.type == PrimitiveType::kCurves) {
+            auto& curves = static_cast<const GeometryCurves&>(*inst.source->geometry());
+            g.vertices = reinterpret_cast<const float3*>(device_pointer(curves.vertices()));
+            g.radii = reinterpret_cast<const float*>(device_pointer(curves.radii()));
+            g.segments =
+                reinterpret_cast<const unsigned*>(device_pointer(curves.segment_indices()));
+            g.curve_type = inst.curve_type;
+            g.material_indices =
+                reinterpret_cast<const unsigned*>(device_pointer(curves.material_indices()));
         }
         g.material_offset = unsigned(flat.materials.size() / std::max(1u, ray_types));
         g.material_count = unsigned(inst.materials.size());

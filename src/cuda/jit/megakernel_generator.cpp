@@ -32,6 +32,7 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
     for (const core::CompiledInstance& inst : scene.instances) {
         attributes = std::max(attributes, inst.attributes->size);
         shape.spheres |= inst.type == PrimitiveType::kSpheres;
+        shape.curves |= inst.type == PrimitiveType::kCurves;
     }
     shape.attribute_bytes = unsigned((attributes + 15) / 16 * 16);
     shape.exceptions = !scene.enabled_exceptions.empty();
@@ -193,6 +194,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_GENERIC_GEOMETRY " << shape.generic_geometry << "\n"
         << "#define LUCENT_GPU_TRIANGLE_GROUPS " << shape.triangle_groups << "\n"
         << "#define LUCENT_GPU_SPHERES " << shape.spheres << "\n"
+        << "#define LUCENT_GPU_CURVES " << shape.curves << "\n"
         << "#define LUCENT_GPU_EXCEPTIONS " << shape.exceptions << "\n"
         << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
         << "#define LUCENT_GPU_OCCLUSION " << shape.occlusion << "\n"

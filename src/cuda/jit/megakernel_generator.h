@@ -36,6 +36,7 @@ struct KernelShape {
     bool generic_geometry = false;  // custom primitives, or a group not made only of triangles
     bool triangle_groups = false;   // some group is made only of triangles (GPU triangle BVH)
     bool spheres = false;           // some instance has built-in spheres
+    bool curves = false;            // some instance has built-in curves
     bool exceptions = false;        // any exception enabled (else bounds checks are compiled out)
     bool print = false;
     bool occlusion = false;  // some bound module declares kUsesOccluded

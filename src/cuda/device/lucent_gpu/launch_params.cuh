@@ -69,7 +69,12 @@ struct GpuGeometryAccel {
 };
 
 /// GpuInstance::type: lucent::PrimitiveType's values.
-enum GpuPrimitiveType : unsigned { kGpuCustom = 0, kGpuTriangles = 1, kGpuSpheres = 2 };
+enum GpuPrimitiveType : unsigned {
+    kGpuCustom = 0,
+    kGpuTriangles = 1,
+    kGpuSpheres = 2,
+    kGpuCurves = 3,
+};
 
 struct GpuInstance {
     unsigned type;  // GpuPrimitiveType
@@ -79,12 +84,14 @@ struct GpuInstance {
     unsigned user_id;  // GeometryInstance::set_instance_id
     ProgramRef intersection;
     ProgramRef attribute;
-    const float3* vertices;
+    const float3* vertices;  // triangles and curves
     const uint3* indices;
-    const unsigned* material_indices;  // triangles and spheres
+    const unsigned* material_indices;  // triangles, spheres and curves
     const float3* centers;             // spheres
-    const float* radii;
-    unsigned single_radius;  // radii[0] for every sphere
+    const float* radii;                // spheres; curves (one per vertex)
+    unsigned single_radius;            // radii[0] for every sphere
+    const unsigned* segments;          // curves: each segment's first vertex
+    unsigned curve_type;               // curves: CurveType
     unsigned material_offset;  // materials[(material_offset + m) * ray_type_count + r]
     unsigned material_count;
 };

@@ -25,6 +25,9 @@
 #ifndef LUCENT_GPU_SPHERES
 #define LUCENT_GPU_SPHERES 1  // built-in spheres (GeometrySpheres)
 #endif
+#ifndef LUCENT_GPU_CURVES
+#define LUCENT_GPU_CURVES 1  // built-in curves (GeometryCurves)
+#endif
 #ifndef LUCENT_GPU_TILES
 #define LUCENT_GPU_TILES 1  // warps take 8x4 tiles of 2D launches
 #endif

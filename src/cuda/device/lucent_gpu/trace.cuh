@@ -130,6 +130,15 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
                                        inst.radii[inst.single_radius ? 0 : local]);
         }
 #endif
+#if LUCENT_GPU_CURVES
+        else if (inst.type == kGpuCurves) {
+            CurvePoint bezier[4];
+            load_curve_segment(inst.curve_type, inst.vertices, inst.radii, inst.segments[local],
+                               bezier);
+            runtime::curve_candidates(GpuPolicy{}, f, instance_index, local, origin, direction,
+                                      inst.curve_type, bezier);
+        }
+#endif
         else {
             runtime::run_intersection(GpuPolicy{}, f, instance_index, inst, local);
         }
