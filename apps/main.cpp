@@ -8,6 +8,7 @@
 #include "bench_fog_command.h"
 #include "bench_igi_command.h"
 #include "bench_present_command.h"
+#include "bench_curves_command.h"
 #include "bench_spheres_command.h"
 #include "cli_errors.h"
 #include "cli_parse.h"
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
     BenchFogArgs bench_fog_args;
     BenchPresentArgs bench_present_args;
     BenchSpheresArgs bench_spheres_args;
+    BenchCurvesArgs bench_curves_args;
     TeaArgs tea_args;
     NoiseArgs noise_args;
     CompareArgs compare_args;
@@ -77,6 +79,7 @@ int main(int argc, char** argv) {
         CLI::App* bench_fog = add_bench_fog_command(bench.bench, bench_fog_args);
         CLI::App* bench_present = add_bench_present_command(bench.bench, bench_present_args);
         CLI::App* bench_spheres = add_bench_spheres_command(bench.bench, bench_spheres_args);
+        CLI::App* bench_curves = add_bench_curves_command(bench.bench, bench_curves_args);
         CLI::App* tea = add_tea_command(app, tea_args);
         CLI::App* noise = add_noise_command(app, noise_args);
         CLI::App* compare = add_compare_command(app, compare_args);
@@ -120,6 +123,10 @@ int main(int argc, char** argv) {
         if (bench_spheres->parsed()) {
             where = "lucent bench spheres";
             return run_bench_spheres_command(bench_spheres_args);
+        }
+        if (bench_curves->parsed()) {
+            where = "lucent bench curves";
+            return run_bench_curves_command(bench_curves_args);
         }
         if (bench_igi->parsed()) {
             where = "lucent bench igi";

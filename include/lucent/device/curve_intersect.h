@@ -276,6 +276,20 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
         pz[i] = dot(q, d);
         pw[i] = b[i].w;
     }
+    // The segment's Bezier points hold it: skip it when their hull, widened by their largest
+    // radius, misses the ray or lies outside the interval (most of the BVH's candidates,
+    // whose boxes are loose around a slanted strand, end here).
+    float x_lo = px[0], x_hi = px[0], y_lo = py[0], y_hi = py[0], z_lo = pz[0], z_hi = pz[0];
+    float w_max = fabsf(pw[0]);
+    for (int i = 1; i < 4; ++i) {
+        x_lo = lc_min(x_lo, px[i]), x_hi = lc_max(x_hi, px[i]);
+        y_lo = lc_min(y_lo, py[i]), y_hi = lc_max(y_hi, py[i]);
+        z_lo = lc_min(z_lo, pz[i]), z_hi = lc_max(z_hi, pz[i]);
+        w_max = lc_max(w_max, fabsf(pw[i]));
+    }
+    if (x_lo > w_max || x_hi < -w_max || y_lo > w_max || y_hi < -w_max ||
+        z_hi + w_max < tmin * speed || z_lo - w_max > tmax * speed)
+        return 0;
     RayCentric c;
     c.x = power_form(px[0], px[1], px[2], px[3]);
     c.y = power_form(py[0], py[1], py[2], py[3]);
