@@ -56,17 +56,27 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
         const float3 c = inst.centers[prim], r = make_float3(inst.radius(prim));
         box = Aabb{c - r, c + r};
     } else if (inst.type == PrimitiveType::kCurves) {
-        // The segment's Bezier points hold it (convex hull), each widened by the largest of
-        // their radii.
-        CurvePoint b[4];
-        load_curve_segment(inst.curve_type, inst.vertices, inst.radii, inst.segments[prim], b);
-        float radius = 0.0f;
-        for (const CurvePoint& q : b) {
+        // Reference `prim` boxes its part of a segment: the part's Bezier points hold it
+        // (convex hull), widened by the largest of their radii and by a few roundings of
+        // the hull's arithmetic (relative, 2^-20 of the largest coordinate).
+        const unsigned references = curve_references(inst.curve_type);
+        const unsigned segment = prim / references, part = prim % references;
+        CurvePoint b[4], hull[4];
+        load_curve_segment(inst.curve_type, inst.vertices, inst.radii, inst.segments[segment], b);
+        const float pieces = float(curve_pieces(inst.curve_type));
+        const int per_reference = curve_pieces(inst.curve_type) / int(references);
+        const float u0 = float(int(part) * per_reference) / pieces;
+        const float u1 = part + 1 == references ? 1.0f : float(int(part + 1) * per_reference) / pieces;
+        curve_part_hull(b, u0, u1, hull);
+        float radius = 0.0f, extent = 0.0f;
+        for (const CurvePoint& q : hull) {
             grow(box, make_float3(q));
             radius = std::max(radius, std::fabs(q.w));
+            extent = std::max({extent, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
         }
-        box.lo = box.lo - make_float3(radius);
-        box.hi = box.hi + make_float3(radius);
+        const float pad = radius + extent * 0x1p-20f;
+        box.lo = box.lo - make_float3(pad);
+        box.hi = box.hi + make_float3(pad);
     } else {
         try {
             inst.bounding_box.entry<BoundingBoxFn>()(inst.bounding_box.rec(), prim, box);
@@ -97,7 +107,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     bool triangles_only = !node.instances.empty();
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = m_scene->instances[i];
-        structure.add(inst.source).add(inst.type).add(inst.primitive_count);
+        structure.add(inst.source).add(inst.type).add(inst.primitive_count).add(inst.bvh_references());
         if (const GeometryTriangles* tris = triangles_of(inst)) {
             structure.add(tris->indices().get())
                 .add(tris->indices() ? tris->indices()->version() : 0);
@@ -151,7 +161,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     uint32_t total = 0;
     for (unsigned i : node.instances) {
         ga.prim_first.push_back(total);
-        total += m_scene->instances[i].primitive_count;
+        total += m_scene->instances[i].bvh_references();
     }
     if (ga.triangles_only) {
         ga.vertices.clear();
@@ -190,7 +200,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         Aabb all = empty_box();
         for (unsigned i : node.instances) {
             const CompiledInstance& inst = m_scene->instances[i];
-            for (unsigned p = 0; p < inst.primitive_count; ++p) {
+            for (unsigned p = 0; p < inst.bvh_references(); ++p) {
                 boxes.push_back(primitive_box(inst, p));
                 if (!is_empty(boxes.back())) grow(all, boxes.back());
             }

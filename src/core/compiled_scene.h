@@ -10,6 +10,7 @@
 #include "accel/bvh.h"
 #include "accel/triangle_accel.h"
 #include "lucent/context.h"
+#include "lucent/device/curve_intersect.h"
 #include "lucent/device/program.h"
 #include "lucent/module.h"
 
@@ -78,6 +79,12 @@ struct CompiledInstance {
     const unsigned* segments = nullptr;
     CurveType curve_type = kCurveCubicBSpline;
     bool triangles() const { return type == PrimitiveType::kTriangles; }
+    /// The primitives of the group's BVH this instance adds: one per primitive, but
+    /// curve_references(type) per curve segment, each boxing part of it.
+    unsigned bvh_references() const {
+        return type == PrimitiveType::kCurves ? primitive_count * curve_references(curve_type)
+                                              : primitive_count;
+    }
 };
 
 /// Acceleration data of a GeometryGroup, kept across compiles while unchanged.

@@ -121,11 +121,15 @@ class Traverser {
                 runtime::sphere_candidates(m_policy, m_frame, n.instances[k], local, origin,
                                            direction, inst.centers[local], inst.radius(local));
             } else if (inst.type == PrimitiveType::kCurves) {
+                // The BVH holds curve_references(type) references per segment.
+                const unsigned references = curve_references(inst.curve_type);
+                const unsigned segment = local / references;
                 CurvePoint bezier[4];
                 load_curve_segment(inst.curve_type, inst.vertices, inst.radii,
-                                   inst.segments[local], bezier);
-                runtime::curve_candidates(m_policy, m_frame, n.instances[k], local, origin,
-                                          direction, inst.curve_type, bezier);
+                                   inst.segments[segment], bezier);
+                runtime::curve_candidates(m_policy, m_frame, n.instances[k], segment,
+                                          local - segment * references, origin, direction,
+                                          inst.curve_type, bezier);
             } else {
                 runtime::run_intersection(m_policy, m_frame, n.instances[k], inst, local);
             }
@@ -135,7 +139,8 @@ class Traverser {
             uint32_t total =
                 ga.prim_first.empty()
                     ? 0
-                    : ga.prim_first.back() + m_scene.instances[n.instances.back()].primitive_count;
+                    : ga.prim_first.back() +
+                          m_scene.instances[n.instances.back()].bvh_references();
             for (uint32_t ref = 0; ref < total; ++ref)
                 if (visit(ref)) return;
         } else {

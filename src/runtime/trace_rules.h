@@ -494,15 +494,17 @@ LUCENT_HD inline void sphere_candidates(const P& p, FrameOf<P>& f, unsigned inst
     }
 }
 
-/// A built-in curve segment given by its Bezier points: each entry and exit inside the ray's
+/// A BVH reference to a built-in curve segment (the segment `prim`, given by its Bezier
+/// points, over the range of u of `reference`): each entry and exit inside the ray's
 /// interval, nearer first, until one is accepted (a ray from inside the tube gets its exit).
 template <class P>
 LUCENT_HD inline void curve_candidates(const P& p, FrameOf<P>& f, unsigned instance_index,
-                                       unsigned prim, float3 origin, float3 direction,
-                                       unsigned curve_type, const CurvePoint bezier[4]) {
+                                       unsigned prim, unsigned reference, float3 origin,
+                                       float3 direction, unsigned curve_type,
+                                       const CurvePoint bezier[4]) {
     CurveHit hits[4];
-    const int count =
-        intersect_curve(origin, direction, curve_type, bezier, f.world_ray.tmin, f.closest, hits);
+    const int count = intersect_curve(origin, direction, curve_type, bezier, reference,
+                                      f.world_ray.tmin, f.closest, hits);
     for (int i = 0; i < count; ++i) {
         if (!(hits[i].t < f.closest)) return;
         BuiltinCurveAttributes a;

@@ -250,13 +250,51 @@ LUCENT_HD inline int curve_pieces(unsigned type) {
     return type == kCurveLinear ? 1 : type == kCurveQuadraticBSpline ? 4 : 8;
 }
 
-/// The intersections of the ray origin + t direction, t in (tmin, tmax), with a segment of
-/// the given type by its cubic Bezier points (curve_bezier), nearest first: for each part of
-/// the segment the ray passes through, its entry and its exit. Writes up to four; returns
-/// how many. The direction need not be unit length.
+/// How many references to a segment of this type the BVH holds, each with the box of its
+/// range of u (curve_pieces / curve_references pieces): a slanted strand's one box would be
+/// mostly empty, and every ray entering it would pay the segment's test.
+LUCENT_HD inline unsigned curve_references(unsigned type) {
+    return type == kCurveLinear ? 1u : type == kCurveQuadraticBSpline ? 2u : 4u;
+}
+
+/// The Bezier points of the segment's part over [u0, u1] (its hull), from the values and
+/// slopes at the ends.
+LUCENT_HD inline void curve_part_hull(const CurvePoint b[4], float u0, float u1,
+                                      CurvePoint out[4]) {
+    const auto at = [&](float u, float4& value, float4& slope) {
+        const float s = 1.0f - u;
+        const float w0 = s * s * s, w1 = 3.0f * u * s * s, w2 = 3.0f * u * u * s, w3 = u * u * u;
+        const float d0 = -3.0f * s * s, d1 = 3.0f * s * s - 6.0f * u * s,
+                    d2 = 6.0f * u * s - 3.0f * u * u, d3 = 3.0f * u * u;
+        value = make_float4(w0 * b[0].x + w1 * b[1].x + w2 * b[2].x + w3 * b[3].x,
+                            w0 * b[0].y + w1 * b[1].y + w2 * b[2].y + w3 * b[3].y,
+                            w0 * b[0].z + w1 * b[1].z + w2 * b[2].z + w3 * b[3].z,
+                            w0 * b[0].w + w1 * b[1].w + w2 * b[2].w + w3 * b[3].w);
+        slope = make_float4(d0 * b[0].x + d1 * b[1].x + d2 * b[2].x + d3 * b[3].x,
+                            d0 * b[0].y + d1 * b[1].y + d2 * b[2].y + d3 * b[3].y,
+                            d0 * b[0].z + d1 * b[1].z + d2 * b[2].z + d3 * b[3].z,
+                            d0 * b[0].w + d1 * b[1].w + d2 * b[2].w + d3 * b[3].w);
+    };
+    float4 v0, s0, v1, s1;
+    at(u0, v0, s0);
+    at(u1, v1, s1);
+    const float h = (u1 - u0) * (1.0f / 3.0f);
+    out[0] = v0;
+    out[1] = v0 + h * s0;
+    out[2] = v1 + (-h) * s1;
+    out[3] = v1;
+}
+
+/// The intersections of the ray origin + t direction, t in (tmin, tmax), with the part of a
+/// segment that BVH reference `reference` (below curve_references(type)) covers, the segment
+/// given by its cubic Bezier points (curve_bezier), nearest first: for each part the ray
+/// passes through, its entry and its exit. An entry or exit that lies at the part's end
+/// inside the segment, still falling (or rising) towards the next part, belongs to that
+/// part and is left to it, so a tube seen through several references is hit once. Writes
+/// up to four; returns how many. The direction need not be unit length.
 LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned type,
-                                     const CurvePoint b[4], float tmin, float tmax,
-                                     CurveHit hits[4]) {
+                                     const CurvePoint b[4], unsigned reference, float tmin,
+                                     float tmax, CurveHit hits[4]) {
     using namespace curve_detail;
     const float speed = length(direction);
     if (!(speed > 0.0f) || !(speed < 3.0e38f)) return 0;
@@ -295,7 +333,12 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
     c.y = power_form(py[0], py[1], py[2], py[3]);
     c.z = power_form(pz[0], pz[1], pz[2], pz[3]);
     c.w = power_form(pw[0], pw[1], pw[2], pw[3]);
-    const int pieces = curve_pieces(type);
+    const int per_reference = curve_pieces(type) / int(curve_references(type));
+    const int pieces = curve_pieces(type), first_piece = int(reference) * per_reference;
+    const float u_first = float(first_piece) / float(pieces);
+    const float u_last = first_piece + per_reference == pieces
+                             ? 1.0f
+                             : float(first_piece + per_reference) / float(pieces);
 
     Span spans[2];
     int span_count = 0;
@@ -305,10 +348,10 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
         if (span_count < 2) spans[span_count++] = current;
         open = false;
     };
-    float a = 0.0f;
+    float a = u_first;
     float ax = c.x.at(a), ay = c.y.at(a), aw = c.w.at(a);
     float adx = c.x.d1(a), ady = c.y.d1(a), adw = c.w.d1(a);
-    for (int k = 0; k < pieces; ++k) {
+    for (int k = first_piece; k < first_piece + per_reference; ++k) {
         const float e = k + 1 == pieces ? 1.0f : float(k + 1) / float(pieces);
         const float h = (e - a) * (1.0f / 3.0f);
         const float ex = c.x.at(e), ey = c.y.at(e), ew = c.w.at(e);
@@ -369,6 +412,16 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
             const float u = side == 0 ? spans[i].u_in : spans[i].u_out;
             const float s = side == 0 ? spans[i].s_in : spans[i].s_out;
             if (!(s > s_min && s < s_max)) continue;
+            const float sign = side == 0 ? -1.0f : 1.0f;
+            if ((u == u_first && u_first > 0.0f) || (u == u_last && u_last < 1.0f)) {
+                // At a part's inner end: the extreme lies beyond it if the side distance
+                // still improves (falls for an entry, rises for an exit) across it. Where it
+                // is flat there, the part after the end keeps it (both parts compute the
+                // same slope at the same u), so a hit at an end is reported once.
+                float slope, unused;
+                side_slope(c, u, sign, slope, unused);
+                if (u == u_first ? sign * -slope > 0.0f : sign * slope >= 0.0f) continue;
+            }
             // The normal from the sphere at u through the hit, in ray-centric coordinates,
             // divided by the radius first (a thin curve's squared offset would underflow).
             const float w = fabsf(c.w.at(u));

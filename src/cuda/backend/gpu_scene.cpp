@@ -277,7 +277,7 @@ gpu::GpuGeometryAccel GpuScene::flatten_geometry_accel(const core::CompiledScene
     flat.accel_prim_first.insert(flat.accel_prim_first.end(), ga.prim_first.begin(),
                                  ga.prim_first.end());
     a.prim_total = 0;
-    for (unsigned i : n.instances) a.prim_total += scene.instances[i].primitive_count;
+    for (unsigned i : n.instances) a.prim_total += scene.instances[i].bvh_references();
     if (ga.triangles_only) {
         // The CPU keeps its wide layout; the GPU gets its own over the same triangles,
         // rebuilt only when they change.
