@@ -140,8 +140,8 @@ class Material;
 /// the engine's traversal with their own intersection code (OptiX's OptixPrimitiveType).
 enum class PrimitiveType { kCustom, kTriangles, kSpheres, kCurves };
 
-/// Common base of Geometry (custom primitives) and the built-in GeometryTriangles and
-/// GeometrySpheres.
+/// Common base of Geometry (custom primitives) and the built-in GeometryTriangles,
+/// GeometrySpheres and GeometryCurves.
 class GeometryBase : public ContextObject, public VariableScope {
   public:
     using ContextObject::ContextObject;

@@ -121,15 +121,9 @@ class Traverser {
                 runtime::sphere_candidates(m_policy, m_frame, n.instances[k], local, origin,
                                            direction, inst.centers[local], inst.radius(local));
             } else if (inst.type == PrimitiveType::kCurves) {
-                // The BVH holds curve_references(type) references per segment.
-                const unsigned references = curve_references(inst.curve_type);
-                const unsigned segment = local / references;
-                CurvePoint bezier[4];
-                load_curve_segment(inst.curve_type, inst.vertices, inst.radii,
-                                   inst.segments[segment], bezier);
-                runtime::curve_candidates(m_policy, m_frame, n.instances[k], segment,
-                                          local - segment * references, origin, direction,
-                                          inst.curve_type, bezier);
+                runtime::curve_candidates(m_policy, m_frame, n.instances[k], local, origin,
+                                          direction, inst.curve_type, inst.vertices, inst.radii,
+                                          inst.segments);
             } else {
                 runtime::run_intersection(m_policy, m_frame, n.instances[k], inst, local);
             }

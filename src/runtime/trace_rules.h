@@ -494,14 +494,19 @@ LUCENT_HD inline void sphere_candidates(const P& p, FrameOf<P>& f, unsigned inst
     }
 }
 
-/// A BVH reference to a built-in curve segment (the segment `prim`, given by its Bezier
-/// points, over the range of u of `reference`): each entry and exit inside the ray's
-/// interval, nearer first, until one is accepted (a ray from inside the tube gets its exit).
+/// BVH reference `local` of a built-in curve instance (curve_references(curve_type) per
+/// segment, each over its range of u): each entry and exit inside the ray's interval,
+/// nearer first, until one is accepted (a ray from inside the tube gets its exit). The
+/// primitive is the segment.
 template <class P>
 LUCENT_HD inline void curve_candidates(const P& p, FrameOf<P>& f, unsigned instance_index,
-                                       unsigned prim, unsigned reference, float3 origin,
-                                       float3 direction, unsigned curve_type,
-                                       const CurvePoint bezier[4]) {
+                                       unsigned local, float3 origin, float3 direction,
+                                       unsigned curve_type, const float3* vertices,
+                                       const float* radii, const unsigned* segments) {
+    const unsigned references = curve_references(curve_type);
+    const unsigned prim = local / references, reference = local - prim * references;
+    CurvePoint bezier[4];
+    load_curve_segment(curve_type, vertices, radii, segments[prim], bezier);
     CurveHit hits[4];
     const int count = intersect_curve(origin, direction, curve_type, bezier, reference,
                                       f.world_ray.tmin, f.closest, hits);

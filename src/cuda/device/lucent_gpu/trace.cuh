@@ -132,15 +132,8 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
 #endif
 #if LUCENT_GPU_CURVES
         else if (inst.type == kGpuCurves) {
-            // The BVH holds curve_references(type) references per segment.
-            const unsigned references = curve_references(inst.curve_type);
-            const unsigned segment = local / references;
-            CurvePoint bezier[4];
-            load_curve_segment(inst.curve_type, inst.vertices, inst.radii, inst.segments[segment],
-                               bezier);
-            runtime::curve_candidates(GpuPolicy{}, f, instance_index, segment,
-                                      local - segment * references, origin, direction,
-                                      inst.curve_type, bezier);
+            runtime::curve_candidates(GpuPolicy{}, f, instance_index, local, origin, direction,
+                                      inst.curve_type, inst.vertices, inst.radii, inst.segments);
         }
 #endif
         else {
