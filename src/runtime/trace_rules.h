@@ -495,9 +495,10 @@ LUCENT_HD inline void sphere_candidates(const P& p, FrameOf<P>& f, unsigned inst
 }
 
 /// BVH reference `local` of a built-in curve instance (curve_references(curve_type) per
-/// segment, each over its range of u): each entry and exit inside the ray's interval,
-/// nearer first, until one is accepted (a ray from inside the tube gets its exit). The
-/// primitive is the segment.
+/// segment, each over its range of u): entries and exits inside the ray's interval, nearer
+/// first, until one is accepted (a ray from inside the tube gets its exit). A part's exit is
+/// searched only when its entry is refused or lies before the interval: an accepted entry
+/// ends the search, every later candidate lying beyond it. The primitive is the segment.
 template <class P>
 LUCENT_HD inline void curve_candidates(const P& p, FrameOf<P>& f, unsigned instance_index,
                                        unsigned local, float3 origin, float3 direction,
@@ -507,18 +508,41 @@ LUCENT_HD inline void curve_candidates(const P& p, FrameOf<P>& f, unsigned insta
     const unsigned prim = local / references, reference = local - prim * references;
     CurvePoint bezier[4];
     load_curve_segment(curve_type, vertices, radii, segments[prim], bezier);
-    CurveHit hits[4];
-    const int count = intersect_curve(origin, direction, curve_type, bezier, reference,
-                                      f.world_ray.tmin, f.closest, hits);
-    for (int i = 0; i < count; ++i) {
-        if (!(hits[i].t < f.closest)) return;
+    CurveParts q;
+    const int parts = find_curve_parts(origin, direction, curve_type, bezier, reference,
+                                       f.world_ray.tmin, f.closest, q);
+    if (parts == 0) return;
+    // Offers one hit; true when the search is over (accepted, or the trace terminated).
+    const auto offer = [&](const CurveHit& hit) {
+        if (!(hit.t < f.closest)) return false;
         BuiltinCurveAttributes a;
-        a.normal = hits[i].normal;
-        a.u = hits[i].u;
-        a.entering = hits[i].entering;
-        if (primitive_candidate(p, f, instance_index, prim, hits[i].t, a) || f.terminated)
-            return;
+        a.normal = hit.normal;
+        a.u = hit.u;
+        a.entering = hit.entering;
+        return primitive_candidate(p, f, instance_index, prim, hit.t, a) || f.terminated;
+    };
+    const int first = parts == 2 && q.part[1].s_in < q.part[0].s_in ? 1 : 0;
+    CurveHit exits[2];
+    int pending = 0;  // exits found, nearest first
+    for (int k = 0; k < parts; ++k) {
+        const int i = k == 0 ? first : 1 - first;
+        const float entry_t = q.part[i].s_in / q.speed;
+        // Exits of earlier parts that come before this entry.
+        while (pending > 0 && exits[0].t < entry_t) {
+            if (offer(exits[0])) return;
+            exits[0] = exits[1];
+            --pending;
+        }
+        CurveHit hit;
+        if (curve_part_hit(q, i, 0, f.world_ray.tmin, f.closest, hit) && offer(hit)) return;
+        if (curve_part_hit(q, i, 1, f.world_ray.tmin, f.closest, hit)) {
+            int j = pending++;
+            for (; j > 0 && exits[j - 1].t > hit.t; --j) exits[j] = exits[j - 1];
+            exits[j] = hit;
+        }
     }
+    for (int k = 0; k < pending; ++k)
+        if (offer(exits[k])) return;
 }
 
 // ---- the device API of intersection and any-hit programs --------------------------------------

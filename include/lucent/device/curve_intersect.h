@@ -237,11 +237,6 @@ LUCENT_HD inline float extreme(const RayCentric& c, float lo, float hi, float si
     return bracketed_root(flipped, at[neg], at[pos]);
 }
 
-/// An interval of u with D >= 0 and its entry and exit parameters and distances.
-struct Span {
-    float u_in, s_in, u_out, s_out;
-};
-
 }  // namespace curve_detail
 
 /// How many pieces the search cuts a segment of this type into: a linear segment (a
@@ -285,17 +280,30 @@ LUCENT_HD inline void curve_part_hull(const CurvePoint b[4], float u0, float u1,
     out[3] = v1;
 }
 
-/// The intersections of the ray origin + t direction, t in (tmin, tmax), with the part of a
-/// segment that BVH reference `reference` (below curve_references(type)) covers, the segment
-/// given by its cubic Bezier points (curve_bezier), nearest first: for each part the ray
-/// passes through, its entry and its exit. An entry or exit that lies at the part's end
-/// inside the segment, still falling (or rising) towards the next part, belongs to that
-/// part and is left to it, so a tube seen through several references is hit once. Writes
-/// up to four; returns how many. The direction need not be unit length.
-LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned type,
-                                     const CurvePoint b[4], unsigned reference, float tmin,
-                                     float tmax, CurveHit hits[4]) {
+/// Where a ray meets one BVH reference's range of a segment: up to two parts of u with
+/// D >= 0, each with its entry, and the ranges its exit is searched over when it is needed
+/// (curve_part_hit): a ray whose entry is accepted never needs the exit.
+struct CurveParts {
+    curve_detail::RayCentric c;
+    float3 e1, e2, d;  // the ray-centric frame
+    float speed, u_first, u_last;
+    int count;
+    struct Part {
+        float u_in, s_in;
+        float lo[2], hi[2];  // the part's range in each piece it spans
+        int ranges;
+    } part[2];
+};
+
+/// Finds the parts of reference `reference` (below curve_references(type)) of the segment
+/// given by its cubic Bezier points (curve_bezier) that the ray origin + t direction passes
+/// through, with their entries; returns how many (0 also for a ray that misses the
+/// reference's hull or the interval (tmin, tmax)). The direction need not be unit length.
+LUCENT_HD inline int find_curve_parts(float3 origin, float3 direction, unsigned type,
+                                      const CurvePoint b[4], unsigned reference, float tmin,
+                                      float tmax, CurveParts& q) {
     using namespace curve_detail;
+    q.count = 0;
     const float speed = length(direction);
     if (!(speed > 0.0f) || !(speed < 3.0e38f)) return 0;
     const float3 d = direction * (1.0f / speed);
@@ -308,15 +316,14 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
 
     float px[4], py[4], pz[4], pw[4];
     for (int i = 0; i < 4; ++i) {
-        const float3 q = make_float3(b[i]) - origin;
-        px[i] = dot(q, e1);
-        py[i] = dot(q, e2);
-        pz[i] = dot(q, d);
+        const float3 r = make_float3(b[i]) - origin;
+        px[i] = dot(r, e1);
+        py[i] = dot(r, e2);
+        pz[i] = dot(r, d);
         pw[i] = b[i].w;
     }
     // The segment's Bezier points hold it: skip it when their hull, widened by their largest
-    // radius, misses the ray or lies outside the interval (most of the BVH's candidates,
-    // whose boxes are loose around a slanted strand, end here).
+    // radius, misses the ray or lies outside the interval.
     float x_lo = px[0], x_hi = px[0], y_lo = py[0], y_hi = py[0], z_lo = pz[0], z_hi = pz[0];
     float w_max = fabsf(pw[0]);
     for (int i = 1; i < 4; ++i) {
@@ -328,27 +335,26 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
     if (x_lo > w_max || x_hi < -w_max || y_lo > w_max || y_hi < -w_max ||
         z_hi + w_max < tmin * speed || z_lo - w_max > tmax * speed)
         return 0;
-    RayCentric c;
+    RayCentric& c = q.c;
     c.x = power_form(px[0], px[1], px[2], px[3]);
     c.y = power_form(py[0], py[1], py[2], py[3]);
     c.z = power_form(pz[0], pz[1], pz[2], pz[3]);
     c.w = power_form(pw[0], pw[1], pw[2], pw[3]);
+    q.e1 = e1, q.e2 = e2, q.d = d, q.speed = speed;
     const int per_reference = curve_pieces(type) / int(curve_references(type));
     const int pieces = curve_pieces(type), first_piece = int(reference) * per_reference;
-    const float u_first = float(first_piece) / float(pieces);
-    const float u_last = first_piece + per_reference == pieces
-                             ? 1.0f
-                             : float(first_piece + per_reference) / float(pieces);
+    q.u_first = float(first_piece) / float(pieces);
+    q.u_last = first_piece + per_reference == pieces
+                   ? 1.0f
+                   : float(first_piece + per_reference) / float(pieces);
 
-    Span spans[2];
-    int span_count = 0;
-    bool open = false;  // the current span reaches the current piece's start
-    Span current{};
-    const auto finish_span = [&]() {
-        if (span_count < 2) spans[span_count++] = current;
+    bool open = false;  // the current part reaches the current piece's start
+    CurveParts::Part current{};
+    const auto finish_part = [&]() {
+        if (q.count < 2) q.part[q.count++] = current;
         open = false;
     };
-    float a = u_first;
+    float a = q.u_first;
     float ax = c.x.at(a), ay = c.y.at(a), aw = c.w.at(a);
     float adx = c.x.d1(a), ady = c.y.d1(a), adw = c.w.d1(a);
     for (int k = first_piece; k < first_piece + per_reference; ++k) {
@@ -362,16 +368,16 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
         const float hx[4] = {ax, ax + h * adx, ex - h * edx, ex};
         const float hy[4] = {ay, ay + h * ady, ey - h * edy, ey};
         const float hw[4] = {aw, aw + h * adw, ew - h * edw, ew};
-        float x_lo = hx[0], x_hi = hx[0], y_lo = hy[0], y_hi = hy[0], w_max = fabsf(hw[0]);
+        float px_lo = hx[0], px_hi = hx[0], py_lo = hy[0], py_hi = hy[0], pw_max = fabsf(hw[0]);
         for (int i = 1; i < 4; ++i) {
-            x_lo = lc_min(x_lo, hx[i]);
-            x_hi = lc_max(x_hi, hx[i]);
-            y_lo = lc_min(y_lo, hy[i]);
-            y_hi = lc_max(y_hi, hy[i]);
-            w_max = lc_max(w_max, fabsf(hw[i]));
+            px_lo = lc_min(px_lo, hx[i]);
+            px_hi = lc_max(px_hi, hx[i]);
+            py_lo = lc_min(py_lo, hy[i]);
+            py_hi = lc_max(py_hi, hy[i]);
+            pw_max = lc_max(pw_max, fabsf(hw[i]));
         }
         float d_peak = -1.0f, u_peak = a;
-        if (x_lo <= w_max && x_hi >= -w_max && y_lo <= w_max && y_hi >= -w_max)
+        if (px_lo <= pw_max && px_hi >= -pw_max && py_lo <= pw_max && py_hi >= -pw_max)
             u_peak = peak(c, a, e, d_peak);
         if (d_peak > 0.0f) {
             const auto D = [&](float u, float& f, float& df) {
@@ -382,54 +388,80 @@ LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned t
             const float lo = sample(c, a).D >= 0.0f ? a : bracketed_root(D, a, u_peak);
             const bool reaches_end = sample(c, e).D >= 0.0f;
             const float hi = reaches_end ? e : bracketed_root(D, e, u_peak);
-            Span piece;
-            piece.u_in = extreme(c, lo, hi, -1.0f);
-            piece.s_in = side_distance(sample(c, piece.u_in), -1.0f);
-            piece.u_out = extreme(c, lo, hi, 1.0f);
-            piece.s_out = side_distance(sample(c, piece.u_out), 1.0f);
-            if (open && lo == a) {  // the part continues from the last piece: widen it
-                if (piece.s_in < current.s_in) current.u_in = piece.u_in, current.s_in = piece.s_in;
-                if (piece.s_out > current.s_out)
-                    current.u_out = piece.u_out, current.s_out = piece.s_out;
+            const float u_in = extreme(c, lo, hi, -1.0f);
+            const float s_in = side_distance(sample(c, u_in), -1.0f);
+            if (open && lo == a && current.ranges < 2) {  // the part continues: widen it
+                if (s_in < current.s_in) current.u_in = u_in, current.s_in = s_in;
             } else {
-                if (open) finish_span();
-                current = piece;
+                if (open) finish_part();
+                current.u_in = u_in, current.s_in = s_in, current.ranges = 0;
             }
+            current.lo[current.ranges] = lo;
+            current.hi[current.ranges] = hi;
+            ++current.ranges;
             open = true;
-            if (!reaches_end) finish_span();
+            if (!reaches_end) finish_part();
         } else if (open) {
-            finish_span();
+            finish_part();
         }
         a = e;
         ax = ex, ay = ey, aw = ew, adx = edx, ady = edy, adw = edw;
     }
-    if (open) finish_span();
+    if (open) finish_part();
+    return q.count;
+}
 
+/// Part i's entry (side 0) or exit (side 1) as a hit, the exit searched now; false when it
+/// lies outside (tmin, tmax), or at the reference's inner end while the side distance
+/// still improves (falls for an entry, rises for an exit) across it: it belongs to the
+/// neighbouring reference, so a tube seen through several references is hit once. Where it
+/// is flat there, the reference after the end keeps it (both compute the same slope at the
+/// same u).
+LUCENT_HD inline bool curve_part_hit(const CurveParts& q, int i, int side, float tmin,
+                                     float tmax, CurveHit& hit) {
+    using namespace curve_detail;
+    const RayCentric& c = q.c;
+    const CurveParts::Part& part = q.part[i];
+    float u = part.u_in, s = part.s_in;
+    if (side == 1) {
+        for (int r = 0; r < part.ranges; ++r) {
+            const float ur = extreme(c, part.lo[r], part.hi[r], 1.0f);
+            const float sr = side_distance(sample(c, ur), 1.0f);
+            if (r == 0 || sr > s) u = ur, s = sr;
+        }
+    }
+    if (!(s > tmin * q.speed && s < tmax * q.speed)) return false;
+    const float sign = side == 0 ? -1.0f : 1.0f;
+    if ((u == q.u_first && q.u_first > 0.0f) || (u == q.u_last && q.u_last < 1.0f)) {
+        float slope, unused;
+        side_slope(c, u, sign, slope, unused);
+        if (u == q.u_first ? sign * -slope > 0.0f : sign * slope >= 0.0f) return false;
+    }
+    // The normal from the sphere at u through the hit, in ray-centric coordinates, divided
+    // by the radius first (a thin curve's squared offset would underflow).
+    const float w = fabsf(c.w.at(u));
+    const float inv = w > 0.0f ? 1.0f / w : 1.0f;
+    const float nx = -c.x.at(u) * inv, ny = -c.y.at(u) * inv, nz = (s - c.z.at(u)) * inv;
+    float3 n = nx * q.e1 + ny * q.e2 + nz * q.d;
+    n = n * (1.0f / length(n));
+    hit = CurveHit{s / q.speed, u, n, side == 0 ? 1u : 0u};
+    return true;
+}
+
+/// The intersections of the ray origin + t direction, t in (tmin, tmax), with the range of
+/// a segment that BVH reference `reference` covers (find_curve_parts), nearest first: for
+/// each part the ray passes through, its entry and its exit. Writes up to four; returns how
+/// many.
+LUCENT_HD inline int intersect_curve(float3 origin, float3 direction, unsigned type,
+                                     const CurvePoint b[4], unsigned reference, float tmin,
+                                     float tmax, CurveHit hits[4]) {
+    CurveParts q;
+    const int parts = find_curve_parts(origin, direction, type, b, reference, tmin, tmax, q);
     int count = 0;
-    const float s_min = tmin * speed, s_max = tmax * speed;
-    for (int i = 0; i < span_count; ++i)
+    for (int i = 0; i < parts; ++i)
         for (int side = 0; side < 2; ++side) {
-            const float u = side == 0 ? spans[i].u_in : spans[i].u_out;
-            const float s = side == 0 ? spans[i].s_in : spans[i].s_out;
-            if (!(s > s_min && s < s_max)) continue;
-            const float sign = side == 0 ? -1.0f : 1.0f;
-            if ((u == u_first && u_first > 0.0f) || (u == u_last && u_last < 1.0f)) {
-                // At a part's inner end: the extreme lies beyond it if the side distance
-                // still improves (falls for an entry, rises for an exit) across it. Where it
-                // is flat there, the part after the end keeps it (both parts compute the
-                // same slope at the same u), so a hit at an end is reported once.
-                float slope, unused;
-                side_slope(c, u, sign, slope, unused);
-                if (u == u_first ? sign * -slope > 0.0f : sign * slope >= 0.0f) continue;
-            }
-            // The normal from the sphere at u through the hit, in ray-centric coordinates,
-            // divided by the radius first (a thin curve's squared offset would underflow).
-            const float w = fabsf(c.w.at(u));
-            const float inv = w > 0.0f ? 1.0f / w : 1.0f;
-            const float nx = -c.x.at(u) * inv, ny = -c.y.at(u) * inv, nz = (s - c.z.at(u)) * inv;
-            float3 n = nx * e1 + ny * e2 + nz * d;
-            n = n * (1.0f / length(n));
-            CurveHit hit{s / speed, u, n, side == 0 ? 1u : 0u};
+            CurveHit hit;
+            if (!curve_part_hit(q, i, side, tmin, tmax, hit)) continue;
             int j = count++;
             for (; j > 0 && hits[j - 1].t > hit.t; --j) hits[j] = hits[j - 1];
             hits[j] = hit;
