@@ -240,16 +240,17 @@ LUCENT_HD inline float extreme(const RayCentric& c, float lo, float hi, float si
 }  // namespace curve_detail
 
 /// How many pieces the search cuts a segment of this type into: a linear segment (a
-/// quadratic D) has one part with D >= 0 at most; the others bend.
+/// quadratic D) has one part with D >= 0 at most, and two pieces only so that it has two
+/// BVH references; the others bend.
 LUCENT_HD inline int curve_pieces(unsigned type) {
-    return type == kCurveLinear ? 1 : type == kCurveQuadraticBSpline ? 4 : 8;
+    return type == kCurveLinear ? 2 : type == kCurveQuadraticBSpline ? 4 : 8;
 }
 
 /// How many references to a segment of this type the BVH holds, each with the box of its
 /// range of u (curve_pieces / curve_references pieces): a slanted strand's one box would be
 /// mostly empty, and every ray entering it would pay the segment's test.
 LUCENT_HD inline unsigned curve_references(unsigned type) {
-    return type == kCurveLinear ? 1u : type == kCurveQuadraticBSpline ? 2u : 4u;
+    return type == kCurveLinear ? 2u : type == kCurveQuadraticBSpline ? 2u : 4u;
 }
 
 /// The Bezier points of the segment's part over [u0, u1] (its hull), from the values and
