@@ -325,8 +325,9 @@ class IgiSample final : public Sample {
                   SampleOption::number(
                       "min_d", 0.1f, 0.0f, 10.0f,
                       "Eq. (1)'s bounding distance, as a fraction of the scene's size"),
-                  SampleOption::integer("max_depth", 4, 1, 16,
-                                        "deepest specular reflection tree"),
+                  SampleOption::integer(
+                      "max_depth", 4, 1, 16,
+                      "deepest specular tree (mirrors; glass reflects and refracts)"),
                   SampleOption::integer(
                       "imperfect_visibility", 0, 0, 2,
                       "VPL shadow rays (IGI paper §4.1) against 0: the triangles; 1: the boxes "

@@ -119,6 +119,8 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
         const bool metal_by_diffuse =
             m.kind == scene::MaterialKind::kMetal && max_component(m.specular) <= 0.0f;
         (*material)["Ks"] = metal_by_diffuse ? m.diffuse : m.specular;
+        // ... and its base colour texture, which tints that colour as it tints Kd.
+        (*material)["specular_map"] = texture_for(metal_by_diffuse ? m.diffuse_texture : "");
         (*material)["Ke"] = m.emission;
         // Perceptual roughness squared (Burley 2012); a floor keeps GGX finite in float.
         (*material)["alpha"] = std::max(m.roughness * m.roughness, 1e-3f);

@@ -103,6 +103,8 @@ LUCENT_RECORD(CameraRecord, camera, accum, output, stream_offset, top_object, ma
 struct SurfaceRecord {
     float3 Kd, Ks, Ke;
     lucent::TextureView diffuse_map;  // multiplies Kd; a 1x1 white texel when there is none
+    // Multiplies Ks: a glTF metal's base colour texture (its colour is its F0), else white.
+    lucent::TextureView specular_map;
     float alpha, ior;
     lucent::BufferView<AreaLight> area_lights;
     lucent::BufferView<const float> area_light_cdf;  // next-event estimation picks by power
@@ -110,8 +112,8 @@ struct SurfaceRecord {
     float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
 };
-LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, alpha, ior, area_lights, area_light_cdf,
-              point_lights, scene_size, top_object)
+LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, specular_map, alpha, ior, area_lights,
+              area_light_cdf, point_lights, scene_size, top_object)
 
 struct MissRecord {
     float3 environment;  // uniform radiance from every direction
@@ -188,7 +190,8 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
                         : 0.0f;
 
     const float3 diffuse = rec.Kd * sample_common::diffuse_texel(rec.diffuse_map, attr.uv);
-    const Bsdf bsdf{Kind, diffuse, rec.Ks, rec.alpha,
+    const float3 specular = rec.Ks * sample_common::diffuse_texel(rec.specular_map, attr.uv);
+    const Bsdf bsdf{Kind, diffuse, specular, rec.alpha,
                     Kind == kDielectric && !outside ? 1.0f / rec.ior : rec.ior};
     const Frame frame = make_frame(n);
     const float3 wo = to_local(frame, -ray.direction);
