@@ -18,7 +18,7 @@ if [ -z "${LUCENT_BUNDLE_BUILD:-}" ]; then
         -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON > /dev/null
 fi
 # Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
-suites="programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf spheres curves scale soak gltf whitted backend igi radiosity direct emitters_textures
+suites="programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf spheres curves textures igi_dielectric scale soak gltf whitted backend igi radiosity direct emitters_textures
         fog pathtracer multi_device gpu_bvh_builder display modules"
 targets="lucent_cli lucent_embed_module"
 python=0  # the Python module: its objects travel, and gpu-check.sh's `python` step links it there
