@@ -323,9 +323,17 @@ void box_interval(const Aabb& box, const TestRay& r, float& t0, float& t1) {
 TEST(TriangleAccel, LeafBoxOcclusionEqualsBruteForceOverItsLeafBoxes) {
     // Occlusion::kLeafBoxes: blocked exactly when some leaf box lies wholly within the ray's
     // interval. Rays whose answer hangs on rounding (a box ending within 1e-4 of tmin or
-    // tmax, or grazed) are skipped; the rest must agree.
-    for (uint32_t seed : {21u, 22u, 23u}) {
-        Mesh m = random_soup(seed, 1500);
+    // tmax, or grazed) are skipped; the rest must agree. The sizes give a tree of one leaf
+    // (the root's one child), one of a few levels, and a deeper one whose walks keep many
+    // nodes on the stack (the query tests two nodes a step, so a step may find the stack
+    // run out after its first).
+    struct Case {
+        uint32_t seed, triangles;
+    };
+    for (const Case c : {Case{21, 1500}, Case{22, 1500}, Case{23, 1500}, Case{24, 6},
+                         Case{25, 30000}}) {
+        const uint32_t seed = c.seed;
+        Mesh m = random_soup(seed, c.triangles);
         TriangleAccel accel;
         accel.build(m.positions, m.indices);
         const std::vector<Aabb> leaves = accel.leaf_boxes();
@@ -348,6 +356,10 @@ TEST(TriangleAccel, LeafBoxOcclusionEqualsBruteForceOverItsLeafBoxes) {
             EXPECT_EQ(accel.occluded_leaf_boxes(r.o, r.d, r.tmin, r.tmax), clear_inside)
                 << "seed " << seed;
             ++(clear_inside ? blocked : open);
+        }
+        if (c.triangles < 1000) {
+            EXPECT_GT(open, 50) << "seed " << seed;
+            continue;
         }
         EXPECT_GT(blocked, 50) << "the rays test both answers";
         EXPECT_GT(open, 50) << "the rays test both answers";

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -280,6 +281,39 @@ TEST_F(CliTest, RenderJsonIsOneObjectWithTheStages) {
     EXPECT_GT(j["total_ms"].get<double>(), 0.0);
     EXPECT_EQ(j["out"], path("w.exr"));
     EXPECT_TRUE(fs::exists(path("w.exr")));
+}
+
+TEST_F(CliTest, JitCheckPrintsNoTimingItDidNotMeasure) {
+    // Issue 21 item 7: with --jit-check the launch once printed -8203 ms (the compile
+    // subtracted from a launch it preceded) and fog -0.14 frames/s. Every stage and rate
+    // printed must be a measured, non-negative time; the JIT stage is one of them.
+    CliRun run = run_cli("render --sample whitted --size 16x16 --jit-check sm_90 --json --out '" +
+                         path("w.png") + "'");
+    if (run.exit_code != 0 && (run.output.find("NVRTC") != std::string::npos ||
+                               run.output.find("CUDA") != std::string::npos))
+        GTEST_SKIP() << "no CUDA backend or NVRTC here: " << run.output;
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json j = nlohmann::json::parse(run.output);
+    bool jit = false, launch = false;
+    for (const auto& stage : j["stages"]) {
+        EXPECT_GE(stage["ms"].get<double>(), 0.0) << stage.dump();
+        jit = jit || stage["name"].get<std::string>().find("JIT") != std::string::npos;
+        launch = launch || stage["name"] == "launch";
+    }
+    EXPECT_TRUE(jit) << j.dump(2);
+    EXPECT_TRUE(launch) << j.dump(2);
+    // The text form, for the fog sample's frames/s too: no negative number anywhere.
+    run = run_cli("render --sample fog --size 16x16 --jit-check sm_90 --out '" + path("f.png") +
+                  "'");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("frames/s"), std::string::npos) << run.output;
+    for (size_t at = run.output.find('-'); at != std::string::npos;
+         at = run.output.find('-', at + 1)) {
+        const bool number = at + 1 < run.output.size() &&
+                            std::isdigit(static_cast<unsigned char>(run.output[at + 1])) &&
+                            (at == 0 || run.output[at - 1] == ' ');
+        EXPECT_FALSE(number) << "a negative figure in: " << run.output;
+    }
 }
 
 TEST_F(CliTest, BadAovNamesTheFlagTheValueAndTheAcceptedOnes) {
