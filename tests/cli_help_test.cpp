@@ -27,9 +27,9 @@ CliRun run_lucent(const std::string& args) {
     return r;
 }
 
-const char* const kCommands[] = {"render",    "view",      "bench rays",    "bench build",
-                                 "bench tea", "bench igi", "bench fog",     "bench spheres",
-                                 "tea",       "noise",     "compare"};
+const char* const kCommands[] = {"render",      "view",      "bench rays",    "bench build",
+                                 "bench tea",   "bench igi", "bench fog",     "bench spheres",
+                                 "bench curves", "tea",      "noise",         "compare"};
 
 TEST(CliHelp, EverySubcommandShowsExamplesOfItself) {
     for (const char* command : kCommands) {
@@ -44,7 +44,7 @@ TEST(CliHelp, EverySubcommandShowsExamplesOfItself) {
 
 TEST(CliHelp, EveryBenchmarkHasJsonOutput) {
     for (const char* bench : {"bench rays", "bench build", "bench tea", "bench igi", "bench fog",
-                              "bench spheres"}) {
+                              "bench spheres", "bench curves"}) {
         const CliRun r = run_lucent(std::string(bench) + " --help");
         EXPECT_NE(r.output.find("--json"), std::string::npos) << bench << "\n" << r.output;
     }
@@ -100,7 +100,7 @@ TEST(CliHelp, EveryUsageErrorHasOneStyleAndMistypesAGuess) {
         {"", "lucent: a command is needed: render, view, bench, tea, noise, compare; run `lucent "
              "--help`"},
         {"bench ray", "lucent bench: 'ray' is not a command (did you mean 'rays'?); the commands "
-                      "are rays, tea, build, igi, fog, present, spheres"},
+                      "are rays, tea, build, igi, fog, present, spheres, curves"},
         {"render --sampel igi", "lucent render: unknown flag --sampel (did you mean '--sample'?); "
                                 "run `lucent render --help`"},
         {"render --spp -3", "lucent render: --spp '-3': expected a number in [0, 1000000]; run "
