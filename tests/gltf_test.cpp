@@ -460,6 +460,11 @@ TEST_F(GltfScenes, MalformedFilesNameTheFileAndTheJsonPath) {
     const std::string syntax = write("s.gltf", R"({"asset": {"version": "2.0"}, "nodes": [)");
     EXPECT_EQ(error_of(syntax).rfind(syntax + ": ", 0), 0u) << error_of(syntax);
 
+    // An empty file: its bytes' data() is null, which memchr (the NUL byte check) must not
+    // be given (UBSan in fuzz.scene_gltf once; tests/fuzz/corpus/gltf/empty.gltf too).
+    const std::string empty = write("empty.gltf", "");
+    EXPECT_EQ(error_of(empty).rfind(empty + ": ", 0), 0u) << error_of(empty);
+
     const std::string cycle = write("cycle.gltf", gltf(std::string(kSquareMesh) + R"(,
   "nodes": [{"children": [1]}, {"mesh": 0, "children": [0]}], "scenes": [{"nodes": [0]}])"));
     EXPECT_EQ(error_of(cycle), cycle + ": nodes[1].children[0]: node 0 is its own ancestor (a cycle)");

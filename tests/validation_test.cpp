@@ -387,6 +387,18 @@ TEST_F(ValidationTest, MapWithAnotherElementTypeIsRejected) {
                  "upload of 3 into 8");
 }
 
+// An empty buffer takes an empty vector (samples::bind_lights uploads no point lights this
+// way): both pointers are null, which memcpy must not be given even for no bytes (UBSan's
+// "null pointer passed as argument 2" once, caught by scripts/test-sanitized.sh).
+TEST_F(ValidationTest, EmptyUploadIntoAnEmptyBufferCopiesNothing) {
+    auto lights = ctx.create_buffer<float4>(BufferType::kInput, 0);
+    EXPECT_NO_THROW(lights->upload(std::vector<float4>{}));
+    EXPECT_EQ(lights->count(), 0u);
+    lights->resize(2);
+    lights->upload(std::vector<float4>{make_float4(1, 2, 3, 4), make_float4(5, 6, 7, 8)});
+    EXPECT_EQ(lights->data<float4>()[1].z, 7.0f);
+}
+
 TEST_F(ValidationTest, UnknownProgramNameIsRejectedWithTheContextsModulesOrHowToAddOne) {
     Context fresh;
     std::string message = expect_error([&] { fresh.create_program("vat_shade"); },

@@ -1,22 +1,23 @@
 // libFuzzer target for the scene loaders (JSON, OBJ + MTL, PLY, glTF): any bytes must give a scene
 // or a lucent::Error, never a crash, a hang or undefined behaviour. The extension of the
-// temporary file picks the loader (LUCENT_FUZZ_EXTENSION, set by run_fuzzer.sh).
+// temporary file picks the loader: the environment's LUCENT_FUZZ_EXTENSION (set by
+// run_fuzzer.sh), so that one executable, built once, fuzzes all four.
 #include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "lucent/error.h"
 #include "scene/scene.h"
 
-#ifndef LUCENT_FUZZ_EXTENSION
-#define LUCENT_FUZZ_EXTENSION ".json"
-#endif
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    static const std::string path =
-        "/tmp/lucent_fuzz_scene_" + std::to_string(::getpid()) + LUCENT_FUZZ_EXTENSION;
+    static const std::string path = [] {
+        const char* extension = std::getenv("LUCENT_FUZZ_EXTENSION");
+        return "/tmp/lucent_fuzz_scene_" + std::to_string(::getpid()) +
+               (extension ? extension : ".json");
+    }();
     if (FILE* f = std::fopen(path.c_str(), "wb")) {
         std::fwrite(data, 1, size, f);
         std::fclose(f);
