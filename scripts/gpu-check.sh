@@ -2,9 +2,11 @@
 # The CUDA checks and benchmarks, for a GPU machine (the `device` tool): run from the repo
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
-# with steps: render examples samples tests igi pathtracer fog tea sanitizer bench builder present sweep profile
-# hotspots multi python (several GPUs: MULTI_SUITES picks the suites run through --devices)
-# (default: render tests sanitizer bench).
+# with steps: render examples samples tests igi pathtracer fog tea sanitizer sanitize bench builder present sweep
+# profile hotspots multi python (several GPUs: MULTI_SUITES picks the suites run through --devices)
+# (default: render tests sanitizer bench). LUCENT_GPU_CHECK_CACHE names a kernel cache folder
+# to keep between runs (your own, e.g. under the tree's ignored build folders); by default
+# each run compiles into a fresh private one.
 set -uo pipefail
 out=${OUT:-gpu-out}
 mkdir -p "$out"
@@ -19,7 +21,7 @@ mkdir -p /work/shared/scenes
 # and the logs, never a fixed path in /tmp that another user could plant first.
 work=$(mktemp -d "${TMPDIR:-/tmp}/lucent-gpu-check.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-export LUCENT_CACHE_DIR=$work/kernel-cache
+export LUCENT_CACHE_DIR=${LUCENT_GPU_CHECK_CACHE:-$work/kernel-cache}
 # Empties the kernel cache, so the next run compiles cold.
 cold_cache() { rm -rf "$LUCENT_CACHE_DIR"; }
 nvidia-smi -L
@@ -203,6 +205,55 @@ sanitizer)
     echo "== compute-sanitizer memcheck: whitted, bench rays"
     compute-sanitizer --tool memcheck --print-limit 20 $R $B/bin/lucent render --sample whitted --backend cuda --size 256x256 --out "$out/whitted_sanitized.png" 2>&1 | tail -8
     compute-sanitizer --tool memcheck --print-limit 20 $R $B/bin/lucent bench rays --backend cuda --size 640x360 --repeat 1 --scene /work/shared/scenes/sponza.obj 2>&1 | tail -12
+    ;;
+sanitize)
+    # compute-sanitizer on every sample and on the GPU test suites: SANITIZE_TOOLS (default
+    # memcheck racecheck initcheck), SANITIZE_PARTS (samples suites), SANITIZE_SUITES (default:
+    # every suite in the bundle). Each run's error count goes to $out/sanitize_summary.txt, its
+    # log (first reports) to $out/sanitize/; a run that ends badly counts as failed.
+    mkdir -p "$out/sanitize"
+    summary="$out/sanitize_summary.txt"
+    sanitized() {  # TOOL LABEL COMMAND...
+        local tool=$1 label=$2; shift 2
+        local log="$out/sanitize/$tool.$label.log" flags=""
+        [ "$tool" = memcheck ] && flags="--leak-check full"
+        [ "$tool" = racecheck ] && flags="--racecheck-report hazard"
+        local t0=$SECONDS
+        timeout 420 compute-sanitizer --tool "$tool" $flags --print-limit 10 --error-exitcode 86 \
+            "$@" > "$log" 2>&1
+        local rc=$?
+        local errors
+        errors=$(grep -hoE "ERROR SUMMARY: [0-9]+ error" "$log" | awk '{ n += $3 } END { print n + 0 }')
+        local hazards
+        hazards=$(grep -hoE "RACECHECK SUMMARY: [0-9]+ hazard" "$log" | awk '{ n += $3 } END { print n + 0 }')
+        printf '%-10s %-44s exit %3d  errors %s  hazards %s  %4d s\n' "$tool" "$label" "$rc" \
+            "$errors" "$hazards" $((SECONDS - t0)) | tee -a "$summary"
+    }
+    for tool in ${SANITIZE_TOOLS:-memcheck racecheck initcheck}; do
+      for part in ${SANITIZE_PARTS:-samples suites}; do
+        if [ "$part" = samples ]; then
+          while read -r label args; do
+            [ -n "$label" ] || continue
+            sanitized "$tool" "$label" $R $B/bin/lucent $args
+          done <<SAMPLES
+whitted render --sample whitted --backend cuda --size 128x128 --out $work/s.png
+direct render --sample direct --backend cuda --scene cornell --size 128x128 --out $work/s.png
+igi render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=32 --out $work/s.png
+igi-accelerated render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=36 --set downsample=4 --set interleave=3 --set imperfect_visibility=1 --out $work/s.png
+radiosity render --sample radiosity --backend cuda --scene cornell --size 128x128 --out $work/s.png
+pathtracer render --sample pathtracer --backend cuda --scene cornell --size 128x128 --spp 4 --out $work/s.exr --aov albedo,normal,depth,position,instance --denoise
+fog render --sample fog --backend cuda --size 128x96 --out $work/s.png
+tea bench tea --backend cuda --megabytes 4
+spheres bench spheres --backend cuda --count 2000 --size 128x128 --repeat 1
+curves bench curves --backend cuda --segments 2000 --size 128x128 --repeat 1
+SAMPLES
+        else
+          for t in ${SANITIZE_SUITES:-$(cd $B/bin && ls *_test | sed 's/_test$//')}; do
+            LUCENT_TEST_BACKEND=cuda LUCENT_SOAK_LAUNCHES=30 sanitized "$tool" "${t}_test" $R $B/bin/${t}_test
+          done
+        fi
+      done
+    done
     ;;
 profile)
     echo "== ncu: the Whitted megakernel at 1024x1024"

@@ -6,9 +6,12 @@
 // two threads at once. LUCENT_SOAK_LAUNCHES sets the count (default 100; the full run is
 // 1,000); LUCENT_TEST_BACKEND=cuda runs it on the GPU. The memory curve is printed.
 //
-// What the Context cannot do is change its device list after construction
-// (ContextOptions::devices is fixed), so that part of the soak is not here; with
-// LUCENT_TEST_DEVICES the whole run goes through the multi-device path.
+// The device list changes too (Context::set_devices): every 11th launch the context moves
+// through a cycle of lists (on the CPU: two CPU devices, one, the constructed choice; with
+// LUCENT_TEST_BACKEND=cuda also the CPU with the GPU, the GPU twice and the GPU alone), and
+// every other move comes between a launch and the reading of its image, so what the old
+// devices wrote must reach the host copy. With LUCENT_TEST_DEVICES the run starts on the
+// multi-device path.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -117,6 +120,27 @@ std::vector<float3> square_vertices(const Shape& s) {
             make_float3(x0, s.y0, s.z), make_float3(x1, s.y1, s.z), make_float3(x0, s.y1, s.z)};
 }
 
+/// The device lists the soak moves through: the constructed choice last (empty: the
+/// backend's one device).
+std::vector<std::vector<DeviceSpec>> device_cycle() {
+    const DeviceSpec cpu{DeviceSpec::Kind::kCpu, 0}, gpu{DeviceSpec::Kind::kCuda, 0};
+    std::vector<std::vector<DeviceSpec>> cycle = {{cpu, cpu}, {cpu}};
+    if (test_backend() == BackendKind::kCuda) {
+        cycle.push_back({cpu, gpu});
+        cycle.push_back({gpu, gpu});
+        cycle.push_back({gpu});
+    }
+    cycle.push_back(test_context_options().devices);
+    return cycle;
+}
+
+std::string device_list_name(const std::vector<DeviceSpec>& devices) {
+    if (devices.empty()) return "the constructed backend";
+    std::string s;
+    for (const DeviceSpec& d : devices) s += (s.empty() ? "" : ",") + device_spec_name(d);
+    return s;
+}
+
 /// The soak's Context and nodes, and the model they should match.
 class SoakScene {
   public:
@@ -197,9 +221,22 @@ class SoakScene {
         }
     }
 
-    /// Launches and counts the pixels that differ from the model's expectation.
-    unsigned launch_and_count_wrong_pixels(std::string& first_wrong) {
+    /// Moves the context onto the next device list of the cycle.
+    void move_devices() {
+        const auto cycle = device_cycle();
+        const std::vector<DeviceSpec>& next = cycle[m_moves++ % cycle.size()];
+        m_ctx.set_devices(next);
+        m_device_list = device_list_name(next);
+    }
+    const std::string& device_list() const { return m_device_list; }
+    unsigned moves() const { return m_moves; }
+
+    /// Launches and counts the pixels that differ from the model's expectation; with
+    /// `move_before_reading` the context changes devices between the launch and the read.
+    unsigned launch_and_count_wrong_pixels(std::string& first_wrong,
+                                           bool move_before_reading = false) {
         m_ctx.launch(0, m_model.width, kHeight);
+        if (move_before_reading) move_devices();
         const std::vector<unsigned> image = read_buffer<unsigned>(*m_image);
         unsigned wrong = 0;
         for (unsigned y = 0; y < kHeight; ++y)
@@ -228,7 +265,13 @@ class SoakScene {
     std::vector<std::shared_ptr<Material>> m_materials;
     std::vector<std::shared_ptr<GeometryInstance>> m_instances;
     std::shared_ptr<Buffer> m_image;
+    unsigned m_moves = 0;
+    std::string m_device_list = "the constructed backend";
 };
+
+/// Every 11th launch moves the device list: alternately before the launch and between the
+/// launch and the read.
+constexpr unsigned kMoveEvery = 11;
 
 /// Resident memory may grow by this much from the end of the warm-up to the last launch:
 /// allocator slack, not a leak (74 KiB measured on the CPU at 100 and at 1,000 launches).
@@ -248,11 +291,17 @@ TEST(Soak, OneContextThroughManyChangingLaunchesStaysCorrectAndFlat) {
     std::printf("soak: resident memory (MiB) before %.2f\n", double(before) / (1 << 20));
     for (unsigned n = 0; n < launches; ++n) {
         if (n > 0) scene.change(n);
+        const bool move = n % kMoveEvery == kMoveEvery - 1;
+        const bool move_between = move && (n / kMoveEvery) % 2 == 1;
+        if (move && !move_between) scene.move_devices();
+        const std::string launched_on = scene.device_list();
         std::string first_wrong;
-        const unsigned wrong = scene.launch_and_count_wrong_pixels(first_wrong);
+        const unsigned wrong = scene.launch_and_count_wrong_pixels(first_wrong, move_between);
         if (wrong > 0 && wrong_launches++ < 5)
-            ADD_FAILURE() << "launch " << n << ": " << wrong << " wrong pixels, first "
-                          << first_wrong << " (" << scene.present_count() << " objects)";
+            ADD_FAILURE() << "launch " << n << " on " << launched_on << ": " << wrong
+                          << " wrong pixels, first " << first_wrong << " ("
+                          << scene.present_count() << " objects"
+                          << (move_between ? ", devices changed before the read" : "") << ")";
         const uint64_t rss = resident_bytes();
         if (n == 0) after_first = rss;
         if (n + 1 == kWarmUp) after_warm_up = rss;
@@ -262,6 +311,7 @@ TEST(Soak, OneContextThroughManyChangingLaunchesStaysCorrectAndFlat) {
     }
     const uint64_t end = resident_bytes();
     EXPECT_EQ(wrong_launches, 0u) << "of " << launches << " launches";
+    std::printf("soak: %u device-list changes\n", scene.moves());
     std::printf("soak: first launch %.2f MiB, after %u %.2f, after 100 %.2f, end %.2f "
                 "(growth after the warm-up %+.3f MiB, bound %.1f)\n",
                 double(after_first) / (1 << 20), kWarmUp, double(after_warm_up) / (1 << 20),
@@ -299,6 +349,53 @@ TEST(Soak, TwoContextsOnTwoThreadsAtOnceGiveCorrectImages) {
     b.join();
     EXPECT_EQ(wrong[0], 0u) << first_wrong[0];
     EXPECT_EQ(wrong[1], 0u) << first_wrong[1];
+}
+
+/// set_devices refuses what cannot run and leaves the context as it was; devices() follows.
+TEST(Soak, DeviceListChangesAreCheckedAndReported) {
+    Context ctx(test_context_options());
+    const std::vector<DeviceSpec> start = ctx.devices();
+    ASSERT_FALSE(start.empty());
+    const DeviceSpec cpu{DeviceSpec::Kind::kCpu, 0};
+    try {
+        ctx.set_devices(std::vector<DeviceSpec>(kMaxDevices + 1, cpu));
+        ADD_FAILURE() << "a list of " << kMaxDevices + 1 << " devices was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("at most " + std::to_string(kMaxDevices)),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(ctx.devices(), start);
+    // A GPU that is not there (ordinal 999) names itself and changes nothing.
+    try {
+        ctx.set_devices({cpu, DeviceSpec{DeviceSpec::Kind::kCuda, 999}});
+        ADD_FAILURE() << "GPU 999 was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("cuda:999"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(ctx.devices(), start);
+    ctx.set_devices({cpu, cpu});
+    EXPECT_EQ(ctx.devices(), (std::vector<DeviceSpec>{cpu, cpu}));
+    EXPECT_EQ(ctx.device_count(), 2u);
+    EXPECT_NE(ctx.backend_name().find("2 devices"), std::string::npos) << ctx.backend_name();
+    ctx.set_devices({});  // back to the backend's one device
+    EXPECT_EQ(ctx.device_count(), 1u);
+    if (test_context_options().devices.empty()) EXPECT_EQ(ctx.devices(), start);
+}
+
+/// What a launch wrote survives a move made before the host read it, for every list of
+/// the cycle (on the GPU this is the fetch through the old devices); one image per list.
+TEST(Soak, WhatALaunchWroteSurvivesEveryDeviceChange) {
+    SoakScene scene(/*seed=*/7);
+    const size_t lists = device_cycle().size();
+    for (size_t k = 0; k < 2 * lists; ++k) {
+        std::string first_wrong;
+        const std::string launched_on = scene.device_list();
+        EXPECT_EQ(scene.launch_and_count_wrong_pixels(first_wrong, /*move_before_reading=*/true),
+                  0u)
+            << "launched on " << launched_on << ", read on " << scene.device_list() << ": "
+            << first_wrong;
+    }
 }
 
 /// The expectation itself: with everything present and the first model, pixels of each

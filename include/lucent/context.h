@@ -126,8 +126,19 @@ class Context : public VariableScope {
     std::string backend_name() const;
     /// Why BackendKind::kAuto chose the CPU ("no NVIDIA driver ..."), or empty.
     const std::string& backend_notice() const;
-    /// How many devices each launch is spread over (1 unless ContextOptions::devices).
+    /// How many devices each launch is spread over (1 unless a device list is set).
     unsigned device_count() const;
+    /// The devices launches run on: the list set (ContextOptions::devices, set_devices), or
+    /// the one device the backend choice made ({cpu} or {cuda:0}).
+    std::vector<DeviceSpec> devices() const;
+    /// Moves every later launch onto `devices`, as ContextOptions::devices would have at
+    /// construction (empty: back to the one device ContextOptions::backend chooses). What
+    /// launches wrote on the old devices is fetched into the buffers' host copies first, the
+    /// old devices' memory is released, and the next launch compiles the scene for the new
+    /// ones; nodes, buffers, programs and variables are kept. The TEA keys follow the new
+    /// device slots (device_tea_key()). Throws Error naming the device that cannot run (or
+    /// a list longer than kMaxDevices), leaving the context on its old devices.
+    void set_devices(std::vector<DeviceSpec> devices);
 
     /// The seed of the per-device TEA keys (device API device_tea_key(); Sebald Fig. 4).
     void set_random_seed(unsigned seed);

@@ -30,22 +30,27 @@ const TypeInfo& payload_type(const py::handle& payload) {
                          py::repr(payload).cast<std::string>());
 }
 
+/// A device list from Python: None (empty: the backend's one device), a string ('0,1',
+/// 'cpu,0', 'all') or a sequence of items ('cpu', 0, 'cuda:1' is not an item: 1 is).
+std::vector<DeviceSpec> device_list(const py::object& devices) {
+    if (devices.is_none()) return {};
+    std::string list;
+    if (py::isinstance<py::str>(devices)) {
+        list = devices.cast<std::string>();
+    } else {
+        for (const py::handle& d : devices)
+            list += (list.empty() ? "" : ",") + py::str(d).cast<std::string>();
+    }
+    return parse_device_list(list);
+}
+
 ContextOptions context_options(const std::string& backend, unsigned threads, int jit_check_sm,
                                const py::object& devices) {
     ContextOptions options;
     options.backend = backend_kind(backend, "Context: backend");
     options.threads = threads;
     options.jit_check_sm = jit_check_sm;
-    if (!devices.is_none()) {
-        std::string list;
-        if (py::isinstance<py::str>(devices)) {
-            list = devices.cast<std::string>();
-        } else {
-            for (const py::handle& d : devices)
-                list += (list.empty() ? "" : ",") + py::str(d).cast<std::string>();
-        }
-        options.devices = parse_device_list(list);
-    }
+    options.devices = device_list(devices);
     return options;
 }
 
@@ -97,6 +102,21 @@ void bind_context(py::module_& m) {
         .def_property_readonly("backend", &Context::backend_name)
         .def_property_readonly("backend_notice", &Context::backend_notice)
         .def_property_readonly("device_count", &Context::device_count)
+        .def_property(
+            "devices",
+            [](const Context& c) {
+                std::vector<std::string> names;
+                for (const DeviceSpec& d : c.devices()) names.push_back(device_spec_name(d));
+                return names;
+            },
+            [](Context& c, const py::object& devices) {
+                std::vector<DeviceSpec> list = device_list(devices);
+                py::gil_scoped_release release;  // a CUDA context takes a while to start
+                c.set_devices(std::move(list));
+            },
+            "The devices launches run on, as names ('cpu', 'cuda:0'). Set it to move later "
+            "launches onto other devices ('0,1', 'cpu,0', 'all', a list, or None for the "
+            "backend's one device): what launches wrote is kept, the scene is compiled again.")
         .def_property("random_seed", &Context::random_seed, &Context::set_random_seed)
         .def_property("entry_point_count", &Context::entry_point_count,
                       &Context::set_entry_point_count)

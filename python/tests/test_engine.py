@@ -198,6 +198,51 @@ def test_the_first_program_from_python():
     np.testing.assert_allclose(pixels[0, 0], (0.1, 0.1, 0.2), rtol=1e-6)  # the background
 
 
+def test_moving_a_context_to_other_devices_keeps_its_scene_and_results():
+    """ctx.devices: the list launches run on; setting it moves later launches (and what the
+    last launch wrote stays readable), a list that cannot run changes nothing."""
+    ctx = lucent.Context(backend=BACKEND)
+    start = ctx.devices
+    assert start == (["cuda:0"] if BACKEND == "cuda" else ["cpu"])
+    camera = ctx.create_program("camera", module="first_program")
+    ctx.set_ray_type(0, "radiance", payload="first_program::Payload")
+    ctx.set_ray_generation_program(0, camera)
+    ctx.set_miss_program(0, ctx.create_program("background"))
+    vertices = ctx.create_buffer("input", "float3", 3)
+    vertices.upload(np.array([[-1, -1, -2], [1, -1, -2.5], [0, 1, -1.5]], np.float32))
+    triangle = ctx.create_geometry_triangles()
+    triangle.vertices = vertices
+    material = ctx.create_material()
+    material.set_closest_hit(0, ctx.create_program("shade"))
+    material["color"] = (1, 0.5, 0.2)
+    instance = ctx.create_geometry_instance()
+    instance.geometry = triangle
+    instance.add_material(material)
+    scene = ctx.create_geometry_group()
+    scene.add_child(instance)
+    image = ctx.create_buffer("output", "float3", (32, 24))
+    ctx["eye"] = (0, 0, 0)
+    ctx["scene"] = scene
+    ctx["image"] = image
+    ctx.launch(0, 32, 24)
+    ctx.devices = ["cpu", "cpu"]  # before the image is read: it must survive the move
+    first = image.numpy().copy()
+    assert ctx.devices == ["cpu", "cpu"] and ctx.device_count == 2
+    assert (first[..., 0] > 0.2).sum() > 50
+    image.upload(np.zeros((24, 32, 3), np.float32))
+    assert ctx.launch(0, 32, 24).recompiled  # compiled again for the new devices
+    np.testing.assert_array_equal(image.numpy(), first)
+    with pytest.raises(lucent.Error, match="cuda:999"):
+        ctx.devices = "cpu,999"
+    with pytest.raises(lucent.Error, match="neither a GPU number nor cpu"):
+        ctx.devices = "cpu,gpu"
+    assert ctx.devices == ["cpu", "cpu"]
+    ctx.devices = None  # back to the backend's one device
+    assert ctx.devices == start and ctx.device_count == 1
+    ctx.launch(0, 32, 24)
+    np.testing.assert_array_equal(image.numpy(), first)
+
+
 def test_engine_errors_are_lucent_errors():
     ctx = lucent.Context(backend=BACKEND)
     with pytest.raises(lucent.Error, match="no_such_module"):

@@ -57,6 +57,10 @@ class Backend {
     virtual void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report);
     /// Brings the host copy of a buffer that the last launch wrote on a device up to date.
     virtual void fetch(const Buffer& /*buffer*/) {}
+    /// The buffers whose host copy is behind this device's (launches wrote them here and the
+    /// host has not read them since): what must be fetched before the device is dropped
+    /// (Context::set_devices). The CPU writes host storage, so it has none.
+    virtual std::vector<std::shared_ptr<const Buffer>> host_copies_behind() const { return {}; }
     /// A 2D float4 buffer as an 8-bit sRGB frame (Context::display_frame): by default
     /// encoded on the host from the host copy; a GPU encodes its own copy in place.
     virtual std::shared_ptr<DisplayFrame> display_frame(const Buffer& output);

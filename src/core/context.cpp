@@ -23,6 +23,7 @@ struct Context::Impl {
     std::unique_ptr<core::CompiledScene> compiled;
     LaunchReport last;
     std::string notice;  // why kAuto chose the CPU
+    ContextOptions options;  // as constructed; devices as last set (set_devices)
     int jit_check_sm = 0;
     unsigned device_count = 1;
     unsigned seed = 0;
@@ -37,6 +38,10 @@ struct Context::Impl {
             device_keys.push_back(generate_tea_key(zafar_tea_key(), make_uint2(slot, seed)));
     }
 
+    /// Launches run on `next` from now on; `devices` is its list (empty: the one device
+    /// options.backend chose).
+    void use_backend(std::unique_ptr<core::Backend> next, const std::vector<DeviceSpec>& devices);
+
     std::string next_name(const char* kind) {
         return std::string(kind) + "#" + std::to_string(++next_id);
     }
@@ -49,18 +54,31 @@ double ms_since(Clock::time_point t0) {
 }
 }  // namespace
 
+namespace {
+void check_device_count(const std::vector<DeviceSpec>& devices, const char* call) {
+    if (devices.size() > kMaxDevices)
+        throw Error(std::string(call) + ": " + std::to_string(devices.size()) +
+                    " devices listed; at most " + std::to_string(kMaxDevices));
+}
+}  // namespace
+
+void Context::Impl::use_backend(std::unique_ptr<core::Backend> next,
+                                const std::vector<DeviceSpec>& devices) {
+    backend = std::move(next);
+    core::Backend* raw = backend.get();
+    shared->fetch_from_device = [raw](const Buffer& b) { raw->fetch(b); };
+    options.devices = devices;
+    device_count = devices.empty() ? 1 : unsigned(devices.size());
+    derive_device_keys();
+}
+
 Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     m_impl->state.context = this;
     m_impl->on_progress = std::move(options.on_progress);
-    if (options.devices.size() > kMaxDevices)
-        throw Error("Context: " + std::to_string(options.devices.size()) +
-                    " devices listed; at most " + std::to_string(kMaxDevices));
-    m_impl->backend = core::make_backend(options, m_impl->notice);
-    if (!options.devices.empty()) m_impl->device_count = unsigned(options.devices.size());
-    core::Backend* backend = m_impl->backend.get();
-    m_impl->shared->fetch_from_device = [backend](const Buffer& b) { backend->fetch(b); };
-    m_impl->derive_device_keys();
-    if (options.jit_check_sm) {
+    check_device_count(options.devices, "Context");
+    m_impl->use_backend(core::make_backend(options, m_impl->notice), options.devices);
+    m_impl->options = std::move(options);
+    if (m_impl->options.jit_check_sm) {
         if (!core::can_jit_check())
             throw Error(
                 "Context: the JIT check needs a build with the CUDA toolkit; drop the option");
@@ -83,6 +101,29 @@ std::string Context::backend_name() const {
 
 unsigned Context::device_count() const {
     return m_impl->device_count;
+}
+
+std::vector<DeviceSpec> Context::devices() const {
+    if (!m_impl->options.devices.empty()) return m_impl->options.devices;
+    // One device from the backend choice: the CPU keeps buffers in host storage, a GPU not.
+    if (m_impl->backend->uses_host_storage()) return {DeviceSpec{DeviceSpec::Kind::kCpu, 0}};
+    return {DeviceSpec{DeviceSpec::Kind::kCuda, 0}};
+}
+
+void Context::set_devices(std::vector<DeviceSpec> devices) {
+    check_device_count(devices, "Context::set_devices");
+    ContextOptions options = m_impl->options;
+    options.devices = devices;
+    std::string notice;
+    // Made before anything changes: a device that cannot run leaves the context as it was.
+    std::unique_ptr<core::Backend> next = core::make_backend(options, notice);
+    // What the old devices wrote reaches the host copies through the old backend.
+    for (const auto& buffer : m_impl->backend->host_copies_behind()) buffer->sync_from_device();
+    // The compiled scene and its per-device state (GPU layouts, kernels) belong to the old
+    // devices; the next launch compiles for the new ones (host accelerations are reused).
+    m_impl->compiled.reset();
+    m_impl->use_backend(std::move(next), devices);
+    m_impl->notice = std::move(notice);
 }
 void Context::set_random_seed(unsigned seed) {
     m_impl->seed = seed;

@@ -158,6 +158,14 @@ class MultiDeviceBackend final : public Backend {
         return Backend::display_frame(output);  // gathered on the host
     }
 
+    std::vector<std::shared_ptr<const Buffer>> host_copies_behind() const override {
+        std::vector<std::shared_ptr<const Buffer>> behind;
+        for (const auto& [raw, buffer] : m_host_stale) behind.push_back(buffer);
+        for (const auto& device : m_devices)  // one device: it marked its outputs itself
+            for (auto& buffer : device->host_copies_behind()) behind.push_back(std::move(buffer));
+        return behind;
+    }
+
     void fetch(const Buffer& buffer) override {
         if (m_devices.size() == 1) return m_devices[0]->fetch(buffer);
         auto stale = m_behind.find(&buffer);

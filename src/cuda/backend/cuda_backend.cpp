@@ -275,6 +275,11 @@ class CudaBackend final : public core::Backend {
         if (m_scene) m_scene->fetch(buffer);
     }
 
+    std::vector<std::shared_ptr<const Buffer>> host_copies_behind() const override {
+        return m_scene ? m_scene->device_newer_buffers()
+                       : std::vector<std::shared_ptr<const Buffer>>{};
+    }
+
     /// Generates the kernel for this scene; compiles it only when the source changed.
     void prepare_kernel(const core::CompiledScene& scene, LaunchReport& report) {
         Megakernel kernel = generate_megakernel(scene, m_scene->programs());

@@ -393,6 +393,13 @@ CUdeviceptr GpuScene::current_mirror(const Buffer& buffer) const {
                                                                                 : 0;
 }
 
+std::vector<std::shared_ptr<const Buffer>> GpuScene::device_newer_buffers() const {
+    std::vector<std::shared_ptr<const Buffer>> newer;
+    for (const auto& [raw, mirror] : m_buffers)
+        if (mirror.device_newer) newer.push_back(mirror.buffer);
+    return newer;
+}
+
 void GpuScene::fetch(const Buffer& buffer) {
     auto found = m_buffers.find(&buffer);
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);

@@ -32,6 +32,8 @@ class GpuScene {
     void mark_outputs_device_newer();
     /// Copies one buffer's device contents to its host copy (no-op if not mirrored).
     void fetch(const Buffer& buffer);
+    /// The buffers whose device copy a launch wrote and the host has not fetched yet.
+    std::vector<std::shared_ptr<const Buffer>> device_newer_buffers() const;
     /// The device copy of a buffer this compile uses, or 0.
     CUdeviceptr mirror(const Buffer& buffer) const;
     /// The device copy when it holds the buffer's newest contents (a launch wrote it, or
