@@ -51,9 +51,21 @@ void CameraController::pan(float x, float y) {
 
 void CameraController::zoom(float factor) {
     const float3 offset = m_camera.eye - m_camera.look;
-    // A floor on the distance keeps the view direction defined.
-    const float d = std::max(length(offset) * factor, 1e-4f * (1.0f + length(m_camera.look)));
+    const float d = std::max(length(offset) * factor, closest_distance());
     m_camera.eye = m_camera.look + normalize(offset) * d;
+}
+
+float CameraController::closest_distance() const {
+    // Relative to the start, so a scene modelled in micrometres zooms as one in metres (an
+    // absolute floor stopped a scene 5e-4 wide at a fifth of its starting distance). And 16
+    // float spacings of the target's largest coordinate at least: the eye, rounded to the
+    // spacing, stays apart from the target with its direction within a few degrees, however
+    // far the scene lies from the origin.
+    const float start = length(m_start.eye - m_start.look);
+    const float largest = std::max({std::fabs(m_camera.look.x), std::fabs(m_camera.look.y),
+                                    std::fabs(m_camera.look.z)});
+    const float spacing = std::nextafter(largest, INFINITY) - largest;
+    return std::max(kClosestFraction * start, 16.0f * spacing);
 }
 
 void CameraController::fly(float forward, float right, float up) {

@@ -21,8 +21,12 @@ class CameraController {
     /// Moves eye and target in the image plane, by fractions of the view's height at the
     /// target (x right, y up): a drag across the window moves the scene with the cursor.
     void pan(float x, float y);
-    /// Scales the eye's distance to the target (below 1: closer); never reaches it.
+    /// Scales the eye's distance to the target (below 1: closer), down to closest_distance().
     void zoom(float factor);
+    /// How close zoom() comes to the target: kClosestFraction of the starting distance, or 16
+    /// float spacings of the target's coordinates where those are coarser (far from 0).
+    float closest_distance() const;
+    static constexpr float kClosestFraction = 1e-5f;
     /// Moves eye and target together along the view direction, its right and the up axis.
     void fly(float forward, float right, float up);
     /// Back to the start.

@@ -66,6 +66,45 @@ TEST(CameraController, ZoomScalesTheDistanceAndNeverReachesTheTarget) {
     EXPECT_GT(c.camera().eye.z, 0.0f);
 }
 
+/// start_camera() scaled by `scale` about 0, then moved by `offset` on every axis.
+Camera placed_camera(float scale, float offset) {
+    Camera c = start_camera();
+    c.eye = c.eye * scale + make_float3(offset);
+    c.look = c.look * scale + make_float3(offset);
+    return c;
+}
+
+TEST(CameraController, ZoomComesAsCloseAtEveryScale) {
+    // The scene 1e-6 as large, its camera alike (10 micrometres from the target): the same
+    // wheel steps give the same share of the starting distance. An absolute floor (1e-4)
+    // stopped the first step here at 1e-4, ten times the starting distance.
+    for (const float scale : {1.0f, 1e-6f, 1e6f}) {
+        CameraController c(placed_camera(scale, 0.0f));
+        c.zoom(0.1f);
+        EXPECT_NEAR(c.distance() / scale, 1.0f, 1e-5f) << "scale " << scale;
+        for (int i = 0; i < 200; ++i) c.zoom(0.1f);
+        EXPECT_NEAR(c.distance() / (10.0f * scale), CameraController::kClosestFraction,
+                    1e-3f * CameraController::kClosestFraction)
+            << "scale " << scale;
+        EXPECT_GT(c.camera().eye.z, c.camera().look.z) << "scale " << scale;
+    }
+}
+
+TEST(CameraController, ZoomAtOffset1e6KeepsTheEyeApartAndTheViewDirection) {
+    // 10 from a target at (1e6, 1e6, 1e6), where floats are 1/16 apart: half the distance is
+    // 5 (an absolute floor of 1e-4 (1 + |look|) = 173 threw the eye back to 173), and the
+    // closest zoom stops 16 spacings (1) from the target, still looking along -z.
+    CameraController c(placed_camera(1.0f, 1e6f));
+    c.zoom(0.5f);
+    EXPECT_NEAR(c.distance(), 5.0f, 0.0625f);
+    for (int i = 0; i < 200; ++i) c.zoom(0.1f);
+    EXPECT_GT(c.distance(), 0.0f);
+    EXPECT_LE(c.distance(), 1.0f + 0.0625f);
+    EXPECT_NEAR(c.closest_distance(), 16.0f * 0.0625f, 1e-6f);
+    const float3 view = normalize(c.camera().look - c.camera().eye);
+    expect_near(view, make_float3(0.0f, 0.0f, -1.0f), 1e-3f);
+}
+
 TEST(CameraController, FlyMovesAlongTheViewAndResetReturns) {
     CameraController c(start_camera());
     c.fly(2.0f, 1.0f, 0.5f);  // forward is -z, right is +x

@@ -9,10 +9,17 @@
 // the fog over it. Rays that start inside the fog (the camera, reflections off the floor)
 // are shaded too: the paper's stated limitation is lifted by reporting a hit at the ray's
 // start when its origin lies inside the box.
+//
+// Robust at any scale and position: secondary rays start at the hit point moved off the surface
+// by Wächter and Binder's offset (Ray Tracing Gems, ch. 6; samples/common/ray_offset.h), which
+// follows the float spacing at the hit and the scene's size, and are traced from tmin 0; the
+// patterns and the noise read the point relative to the modelled scene's origin; every other
+// length is the scene's (a march step, a noise lattice) or a share of the ray's own span.
 #pragma once
 
 #include "lucent/device.h"
 #include "samples/common/common_programs.h"
+#include "samples/common/ray_offset.h"
 #include "lucent/device/noise.h"
 
 namespace fog {
@@ -64,7 +71,7 @@ LUCENT_RECORD(CameraRecord, camera, output, top_object)
 struct LightingParams {
     lucent::BufferView<PointLight> lights;
     float3 ambient;
-    float scene_epsilon;
+    float scene_size;
     unsigned max_depth;
     lucent::Handle top_object;
 };
@@ -78,24 +85,25 @@ struct PhongRecord {
     unsigned pattern;
     float pattern_scale;  // tile size, or noise lattice size
     uint4 noise_key;
+    float3 model_origin;  // where the modelled scene's origin lies: patterns are relative to it
     lucent::BufferView<PointLight> lights;
     float3 ambient;
-    float scene_epsilon;
+    float scene_size;  // the scene's longest side: ray offsets follow it
     unsigned max_depth;
     lucent::Handle top_object;
 };
 LUCENT_RECORD(PhongRecord, Kd_a, Kd_b, Ks, phong_exponent, Kr, pattern, pattern_scale, noise_key,
-              lights, ambient, scene_epsilon, max_depth, top_object)
+              model_origin, lights, ambient, scene_size, max_depth, top_object)
 
 struct GlassRecord {
     float ior;
     float3 extinction;   // Beer's law: per unit distance inside the glass
     float3 shadow_tint;  // what a shadow ray keeps through the crystal
-    float scene_epsilon;
+    float scene_size;
     unsigned max_depth;
     lucent::Handle top_object;
 };
-LUCENT_RECORD(GlassRecord, ior, extinction, shadow_tint, scene_epsilon, max_depth, top_object)
+LUCENT_RECORD(GlassRecord, ior, extinction, shadow_tint, scene_size, max_depth, top_object)
 
 struct FogBoxRecord {  // the fog box's bounds, for its bounding-box and intersection programs
     float3 box_min, box_max;
@@ -111,11 +119,12 @@ struct FogRecord {
     unsigned falloff;   // 0: no falloff in y (tests)
     unsigned rounds;    // TEA rounds of the noise
     uint4 noise_key;    // generate_tea_key(device, seed): Sebald Fig. 4
+    float3 model_origin;  // the noise is a function of the point relative to it
     float3 fog_color;
     lucent::Handle solid_object;  // the scene without the fog box
 };
 LUCENT_RECORD(FogRecord, box_min, box_max, density, step, noise_scale, noise, falloff, rounds,
-              noise_key, fog_color, solid_object)
+              noise_key, model_origin, fog_color, solid_object)
 
 struct MissRecord {
     lucent::TextureView environment;  // equirectangular; used when has_environment
@@ -124,20 +133,21 @@ struct MissRecord {
 LUCENT_RECORD(MissRecord, environment, has_environment)
 
 LUCENT_HD inline LightingParams lighting(const PhongRecord& r) {
-    return LightingParams{r.lights, r.ambient, r.scene_epsilon, r.max_depth, r.top_object};
+    return LightingParams{r.lights, r.ambient, r.scene_size, r.max_depth, r.top_object};
 }
 
 /// What reaches p from `light`: its intensity over d^2 times what shadow rays let through.
+/// The shadow ray leaves from `origin`, p moved off its surface, so it starts at tmin 0.
 LUCENT_HD inline float3 light_arriving(const LightingParams& p, float3 origin, float3 to_light,
                                        const PointLight& light) {
     ShadowPayload s{make_float3(1.0f)};
-    lucent::trace(p.top_object,
-                  lucent::make_ray(origin, to_light, kShadowRay, p.scene_epsilon, 0.999f), s);
+    lucent::trace(p.top_object, lucent::make_ray(origin, to_light, kShadowRay, 0.0f, 0.999f), s);
     return light.intensity * s.attenuation * (1.0f / dot(to_light, to_light));
 }
 
-/// The procedural pattern's colour at p.
+/// The procedural pattern's colour at p (relative to the modelled scene's origin).
 LUCENT_HD inline float3 pattern_colour(const PhongRecord& r, float3 p) {
+    p = p - r.model_origin;
     if (r.pattern == 0) {
         // Tiles with grout: checker of two shades, a darker line near each edge.
         const float u = p.x / r.pattern_scale, v = p.z / r.pattern_scale;
@@ -212,7 +222,7 @@ LUCENT_CLOSEST_HIT(fog_phong, fog::PhongRecord, fog::RadiancePayload, fog::HitAt
     const float3 p = ray.origin + lucent::t_hit() * ray.direction;
     const float3 n =
         faceforward(normalize(lucent::object_to_world_normal(attr.normal)), ray.direction);
-    const float3 origin = p + rec.scene_epsilon * n;
+    const float3 origin = sample_common::offset_along_normal(p, n, rec.scene_size);
     const float3 kd = fog::pattern_colour(rec, p);
     float3 color = kd * rec.ambient;
     const fog::LightingParams params = fog::lighting(rec);
@@ -255,17 +265,18 @@ LUCENT_CLOSEST_HIT(fog_glass, fog::GlassRecord, fog::RadiancePayload, fog::HitAt
     float3 color = make_float3(0.0f);
     if (prd.depth + 1 < int(rec.max_depth)) {
         fog::RadiancePayload reflected{make_float3(0.0f), 0.0f, prd.depth + 1};
-        lucent::trace(
-            rec.top_object,
-            lucent::make_ray(p + rec.scene_epsilon * n, reflect(d, n), fog::kRadianceRay, 0.0f),
-            reflected);
+        lucent::trace(rec.top_object,
+                      lucent::make_ray(sample_common::offset_along_normal(p, n, rec.scene_size),
+                                       reflect(d, n), fog::kRadianceRay, 0.0f),
+                      reflected);
         color += F * reflected.color;
         if (F < 1.0f) {
             const float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
             const float3 t = normalize(eta * d + (eta * cos_i - sqrtf(1.0f - sin2_t)) * n);
             fog::RadiancePayload refracted{make_float3(0.0f), 0.0f, prd.depth + 1};
             lucent::trace(rec.top_object,
-                          lucent::make_ray(p - rec.scene_epsilon * n, t, fog::kRadianceRay, 0.0f),
+                          lucent::make_ray(sample_common::offset_along_normal(p, -n, rec.scene_size),
+                                           t, fog::kRadianceRay, 0.0f),
                           refracted);
             color += (1.0f - F) * refracted.color;
         }
@@ -305,8 +316,12 @@ LUCENT_INTERSECTION(fog_box_intersect, fog::FogBoxRecord, fog::HitAttributes) {
     const lucent::Ray& ray = lucent::current_ray();
     const float2 span = fog::box_span(rec.box_min, rec.box_max, ray.origin, ray.direction);
     if (span.x > span.y || span.y <= ray.tmin) return;
-    // From outside: the entry point. From inside (the origin is in the fog): the ray's start.
-    const float t = span.x > ray.tmin ? span.x : ray.tmin + 1e-6f * (1.0f + fabsf(ray.tmin));
+    // From outside: the entry point. From inside (the origin is in the fog): just past the
+    // ray's start (a hit must lie beyond tmin), by a millionth of its way through the box and
+    // of tmin, so at any scale as little fog is skipped and tmin is passed by some floats.
+    const float t = span.x > ray.tmin
+                        ? span.x
+                        : ray.tmin + 1e-6f * (fabsf(ray.tmin) + (span.y - span.x));
     if (lucent::potential_intersection(t)) {
         attr.normal = make_float3(0.0f, 1.0f, 0.0f);
         attr.t_exit = span.y;
@@ -342,7 +357,8 @@ LUCENT_CLOSEST_HIT(fog_volume, fog::FogRecord, fog::RadiancePayload, fog::HitAtt
     // linearly from 1 at the bottom of the box to 0 at its top. Every term is linear in the
     // step index, so the march only adds increments.
     const float inv_scale = 1.0f / rec.noise_scale;
-    float nx = start.x * inv_scale, nz = start.z * inv_scale;
+    float nx = (start.x - rec.model_origin.x) * inv_scale,
+          nz = (start.z - rec.model_origin.z) * inv_scale;
     const float dnx = dt * d.x * inv_scale, dnz = dt * d.z * inv_scale;
     const float inv_height = 1.0f / (rec.box_max.y - rec.box_min.y);
     float fall = (rec.box_max.y - start.y) * inv_height;

@@ -23,6 +23,12 @@ struct Mesh {
     std::vector<uint3> triangles;
 };
 
+/// `m` moved by `placement`.
+Mesh placed(Mesh m, const Placement& placement) {
+    for (float3& p : m.positions) p = placement.point(p);
+    return m;
+}
+
 Mesh floor_mesh() {
     const float h = kFloorHalf;
     return {{{-h, 0, -h}, {h, 0, -h}, {h, 0, h}, {-h, 0, h}}, {{0, 2, 1}, {0, 3, 2}}};
@@ -73,22 +79,32 @@ Mesh crystal_mesh(float3 base, float radius) {
 }
 
 /// Ray types, recursion depth, lights and the context-wide variables.
-void set_up_context(Context& ctx, const FogOptions& options) {
+void set_up_context(Context& ctx, const FogOptions& options, const Placement& placement) {
     ctx.set_ray_type<fog::RadiancePayload>(fog::kRadianceRay, "radiance");
     ctx.set_ray_type<fog::ShadowPayload>(fog::kShadowRay, "shadow", /*expects_closest_hit=*/false);
     // Each level of the reflection and refraction tree may cross the fog, whose look behind
     // itself is one more trace at the same depth: two frames per level, and the camera's.
     ctx.set_max_recursion_depth(2 * options.max_depth + 2);
 
-    const std::vector<fog::PointLight> lights = {
+    std::vector<fog::PointLight> lights = {
         {make_float3(-8.0f, 20.0f, -10.0f), make_float3(420.0f, 410.0f, 390.0f)},
         {make_float3(10.0f, 14.0f, 9.0f), make_float3(110.0f, 95.0f, 75.0f)}};
+    for (fog::PointLight& light : lights) {
+        light.position = placement.point(light.position);
+        light.intensity = placement.intensity(light.intensity);
+    }
     auto light_buffer =
         ctx.create_buffer<fog::PointLight>(BufferType::kInput, unsigned(lights.size()));
     light_buffer->upload(lights);
     ctx["lights"] = light_buffer;
     ctx["ambient"] = make_float3(0.12f, 0.13f, 0.15f);
-    ctx["scene_epsilon"] = 1e-3f;
+    // Secondary rays start off their surface by an offset that follows the scene's size (the
+    // floor's side) and the float spacing at the hit (samples/common/ray_offset.h); a fixed
+    // 1e-3 was a whole scene at scale 1e-6 and less than a float's spacing at 1e6.
+    ctx["scene_size"] = placement.length(2.0f * kFloorHalf);
+    // The patterns and the noise are functions of the point relative to the modelled
+    // scene's origin, so they move with the scene.
+    ctx["model_origin"] = placement.point(make_float3(0.0f));
     ctx["max_depth"] = options.max_depth;
     // Sebald Fig. 4: this device's key from its identifier and the seed.
     ctx["noise_key"] = generate_tea_key(zafar_tea_key(), make_uint2(options.device, options.seed));
@@ -98,8 +114,8 @@ struct SolidMaterials {
     std::shared_ptr<Material> floor, box, glass;
 };
 
-/// The tutorial's tiled floor, rusty box and glass crystal.
-SolidMaterials create_materials(Context& ctx) {
+/// The tutorial's tiled floor, rusty box and glass crystal; their lengths placed.
+SolidMaterials create_materials(Context& ctx, const Placement& placement) {
     auto phong = ctx.create_program(LUCENT_PROGRAM(fog::fog_phong));
     auto opaque = ctx.create_program(LUCENT_PROGRAM(fog::fog_opaque_shadow));
     SolidMaterials m{ctx.create_material(), ctx.create_material(), ctx.create_material()};
@@ -112,7 +128,7 @@ SolidMaterials create_materials(Context& ctx) {
     (*m.floor)["phong_exponent"] = 40.0f;
     (*m.floor)["Kr"] = make_float3(0.1f);
     (*m.floor)["pattern"] = 0u;
-    (*m.floor)["pattern_scale"] = 2.0f;
+    (*m.floor)["pattern_scale"] = placement.length(2.0f);
     m.box->set_name("rusty box");
     m.box->set_closest_hit(fog::kRadianceRay, phong);
     m.box->set_any_hit(fog::kShadowRay, opaque);
@@ -122,20 +138,22 @@ SolidMaterials create_materials(Context& ctx) {
     (*m.box)["phong_exponent"] = 60.0f;
     (*m.box)["Kr"] = make_float3(0.35f);
     (*m.box)["pattern"] = 1u;
-    (*m.box)["pattern_scale"] = 1.2f;
+    (*m.box)["pattern_scale"] = placement.length(1.2f);
     m.glass->set_name("crystal");
     m.glass->set_closest_hit(fog::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(fog::fog_glass)));
     m.glass->set_any_hit(fog::kShadowRay,
                          ctx.create_program(LUCENT_PROGRAM(fog::fog_glass_shadow)));
     (*m.glass)["ior"] = 1.5f;
-    (*m.glass)["extinction"] = make_float3(0.35f, 0.06f, 0.22f);
+    (*m.glass)["extinction"] = make_float3(
+        placement.per_length(0.35f), placement.per_length(0.06f), placement.per_length(0.22f));
     (*m.glass)["shadow_tint"] = make_float3(0.78f, 0.9f, 0.84f);
     return m;
 }
 
 /// The triangles in a GeometryGroup of their own: it gets the triangle BVH's fast
 /// traversal, which a group holding the fog box (a custom primitive) would lose.
-std::shared_ptr<GeometryGroup> solid_group(Context& ctx, const SolidMaterials& materials) {
+std::shared_ptr<GeometryGroup> solid_group(Context& ctx, const SolidMaterials& materials,
+                                           const Placement& placement) {
     auto attributes = ctx.create_program(LUCENT_PROGRAM(fog::fog_mesh_attributes));
     auto solids = ctx.create_geometry_group();
     auto add_mesh = [&](const Mesh& mesh, const std::shared_ptr<Material>& material,
@@ -158,16 +176,18 @@ std::shared_ptr<GeometryGroup> solid_group(Context& ctx, const SolidMaterials& m
         instance->add_material(material);
         solids->add_child(instance);
     };
-    add_mesh(floor_mesh(), materials.floor, "floor");
-    add_mesh(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)),
+    add_mesh(placed(floor_mesh(), placement), materials.floor, "floor");
+    add_mesh(placed(box_mesh(make_float3(-5.0f, 0.0f, -3.5f), make_float3(-1.0f, 7.0f, 0.5f)),
+                    placement),
              materials.box, "box");
-    add_mesh(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), materials.glass, "crystal");
+    add_mesh(placed(crystal_mesh(make_float3(3.5f, 0.0f, 2.0f), 1.4f), placement),
+             materials.glass, "crystal");
     return solids;
 }
 
 /// Sebald §3.1: a box with the floor's x, z extent and the fog's height, in a group of its
 /// own beside the solids; both under the top object.
-void add_fog_box(Context& ctx, const FogOptions& options,
+void add_fog_box(Context& ctx, const FogOptions& options, const Placement& placement,
                  const std::shared_ptr<GeometryGroup>& solids) {
     auto fog_material = ctx.create_material();
     fog_material->set_name("fog");
@@ -175,9 +195,9 @@ void add_fog_box(Context& ctx, const FogOptions& options,
                                   ctx.create_program(LUCENT_PROGRAM(fog::fog_volume)));
     fog_material->set_any_hit(fog::kShadowRay,
                               ctx.create_program(LUCENT_PROGRAM(fog::fog_volume_shadow)));
-    (*fog_material)["density"] = options.density;
-    (*fog_material)["step"] = options.step;
-    (*fog_material)["noise_scale"] = options.noise_scale;
+    (*fog_material)["density"] = placement.per_length(options.density);
+    (*fog_material)["step"] = placement.length(options.step);
+    (*fog_material)["noise_scale"] = placement.length(options.noise_scale);
     (*fog_material)["noise"] = unsigned(options.noise);
     (*fog_material)["falloff"] = unsigned(options.falloff);
     (*fog_material)["rounds"] = options.rounds;
@@ -190,8 +210,8 @@ void add_fog_box(Context& ctx, const FogOptions& options,
     auto instance = ctx.create_geometry_instance();
     instance->set_geometry(fog_box);
     // On the instance: its intersection and its closest hit both read them.
-    (*instance)["box_min"] = make_float3(-kFloorHalf, 0.0f, -kFloorHalf);
-    (*instance)["box_max"] = make_float3(kFloorHalf, options.height, kFloorHalf);
+    (*instance)["box_min"] = placement.point(make_float3(-kFloorHalf, 0.0f, -kFloorHalf));
+    (*instance)["box_max"] = placement.point(make_float3(kFloorHalf, options.height, kFloorHalf));
     instance->add_material(fog_material);
     auto fog_group = ctx.create_geometry_group();
     fog_group->add_child(instance);
@@ -249,21 +269,23 @@ FogOptions read_fog_options(const OptionValues& v) {
 struct FogScene::Impl {
     Context ctx;
     FogOptions options;
+    Placement placement;
     unsigned width, height;
     std::shared_ptr<Buffer> camera, output;
 
-    Impl(const FogOptions& o, unsigned w, unsigned h, const ContextOptions& c)
-        : ctx(c), options(o), width(w), height(h) {}
+    Impl(const FogOptions& o, const Placement& p, unsigned w, unsigned h, const ContextOptions& c)
+        : ctx(c), options(o), placement(p), width(w), height(h) {}
 };
 
 FogScene::FogScene(const FogOptions& options, unsigned width, unsigned height,
-                   const ContextOptions& context_options)
-    : m(std::make_unique<Impl>(options, width, height, context_options)) {
+                   const ContextOptions& context_options, const Placement& placement)
+    : m(std::make_unique<Impl>(options, placement, width, height, context_options)) {
     Context& ctx = m->ctx;
-    set_up_context(ctx, options);
-    const std::shared_ptr<GeometryGroup> solids = solid_group(ctx, create_materials(ctx));
+    set_up_context(ctx, options, placement);
+    const std::shared_ptr<GeometryGroup> solids =
+        solid_group(ctx, create_materials(ctx, placement), placement);
     if (options.fog)
-        add_fog_box(ctx, options, solids);
+        add_fog_box(ctx, options, placement, solids);
     else
         ctx["top_object"] = solids;
     ctx.set_miss_program(fog::kRadianceRay, environment_program(ctx, options.environment));
@@ -285,7 +307,7 @@ scene::Camera FogScene::orbit_camera(float orbit_degrees) const {
     camera.eye = make_float3(r * std::sin(a), m->options.eye_height, -r * std::cos(a));
     camera.look = kLookAt;
     camera.fov_degrees = 45.0f;
-    return camera;
+    return m->placement.camera(camera);
 }
 
 const LaunchReport& FogScene::render(float orbit_degrees) {

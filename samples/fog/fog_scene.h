@@ -1,6 +1,7 @@
 // The fog sample's scene, built once and rendered for any camera on its orbit: the OptiX SDK
 // tutorial's floor, box and crystal, point lights, the environment, and the fog box
-// (Sebald, §3.1). The sample renders one frame; `lucent bench fog` renders a path.
+// (Sebald, §3.1). The sample renders one frame; `lucent bench fog` renders a path. A
+// Placement moves the whole scene (tests/scale_test.cpp).
 #pragma once
 
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include "lucent/context.h"
 #include "samples/options.h"
+#include "samples/placement.h"
 #include "scene/scene.h"
 
 namespace lucent::samples {
@@ -34,14 +36,19 @@ FogOptions read_fog_options(const OptionValues& values);
 
 class FogScene {
   public:
-    FogScene(const FogOptions& options, unsigned width, unsigned height, const ContextOptions& ctx);
+    /// The scene as modelled, moved by `placement`: geometry, lights, the fog box and the
+    /// orbit's camera; the options' lengths (step, height, noise scale, eye height and
+    /// distance) are in the modelled scene's units, and the patterns and the fog's noise move
+    /// with it. The image is that of the unmoved scene, up to rounding.
+    FogScene(const FogOptions& options, unsigned width, unsigned height, const ContextOptions& ctx,
+             const Placement& placement = {});
     ~FogScene();
 
     /// Places the camera at `orbit_degrees` around the scene and launches; returns the report.
     const LaunchReport& render(float orbit_degrees);
     /// Launches with any camera (the viewer's); returns the report.
     const LaunchReport& render(const scene::Camera& camera);
-    /// The camera at `orbit_degrees` on the orbit of the options' height and distance.
+    /// The camera at `orbit_degrees` on the orbit of the options' height and distance (placed).
     scene::Camera orbit_camera(float orbit_degrees) const;
     Context& context();
     const Buffer& output() const;

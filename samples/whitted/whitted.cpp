@@ -32,8 +32,7 @@ sample_common::PinholeCamera camera_frame(const WhittedLayout& layout, float asp
 }
 
 /// The sample's camera as a scene::Camera, with the parts settings.camera gives replaced.
-scene::Camera whitted_camera(const RenderSettings& settings) {
-    const WhittedLayout& layout = whitted_layout();
+scene::Camera whitted_camera(const WhittedLayout& layout, const RenderSettings& settings) {
     scene::Camera own;
     own.eye = layout.eye;
     own.look = layout.lookat;
@@ -43,9 +42,10 @@ scene::Camera whitted_camera(const RenderSettings& settings) {
 }
 
 /// The pinhole of the render: the sample's own frame, or that of the camera asked for.
-sample_common::PinholeCamera whitted_pinhole(const RenderSettings& settings) {
-    if (settings.camera.empty()) return camera_frame(whitted_layout(), settings.aspect());
-    return pinhole_camera(whitted_camera(settings), settings.aspect());
+sample_common::PinholeCamera whitted_pinhole(const WhittedLayout& layout,
+                                             const RenderSettings& settings) {
+    if (settings.camera.empty()) return camera_frame(layout, settings.aspect());
+    return pinhole_camera(whitted_camera(layout, settings), settings.aspect());
 }
 
 /// The sample's --set options, checked.
@@ -67,8 +67,7 @@ struct WhittedOptions {
 /// Up to three white point lights; their colours share one unit of intensity so the
 /// exposure stays the same whatever the count.
 std::vector<whitted::BasicLight> make_lights(const WhittedLayout& layout, int count) {
-    const float3 positions[3] = {layout.key_light, make_float3(-12.0f, 25.0f, 24.0f),
-                                 make_float3(30.0f, 20.0f, -30.0f)};
+    const float3 positions[3] = {layout.key_light, layout.fill_lights[0], layout.fill_lights[1]};
     std::vector<whitted::BasicLight> lights;
     for (int i = 0; i < count; ++i) {
         whitted::BasicLight light{};
@@ -107,10 +106,9 @@ void set_variables(Context& ctx, Program& camera, const WhittedOptions& options)
 
 /// Ray types, exceptions, the output buffer (context variable output_buffer) of width x
 /// height, and the camera (reading `camera_buffer`, entry 0), exception and miss programs.
-std::shared_ptr<Buffer> create_programs(Context& ctx, const WhittedOptions& options,
-                                        unsigned width, unsigned height,
-                                        const CameraBuffer& camera_buffer) {
-    const WhittedLayout& layout = whitted_layout();
+std::shared_ptr<Buffer> create_programs(Context& ctx, const WhittedLayout& layout,
+                                        const WhittedOptions& options, unsigned width,
+                                        unsigned height, const CameraBuffer& camera_buffer) {
     ctx.set_ray_type<whitted::RadiancePayload>(whitted::kRadianceRay, "radiance");
     // Shadow rays need only any-hit (attenuate or stop) and no miss program: a ray that
     // reaches the light returns the attenuation the glass left it.
@@ -152,9 +150,8 @@ Shapes create_shapes(Context& ctx, const WhittedLayout& layout) {
     floor->set_bounding_box_program(
         ctx.create_program(LUCENT_PROGRAM(whitted::whitted_parallelogram_bounds)));
     {
-        const float3 anchor = make_float3(-20.0f, layout.floor_height, -22.0f);
-        const float3 v1 = make_float3(0.0f, 0.0f, 40.0f);  // (v1 x v2) points up
-        const float3 v2 = make_float3(40.0f, 0.0f, 0.0f);
+        const float3 anchor = layout.floor_anchor;
+        const float3 v1 = layout.floor_edge1, v2 = layout.floor_edge2;
         const float3 normal = normalize(cross(v1, v2));
         (*floor)["plane"] = make_float4(normal, dot(normal, anchor));
         (*floor)["v1"] = v1 / dot(v1, v1);
@@ -244,8 +241,7 @@ Materials create_materials(Context& ctx, const WhittedLayout& layout) {
     (*glass_material)["reflection_color"] = make_float3(1.0f);
     (*glass_material)["refraction_maxdepth"] = 10;
     (*glass_material)["reflection_maxdepth"] = 5;
-    (*glass_material)["extinction_constant"] =
-        make_float3(std::log(0.83f), std::log(0.83f), std::log(0.83f));
+    (*glass_material)["extinction_constant"] = make_float3(layout.glass_extinction);
     (*glass_material)["cutoff_color"] = make_float3(0.034f, 0.055f, 0.085f);
     (*glass_material)["importance_cutoff"] = 0.01f;
     return {floor_material, metal_material, glass_material};
@@ -279,12 +275,12 @@ std::shared_ptr<GeometryGroup> scene_group(Context& ctx, const WhittedLayout& la
     return group;
 }
 
-/// Builds the whole scene into `ctx`, the camera program reading `camera` at entry 0; returns
-/// the float4 output buffer (context variable output_buffer) of width x height.
-std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options, unsigned width,
+/// Builds the whole scene of `layout` into `ctx`, the camera program reading `camera` at entry
+/// 0; returns the float4 output buffer (context variable output_buffer) of width x height.
+std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedLayout& layout,
+                                    const WhittedOptions& options, unsigned width,
                                     unsigned height, const CameraBuffer& camera_buffer) {
-    const WhittedLayout& layout = whitted_layout();
-    auto output = create_programs(ctx, options, width, height, camera_buffer);
+    auto output = create_programs(ctx, layout, options, width, height, camera_buffer);
     const Shapes shapes = create_shapes(ctx, layout);
     auto group = scene_group(ctx, layout, shapes, create_materials(ctx, layout));
     const std::vector<whitted::BasicLight> lights = make_lights(layout, options.lights);
@@ -296,7 +292,10 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedOptions& options,
     ctx["top_object"] = group;
     ctx["top_shadower"] = group;
     ctx["ambient_light_color"] = make_float3(layout.ambient);
-    ctx["scene_epsilon"] = 1e-3f;
+    // Secondary rays start off their surface by an offset that follows the scene's size and
+    // the float spacing at the hit (samples/common/ray_offset.h); a fixed 1e-3 was a whole
+    // scene at scale 1e-6 and less than a float's spacing at 1e6.
+    ctx["scene_size"] = layout.size;
     return output;
 }
 
@@ -307,9 +306,11 @@ class WhittedSession final : public CameraSession {
     WhittedSession(const Sample& sample, const RenderSettings& settings,
                    const WhittedOptions& options)
         : CameraSession(sample, settings), m_lights(options.lights) {
-        set_output(build_scene(context(), options, settings.width, settings.height, camera()));
+        const WhittedLayout& layout = whitted_layout();
+        set_output(
+            build_scene(context(), layout, options, settings.width, settings.height, camera()));
         m_camera = context().ray_generation_program(0);
-        start_at(whitted_camera(settings), whitted_pinhole(settings));
+        start_at(whitted_camera(layout, settings), whitted_pinhole(layout, settings));
     }
 
   private:
@@ -348,14 +349,19 @@ class WhittedSample final : public Sample {
                  }) {}
 
     RenderResult render(const RenderSettings& settings) const override {
+        return render_placed(settings, whitted_layout());
+    }
+
+    /// One frame of the scene of `layout`.
+    RenderResult render_placed(const RenderSettings& settings, const WhittedLayout& layout) const {
         const WhittedOptions options(read_options(settings));
         check_scene(settings);
         const Clock::time_point setup_start = Clock::now();
         Context ctx(settings.context_options());
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
-        camera.set(whitted_pinhole(settings));
-        auto output = build_scene(ctx, options, settings.width, settings.height, camera);
+        camera.set(whitted_pinhole(layout, settings));
+        auto output = build_scene(ctx, layout, options, settings.width, settings.height, camera);
         out.stages.push_back({"scene setup", ms_since(setup_start)});
         timed_launch(ctx, 0, settings, out);
         out.image = image_from_output(*output);
@@ -373,6 +379,11 @@ const RegisterSample<WhittedSample> kRegistered(/*help_order=*/10);
 
 }  // namespace
 
+RenderResult render_whitted(const RenderSettings& settings, const Placement& placement) {
+    const auto& sample = dynamic_cast<const WhittedSample&>(find_sample(kSceneName));
+    return sample.render_placed(settings, whitted_layout(placement));
+}
+
 const WhittedLayout& whitted_layout() {
     static const WhittedLayout layout = [] {
         WhittedLayout l{};
@@ -387,16 +398,37 @@ const WhittedLayout& whitted_layout() {
         l.glass_radius = 1.0f;
         l.glass_thickness = 0.04f;
         l.floor_height = 0.01f;
+        l.floor_anchor = make_float3(-20.0f, l.floor_height, -22.0f);
+        l.floor_edge1 = make_float3(0.0f, 0.0f, 40.0f);
+        l.floor_edge2 = make_float3(40.0f, 0.0f, 0.0f);
         l.key_light = make_float3(6.0f, 40.0f, 21.0f);
+        l.fill_lights[0] = make_float3(-12.0f, 25.0f, 24.0f);
+        l.fill_lights[1] = make_float3(30.0f, 20.0f, -30.0f);
         // With ambient 0.3 the lit floor stays below 1 (no clipped checkers).
         l.light_intensity = 0.9f;
         l.ambient = 0.3f;
         // Four surfaces (the shell's two sides, twice) let 0.85^4 = 52 % through at the
         // shadow's centre, less towards its rim where Fresnel reflection grows.
         l.glass_shadow_transmission = 0.85f;
+        l.glass_extinction = std::log(0.83f);
+        l.size = 40.0f;
         return l;
     }();
     return layout;
+}
+
+WhittedLayout whitted_layout(const Placement& placement) {
+    WhittedLayout l = whitted_layout();
+    for (float3* p : {&l.eye, &l.lookat, &l.metal_center, &l.glass_center, &l.floor_anchor,
+                      &l.key_light, &l.fill_lights[0], &l.fill_lights[1]})
+        *p = placement.point(*p);
+    l.floor_height = l.floor_anchor.y;
+    l.floor_edge1 = placement.vector(l.floor_edge1);
+    l.floor_edge2 = placement.vector(l.floor_edge2);
+    for (float* length : {&l.metal_radius, &l.glass_radius, &l.glass_thickness, &l.size})
+        *length = placement.length(*length);
+    l.glass_extinction = placement.per_length(l.glass_extinction);
+    return l;
 }
 
 float2 whitted_project(float3 p, unsigned width, unsigned height) {

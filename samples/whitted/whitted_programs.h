@@ -5,9 +5,14 @@
 // checkered Phong floor, a reflective metal, a Fresnel glass, point lights with shadow rays
 // whose any-hit programs either stop the ray (opaque) or attenuate it (glass).
 //
+// Secondary rays (shadow, reflection, refraction) start at the hit point moved off the surface
+// by Wächter and Binder's offset (Ray Tracing Gems, ch. 6; samples/common/ray_offset.h), which
+// follows the float spacing at the hit and the scene's size, and are traced from tmin 0: the
+// scene renders alike at any scale and far from the origin (tests/scale_test.cpp).
+//
 // Single source: compiled by g++ into the host (CPU backend) and by NVRTC for the GPU, so
 // it uses only lucent/device.h, the C math functions and the samples' shared pinhole camera
-// (samples/common/camera.h).
+// and ray offset (samples/common/).
 //
 // Everything lives in namespace `whitted`, the namespace of its module: the host names a
 // program as LUCENT_PROGRAM(whitted::whitted_camera).
@@ -15,6 +20,7 @@
 
 #include "lucent/device.h"
 #include "samples/common/camera.h"
+#include "samples/common/ray_offset.h"
 
 namespace whitted {
 
@@ -113,12 +119,12 @@ struct PhongRecord {
     float3 ambient_light_color;
     BufferView<BasicLight> lights;
     Handle top_object, top_shadower;
-    float scene_epsilon;
+    float scene_size;  // the scene's longest side: ray offsets follow it
     int max_depth;
     int shadows;  // 0: shadow rays off (every light reaches every point that faces it)
 };
 LUCENT_RECORD(PhongRecord, Ka, Kd, Ks, phong_exp, reflectivity, ambient_light_color, lights,
-              top_object, top_shadower, scene_epsilon, max_depth, shadows)
+              top_object, top_shadower, scene_size, max_depth, shadows)
 
 struct CheckerRecord {
     TextureView checker;   // float4 texels: rgb is the colour (ambient = diffuse)
@@ -129,12 +135,12 @@ struct CheckerRecord {
     float3 ambient_light_color;
     BufferView<BasicLight> lights;
     Handle top_object, top_shadower;
-    float scene_epsilon;
+    float scene_size;
     int max_depth;
     int shadows;
 };
 LUCENT_RECORD(CheckerRecord, checker, checker_scale, Ks, phong_exp, reflectivity,
-              ambient_light_color, lights, top_object, top_shadower, scene_epsilon, max_depth,
+              ambient_light_color, lights, top_object, top_shadower, scene_size, max_depth,
               shadows)
 
 struct GlassRecord {
@@ -146,12 +152,12 @@ struct GlassRecord {
     float importance_cutoff;
     int refraction_maxdepth, reflection_maxdepth;
     int max_depth;
-    float scene_epsilon;
+    float scene_size;
     Handle top_object;
 };
 LUCENT_RECORD(GlassRecord, fresnel_exponent, fresnel_minimum, fresnel_maximum, refraction_index,
               refraction_color, reflection_color, extinction_constant, cutoff_color,
-              importance_cutoff, refraction_maxdepth, reflection_maxdepth, max_depth, scene_epsilon,
+              importance_cutoff, refraction_maxdepth, reflection_maxdepth, max_depth, scene_size,
               top_object)
 
 struct GlassShadowRecord {
@@ -208,12 +214,14 @@ LUCENT_HD inline bool sphere_roots(float3 o, float3 d, float3 center, float radi
 }
 
 /// Ambient + Phong direct lighting with shadow rays from every light, plus a mirror
-/// reflection ray weighted by `reflectivity` (the SDK's phongShade).
+/// reflection ray weighted by `reflectivity` (the SDK's phongShade). `normal` faces the
+/// incoming ray: both kinds of ray leave on its side.
 template <class Rec>
 LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 Ka, float3 Kd,
                                   float3 Ks, float phong_exp, float3 reflectivity, float3 normal) {
     const lucent::Ray& ray = lucent::current_ray();
     float3 hit_point = ray.origin + lucent::t_hit() * ray.direction;
+    float3 origin = sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
     float3 dir = normalize(ray.direction);
 
     float3 result = Ka * rec.ambient_light_color;
@@ -229,10 +237,10 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
         if (rec.shadows && light.casts_shadow) {
             ShadowPayload shadow_prd;
             shadow_prd.attenuation = make_float3(1.0f);
-            lucent::trace(
-                rec.top_shadower,
-                lucent::make_ray(hit_point, L, kShadowRay, rec.scene_epsilon, light_distance),
-                shadow_prd);
+            // To the point light itself: no surface there to stop short of.
+            lucent::trace(rec.top_shadower,
+                          lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance),
+                          shadow_prd);
             light_attenuation = shadow_prd.attenuation;
         }
         if (max_component(light_attenuation) <= 0.0f) continue;
@@ -253,8 +261,7 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
         reflected.result = make_float3(0.0f);
         if (reflected.importance >= 0.01f && reflected.depth <= rec.max_depth) {
             float3 R = reflect(dir, normal);
-            lucent::trace(rec.top_object,
-                          lucent::make_ray(hit_point, R, kRadianceRay, rec.scene_epsilon),
+            lucent::trace(rec.top_object, lucent::make_ray(origin, R, kRadianceRay, 0.0f),
                           reflected);
             result += reflectivity * reflected.result;
         }
@@ -450,8 +457,12 @@ LUCENT_BOUNDING_BOX(whitted_parallelogram_bounds, whitted::ParallelogramRecord) 
     float3 e2 = rec.v2 / dot(rec.v2, rec.v2);
     float3 p00 = rec.anchor, p10 = rec.anchor + e1, p01 = rec.anchor + e2;
     float3 p11 = rec.anchor + e1 + e2;
-    // A flat box is valid but leaves no margin for the slab test's rounding: pad it.
-    float3 pad = make_float3(1e-4f * (length(e1) + length(e2)));
+    // A flat box is valid but leaves no margin for the slab test's rounding: pad it, by a
+    // share of its size and, far from the origin, by a few float spacings of its corner
+    // (there a share of the size alone can round away).
+    float3 far = fmaxf(fmaxf(fmaxf(p00, -p00), fmaxf(p10, -p10)),
+                       fmaxf(fmaxf(p01, -p01), fmaxf(p11, -p11)));
+    float3 pad = make_float3(1e-4f * (length(e1) + length(e2)) + 1e-6f * max_component(far));
     box.lo = fminf(fminf(p00, p10), fminf(p01, p11)) - pad;
     box.hi = fmaxf(fmaxf(p00, p10), fmaxf(p01, p11)) + pad;
 }
@@ -492,9 +503,9 @@ LUCENT_CLOSEST_HIT(whitted_glass_radiance, whitted::GlassRecord, whitted::Radian
 
     float3 result = make_float3(0.0f);
     float reflection = 1.0f;  // total internal reflection unless refraction succeeds
+    float3 facing = leaving ? -n : n;  // towards the side the ray came from
     if (prd.depth <
         (rec.refraction_maxdepth < rec.max_depth ? rec.refraction_maxdepth : rec.max_depth)) {
-        float3 facing = leaving ? -n : n;
         float eta = leaving ? rec.refraction_index : 1.0f / rec.refraction_index;
         float3 transmitted;
         if (refract(transmitted, i, facing, eta)) {
@@ -511,9 +522,10 @@ LUCENT_CLOSEST_HIT(whitted_glass_radiance, whitted::GlassRecord, whitted::Radian
                 refr.result = make_float3(0.0f);
                 refr.importance = importance;
                 refr.depth = prd.depth + 1;
+                float3 origin =
+                    sample_common::offset_along_normal(hit_point, -facing, rec.scene_size);
                 lucent::trace(rec.top_object,
-                              lucent::make_ray(hit_point, transmitted, whitted::kRadianceRay,
-                                               rec.scene_epsilon),
+                              lucent::make_ray(origin, transmitted, whitted::kRadianceRay, 0.0f),
                               refr);
                 refracted = refr.result;
             }
@@ -530,9 +542,9 @@ LUCENT_CLOSEST_HIT(whitted_glass_radiance, whitted::GlassRecord, whitted::Radian
             refl.result = make_float3(0.0f);
             refl.importance = importance;
             refl.depth = prd.depth + 1;
+            float3 origin = sample_common::offset_along_normal(hit_point, facing, rec.scene_size);
             lucent::trace(rec.top_object,
-                          lucent::make_ray(hit_point, reflect(i, n), whitted::kRadianceRay,
-                                           rec.scene_epsilon),
+                          lucent::make_ray(origin, reflect(i, n), whitted::kRadianceRay, 0.0f),
                           refl);
             reflected = refl.result;
         }
