@@ -209,8 +209,10 @@ sanitizer)
 sanitize)
     # compute-sanitizer on every sample and on the GPU test suites: SANITIZE_TOOLS (default
     # memcheck racecheck initcheck), SANITIZE_PARTS (samples suites), SANITIZE_SUITES (default:
-    # every suite in the bundle). Each run's error count goes to $out/sanitize_summary.txt, its
-    # log (first reports) to $out/sanitize/; a run that ends badly counts as failed.
+    # every suite in the bundle), SANITIZE_JOBS runs at once (default 4: the tools' time is
+    # mostly the host's instrumenting of each loaded kernel). Each run's error count goes to
+    # $out/sanitize_summary.txt, its log (first reports) to $out/sanitize/; a run that ends
+    # badly (exit other than 0) counts as failed.
     mkdir -p "$out/sanitize"
     summary="$out/sanitize_summary.txt"
     sanitized() {  # TOOL LABEL COMMAND...
@@ -229,31 +231,36 @@ sanitize)
         printf '%-10s %-44s exit %3d  errors %s  hazards %s  %4d s\n' "$tool" "$label" "$rc" \
             "$errors" "$hazards" $((SECONDS - t0)) | tee -a "$summary"
     }
+    in_background() {  # sanitized ARGS... with at most SANITIZE_JOBS at once
+        while [ "$(jobs -rp | wc -l)" -ge "${SANITIZE_JOBS:-4}" ]; do wait -n; done
+        sanitized "$@" &
+    }
     for tool in ${SANITIZE_TOOLS:-memcheck racecheck initcheck}; do
       for part in ${SANITIZE_PARTS:-samples suites}; do
         if [ "$part" = samples ]; then
           while read -r label args; do
             [ -n "$label" ] || continue
-            sanitized "$tool" "$label" $R $B/bin/lucent $args
+            in_background "$tool" "$label" $R $B/bin/lucent $args
           done <<SAMPLES
-whitted render --sample whitted --backend cuda --size 128x128 --out $work/s.png
-direct render --sample direct --backend cuda --scene cornell --size 128x128 --out $work/s.png
-igi render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=32 --out $work/s.png
-igi-accelerated render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=36 --set downsample=4 --set interleave=3 --set imperfect_visibility=1 --out $work/s.png
-radiosity render --sample radiosity --backend cuda --scene cornell --size 128x128 --out $work/s.png
-pathtracer render --sample pathtracer --backend cuda --scene cornell --size 128x128 --spp 4 --out $work/s.exr --aov albedo,normal,depth,position,instance --denoise
-fog render --sample fog --backend cuda --size 128x96 --out $work/s.png
+whitted render --sample whitted --backend cuda --size 128x128 --out $work/$tool-whitted.png
+direct render --sample direct --backend cuda --scene cornell --size 128x128 --out $work/$tool-direct.png
+igi render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=32 --out $work/$tool-igi.png
+igi-accelerated render --sample igi --backend cuda --scene cornell --size 128x128 --set vpls=36 --set downsample=4 --set interleave=3 --set imperfect_visibility=1 --out $work/$tool-igi-accelerated.png
+radiosity render --sample radiosity --backend cuda --scene cornell --size 128x128 --out $work/$tool-radiosity.png
+pathtracer render --sample pathtracer --backend cuda --scene cornell --size 128x128 --spp 4 --out $work/$tool-pathtracer.exr --aov albedo,normal,depth,position,instance --denoise
+fog render --sample fog --backend cuda --size 128x96 --out $work/$tool-fog.png
 tea bench tea --backend cuda --megabytes 4
 spheres bench spheres --backend cuda --count 2000 --size 128x128 --repeat 1
 curves bench curves --backend cuda --segments 2000 --size 128x128 --repeat 1
 SAMPLES
         else
           for t in ${SANITIZE_SUITES:-$(cd $B/bin && ls *_test | sed 's/_test$//')}; do
-            LUCENT_TEST_BACKEND=cuda LUCENT_SOAK_LAUNCHES=30 sanitized "$tool" "${t}_test" $R $B/bin/${t}_test
+            LUCENT_TEST_BACKEND=cuda LUCENT_SOAK_LAUNCHES=60 in_background "$tool" "${t}_test" $R $B/bin/${t}_test
           done
         fi
       done
     done
+    wait
     ;;
 profile)
     echo "== ncu: the Whitted megakernel at 1024x1024"

@@ -17,6 +17,7 @@
 #include "samples/sample.h"
 #include "samples/settings_error.h"
 #include "scene/image_compare.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -26,7 +27,7 @@ using lucent::samples::RenderSettings;
 RenderSettings cornell(unsigned size, unsigned spp) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.threads = 2;
     settings.spp = spp;
     return settings;
@@ -162,8 +163,7 @@ TEST(Denoise, BringsAFourSppCornellBoxMuchNearerTheReference) {
 /// uniform noise of +-0.15.
 TEST(Denoise, KeepsAHardEdgeBetweenTwoNormalsAndFlattensTheNoise) {
     constexpr unsigned w = 64, h = 32;
-    lucent::ContextOptions options{lucent::BackendKind::kCpu, 2};
-    lucent::Context ctx(options);
+    lucent::Context ctx(lucent_tests::test_context_options());
     auto image = [&] { return ctx.create_buffer<float4>(lucent::BufferType::kInputOutput, w, h); };
     lucent::samples::AtrousDenoiser::Guides guides{image(), image(), image()};
     auto colour = image();

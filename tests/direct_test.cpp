@@ -7,6 +7,7 @@
 
 #include "samples/sample.h"
 #include "scene/image_io.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -16,7 +17,7 @@ using lucent::samples::RenderSettings;
 RenderResult render(const std::string& scene, unsigned size = 96) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.scene = scene;
     settings.sets["area_samples"] = "16";
     return lucent::samples::find_sample("direct").render(settings);

@@ -373,7 +373,7 @@ TEST_F(GltfScenes, RenderHitsTheInstancedMeshWhereItsTransformPutsIt) {
     const std::string path = write("r.glb", glb(gltf(rest), ""));
     lucent::samples::RenderSettings settings;
     settings.width = settings.height = 64;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.threads = 2;
     settings.scene = path;
     const auto r = lucent::samples::find_sample("direct").render(settings);
@@ -408,7 +408,7 @@ TEST_F(GltfScenes, ShadingNormalsOfANonUniformlyScaledInstanceAreByTheInverseTra
             {"translation": [0, 0, 100], "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
     lucent::samples::RenderSettings settings;
     settings.width = settings.height = 64;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.threads = 2;
     settings.scene = write("n.gltf", gltf(rest));
     const auto r = lucent::samples::find_sample("direct").render(settings);

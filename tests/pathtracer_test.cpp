@@ -14,6 +14,7 @@
 
 #include "samples/sample.h"
 #include "samples/pathtracer/pathtracer_bsdf.h"
+#include "tests/test_support.h"
 
 namespace {
 
@@ -26,7 +27,7 @@ RenderResult render(const std::string& scene, unsigned size, unsigned spp,
                     const std::map<std::string, std::string>& sets = {}) {
     RenderSettings settings;
     settings.width = settings.height = size;
-    settings.backend = lucent::BackendKind::kCpu;
+    settings.backend = lucent_tests::test_backend();  // LUCENT_TEST_BACKEND=cuda: the GPU
     settings.threads = 2;
     settings.scene = scene;
     settings.spp = spp;
