@@ -318,7 +318,7 @@ TEST_F(ViewTest, SoakKeepsEveryFrameRightAndMemoryFlatAsTheWindowIsResized) {
     if (!has_xvfb_viewer()) GTEST_SKIP() << "needs xvfb-run and a build with the viewer";
     const CliRun r = run(xvfb_lucent() +
                          "view --sample whitted --backend cpu --threads 1 --size 160x120 "
-                         "--soak 15");
+                         "--soak 10");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("lucent view: soak: passed"), std::string::npos) << r.output;
     const double start = figure_after(r.output, "soak: resident memory start ");
@@ -330,7 +330,10 @@ TEST_F(ViewTest, SoakKeepsEveryFrameRightAndMemoryFlatAsTheWindowIsResized) {
     const double growth = figure_after(r.output, "growth after warm-up ");
     const double bound = figure_after(r.output, "(bound ");
     ASSERT_FALSE(std::isnan(growth)) << r.output;
-    EXPECT_LE(growth, bound) << r.output;
+    // A sanitized build says it leaves the bound out (AddressSanitizer's quarantine keeps
+    // freed blocks); its frames are still checked.
+    if (r.output.find("memory bound not checked") == std::string::npos)
+        EXPECT_LE(growth, bound) << r.output;
     unsigned long long cycles = 0, sizes = 0, window_frames = 0, rendered = 0, compared = 0,
                        home = 0;
     const size_t at = r.output.find(" cycles, ");
@@ -342,12 +345,12 @@ TEST_F(ViewTest, SoakKeepsEveryFrameRightAndMemoryFlatAsTheWindowIsResized) {
                           &cycles, &sizes, &window_frames, &rendered, &compared, &home),
               6)
         << r.output;
-    // Two warm-up cycles and at least one measured; every size of every cycle reached by a
-    // render of that size; the frames of the sizes without the panel compared (five of nine);
-    // and after the first cycle, each return to the start compared with it.
+    // Two warm-up cycles and at least one measured; every size of every cycle (ten)
+    // reached by a render of that size; the frames of the sizes without the panel compared
+    // (seven of ten); and after the first cycle, each return to the start compared with it.
     EXPECT_GE(cycles, 3u);
-    EXPECT_EQ(sizes, cycles * 9);
-    EXPECT_GE(compared, cycles * 5);
+    EXPECT_EQ(sizes, cycles * 10);
+    EXPECT_GE(compared, cycles * 7);
     EXPECT_EQ(home, cycles - 1);
     EXPECT_GE(rendered, sizes);
 }

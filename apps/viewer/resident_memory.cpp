@@ -10,6 +10,12 @@
 
 namespace lucent::viewer {
 
+void return_large_blocks_when_freed() {
+#if defined(__GLIBC__)
+    mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
+}
+
 uint64_t resident_bytes() {
 #if defined(__GLIBC__)
     malloc_trim(0);  // every arena's free pages, not only the top of the main heap

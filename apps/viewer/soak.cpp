@@ -10,10 +10,15 @@
 namespace lucent::viewer {
 namespace {
 
-/// The window sizes of one cycle, before the home (starting) size ends it: a single pixel, odd
-/// sides, thin and tall, and up to 1280x720 (a 1280x1024 Xvfb screen holds all of them).
-constexpr std::pair<int, int> kCycleSizes[] = {{1, 1},     {1280, 720}, {17, 9},   {640, 360},
-                                               {333, 211}, {64, 480},   {1024, 7}, {801, 599}};
+/// The steps of one cycle before the home (starting) size ends it: a single pixel, odd
+/// sides, thin and tall, up to 1280x720 (a 1280x1024 Xvfb screen holds them all), and a
+/// change of the width alone and of the height alone (a texture resized by one side only
+/// would show the wrong pixels).
+constexpr CycleStep kCycle[] = {
+    {1, 1, false, false},   {1280, 720, true, false}, {17, 9, false, false},
+    {640, 9, false, false}, {640, 480, false, false}, {333, 211, true, true},
+    {64, 720, false, false}, {1024, 7, true, false},  {801, 599, false, false},
+};
 
 /// Cycles before the memory baseline: every size, switch, denoiser and option value has been
 /// seen twice, so the allocators' pools, Mesa's compiled shader variants and the scene
@@ -27,10 +32,10 @@ constexpr uint64_t kMeasuredCycles = 1;
 /// Resident memory may grow by this much from the end of the warm-up to the end (both
 /// measured at the end of a cycle: the same window size, camera and options, after
 /// malloc_trim). Measured without a leak: within +-1 MiB over 10 minutes (docs/testing.md).
-/// A leak of what a resize replaces fails it within a cycle: one cycle's sizes hold 1.76
-/// million pixels, so the window's texture or pixel-buffer storage leaked at each resize is
-/// 6.7 MiB a cycle (RGBA8), the render's float4 output 27 MiB, and a leaked session (the
-/// scene, its BVH and compiled programs) more.
+/// A leak of what a resize replaces fails it within a cycle: one cycle's sizes hold 1.84
+/// million pixels besides the home size, so the window's texture or pixel-buffer storage
+/// leaked at each resize is 7 MiB a cycle (RGBA8), the render's float4 output 28 MiB, and a
+/// leaked session (the scene, its BVH and compiled programs) more.
 constexpr uint64_t kMemoryBound = 4u << 20;
 
 /// A step's frame must reach the window within this (a render at 1280x720 on one slow
@@ -66,9 +71,10 @@ Soak::Soak(double seconds, const samples::Sample& sample, const samples::RenderS
       m_denoiser(denoiser),
       m_initial_spp(settings.spp),
       m_start(Clock::now()) {
+    return_large_blocks_when_freed();
     m_rss_start = resident_bytes();
-    m_sizes.assign(std::begin(kCycleSizes), std::end(kCycleSizes));
-    m_sizes.emplace_back(int(settings.width), int(settings.height));
+    m_steps_of_cycle.assign(std::begin(kCycle), std::end(kCycle));
+    m_steps_of_cycle.push_back({int(settings.width), int(settings.height), false, false});
     // Switches flip; integers go to another value of their range. Numbers and text stay
     // (the panel's sliders and fields reach the same set_option).
     for (const samples::SampleOption& o : sample.options) {
@@ -87,7 +93,8 @@ Soak::Soak(double seconds, const samples::Sample& sample, const samples::RenderS
     }
     std::printf("lucent view: soak: %.0f s of %s; a cycle resizes the window to", seconds,
                 sample.name.c_str());
-    for (const auto& [w, h] : m_sizes) std::printf(" %s", size_text(w, h).c_str());
+    for (const CycleStep& step : m_steps_of_cycle)
+        std::printf(" %s", size_text(step.width, step.height).c_str());
     std::printf(" (the last: the start, compared with the first cycle's frame)\n");
     std::printf("lucent view: soak: resident memory start %.2f MiB\n", mib(m_rss_start));
     std::fflush(stdout);
@@ -120,13 +127,13 @@ void Soak::drive(const SoakTargets& targets, const WorkerStatus& status) {
         ++m_sizes_followed;
         if (home_step()) end_cycle();
         if (m_done) return;
-        m_step_in_cycle = (m_step_in_cycle + 1) % m_sizes.size();
+        m_step_in_cycle = (m_step_in_cycle + 1) % m_steps_of_cycle.size();
         start_step(targets, status);
     } else if (std::chrono::duration<double>(Clock::now() - m_step_start).count() >
                kStepTimeoutSeconds) {
-        const auto [w, h] = m_sizes[m_step_in_cycle];
+        const CycleStep& step = m_steps_of_cycle[m_step_in_cycle];
         fail("the window is " + size_text(m_fb_width, m_fb_height) + " (asked for " +
-             size_text(w, h) + ") but no frame of that size reached it in " +
+             size_text(step.width, step.height) + ") but no frame of that size reached it in " +
              std::to_string(int(kStepTimeoutSeconds)) + " s: the render does not follow the window");
     }
 }
@@ -136,8 +143,8 @@ void Soak::start_step(const SoakTargets& targets, const WorkerStatus& status) {
     m_step_window_frames = 0;
     m_step_checked = false;
     m_step_start = Clock::now();
-    const auto [w, h] = m_sizes[m_step_in_cycle];
-    targets.window.set_size(w, h);
+    const CycleStep& step = m_steps_of_cycle[m_step_in_cycle];
+    targets.window.set_size(step.width, step.height);
     scene::CameraController& camera = targets.camera;
     if (home_step()) {
         // Everything as it started: the frame must be the first cycle's again.
@@ -155,10 +162,8 @@ void Soak::start_step(const SoakTargets& targets, const WorkerStatus& status) {
         camera.orbit(0.3f, 0.05f * sign);
         camera.zoom(sign > 0 ? 0.85f : 1 / 0.85f);
         camera.pan(0.02f * sign, -0.01f);
-        // The panel on every other size (its frames checked for their size only), the key
-        // list on every fourth.
-        targets.show_panel = m_step_in_cycle % 2 == 1;
-        targets.show_keys = m_step_in_cycle % 4 == 3;
+        targets.show_panel = step.panel;
+        targets.show_keys = step.keys;
         if (status.denoises) targets.worker.set_denoiser(m_denoiser = next_denoiser(m_denoiser));
         if (!m_options.empty()) {
             OptionFlip& o = m_options[m_steps % m_options.size()];

@@ -19,6 +19,13 @@ namespace lucent::viewer {
 
 class Window;
 
+/// One step of the soak's cycle: a window size, and whether the panel (and the F1 list)
+/// covers part of it, when its frame is checked for its size only.
+struct CycleStep {
+    int width, height;
+    bool panel, keys;
+};
+
 /// What the soak drives: the viewer loop's own window, worker, camera and switches.
 struct SoakTargets {
     Window& window;
@@ -59,14 +66,14 @@ class Soak {
     struct OptionFlip {
         std::string name, initial, other, current;
     };
-    bool home_step() const { return m_step_in_cycle + 1 == m_sizes.size(); }
+    bool home_step() const { return m_step_in_cycle + 1 == m_steps_of_cycle.size(); }
     void start_step(const SoakTargets& targets, const WorkerStatus& status);
     void end_cycle();
     void fail(const std::string& why);
     double elapsed() const;
 
     double m_seconds;
-    std::vector<std::pair<int, int>> m_sizes;  // one cycle; the last is the starting size
+    std::vector<CycleStep> m_steps_of_cycle;  // the last: the starting size (home)
     std::vector<OptionFlip> m_options;
     samples::ViewDenoiser m_initial_denoiser, m_denoiser;
     unsigned m_initial_spp;
