@@ -31,8 +31,9 @@ constexpr uint64_t kMeasuredCycles = 1;
 
 /// Resident memory may grow by this much from the end of the warm-up to the end (both
 /// measured at the end of a cycle: the same window size, camera and options, after
-/// malloc_trim). Measured without a leak: within +-1 MiB over 10 minutes (docs/testing.md).
-/// A leak of what a resize replaces fails it within a cycle: one cycle's sizes hold 1.84
+/// malloc_trim). Measured without a leak (docs/testing.md): +0.01 MiB over 10 minutes of
+/// whitted, +0.03 over 2 minutes of the path tracer, the figures of single cycles within
+/// 0.03 of each other; the bound leaves room for small blocks' allocator slack. A leak of what a resize replaces fails it within a cycle: one cycle's sizes hold 1.84
 /// million pixels besides the home size, so the window's texture or pixel-buffer storage
 /// leaked at each resize is 7 MiB a cycle (RGBA8), the render's float4 output 28 MiB, and a
 /// leaked session (the scene, its BVH and compiled programs) more.
