@@ -75,6 +75,16 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
                     "With --frames: save what the window shows before exiting: " + formats +
                         " (the 8-bit window pixels; the float files hold them linear)")
         ->type_name("FILE");
+    cmd->add_flag("--fit-window", args.fit_window,
+                  "Render at the window's size, following it as it is resized (--size is the "
+                  "first window's)");
+    cmd->add_option("--soak", args.soak,
+                    "Soak test: resize the window through 1x1 to 1280x720 and move the camera, "
+                    "the panel, the denoiser and the options for this long (whole cycles), "
+                    "rendering at the window's size; exit 1 when a frame the window shows is "
+                    "not the rendered one or resident memory grew after the warm-up")
+        ->type_name("SECONDS")
+        ->check(CLI::Range(1.0, 604800.0).description(""));
     cmd->add_flag("--no-panel", args.no_panel, "Hide the control panel (Tab or H toggles it)");
     cmd->add_option("--ui-scale", args.ui_scale,
                     "Scale of the panel's text and controls; 0 = the window's content scale "
@@ -100,7 +110,9 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args) {
         "  lucent view --sample fog --set step=0.1\n"
         "  lucent view --sample radiosity --set show_vpls=1     # then M, I and L toggle\n"
         "  xvfb-run -a -s '-screen 0 1280x1024x24' lucent view --sample whitted "
-        "--size 160x120 --frames 2 --no-panel --screenshot view.png\n");
+        "--size 160x120 --frames 2 --no-panel --screenshot view.png\n"
+        "  xvfb-run -a -s '-screen 0 1280x1024x24' lucent view --sample whitted --backend cpu "
+        "--size 160x120 --soak 600\n");
     return cmd;
 }
 
@@ -132,6 +144,8 @@ int run_view(const ViewArgs& args) {
                              ": needs --frames N (the frame to save)");
         check_image_path("--screenshot", args.screenshot);
     }
+    if (args.soak > 0 && args.frames > 0)
+        throw UsageError("--soak and --frames both end the run: give one of them");
     const samples::ViewDenoiser denoiser = parse_view_denoiser("--denoiser", args.denoiser);
     const samples::Sample& sample = samples::find_sample(args.sample);
     sample.read_options(settings);  // every --set checked before the window opens
@@ -145,6 +159,8 @@ int run_view(const ViewArgs& args) {
     config.ui_scale = args.ui_scale;
     config.denoiser = denoiser;
     config.verbose = args.verbose;
+    config.fit_window = args.fit_window;
+    config.soak = args.soak;
     return viewer::run_viewer(config);
 #else
     throw Error(

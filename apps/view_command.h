@@ -27,6 +27,8 @@ struct ViewArgs {
     std::string denoiser = "off";
     CameraFlags camera_flags;  // --eye --look --up --fov: the camera to start from
     bool verbose = false;
+    bool fit_window = false;  // render at the window's size as it is resized
+    double soak = 0;          // >0: the soak, this many seconds (apps/viewer/soak.h)
 };
 
 /// Adds the `view` subcommand to `app`; its options fill `args`.

@@ -30,7 +30,12 @@ void RenderWorker::take_rows(const LaunchProgress& p) {
             out = b;
     if (!out || p.size.z != 1) return;
     const unsigned w = p.size.x, h = p.size.y;
-    if (p.rows_done <= m_partial_rows) m_partial_rows = 0;  // a new launch
+    // A new launch: its rows start again (one of another size, after a resize, may report
+    // more rows in its first band than the last launch had).
+    if (p.rows_done <= m_partial_rows || w != m_partial_width || h != m_partial_height)
+        m_partial_rows = 0;
+    m_partial_width = w;
+    m_partial_height = h;
     const unsigned first = m_partial_rows;
     m_partial_rows = p.rows_done;
     std::vector<unsigned char> rgba(size_t(w) * (p.rows_done - first) * 4);
@@ -112,6 +117,14 @@ void RenderWorker::set_denoiser(samples::ViewDenoiser denoiser) {
     m_wake.notify_all();
 }
 
+void RenderWorker::set_size(unsigned width, unsigned height) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_pending_size.emplace(width, height);
+    }
+    m_wake.notify_all();
+}
+
 std::optional<ShownFrame> RenderWorker::frame_after(uint64_t after) {
     std::lock_guard lock(m_mutex);
     if (m_latest.number <= after) return std::nullopt;
@@ -129,7 +142,8 @@ uint64_t RenderWorker::frames_done() {
 }
 
 bool RenderWorker::has_work() const {
-    if (m_pending_camera || !m_pending_sets.empty() || m_pending_reset || m_pending_denoiser)
+    if (m_pending_camera || !m_pending_sets.empty() || m_pending_reset || m_pending_denoiser ||
+        m_pending_size)
         return true;
     if (m_frame_limit > 0) return m_latest.number < m_frame_limit && m_status.error.empty();
     return !m_converged;
@@ -170,12 +184,14 @@ void RenderWorker::run() {
         std::map<std::string, std::string> new_sets;
         bool reset = false;
         std::optional<samples::ViewDenoiser> new_denoiser;
+        std::optional<std::pair<unsigned, unsigned>> new_size;
         {
             std::unique_lock lock(m_mutex);
             m_wake.wait(lock, [this] { return m_stop || has_work(); });
             if (m_stop) return;
             new_camera.swap(m_pending_camera);
             new_sets.swap(m_pending_sets);
+            new_size.swap(m_pending_size);
             reset = m_pending_reset;
             m_pending_reset = false;
             if (m_pending_denoiser) new_denoiser = m_status.denoiser;
@@ -191,6 +207,13 @@ void RenderWorker::run() {
                 m_session->set_camera(camera);
             }
             bool rebuild = false;
+            if (new_size && (new_size->first != m_settings.width ||
+                             new_size->second != m_settings.height)) {
+                // A session's buffers have its size: open one at the new size.
+                m_settings.width = new_size->first;
+                m_settings.height = new_size->second;
+                rebuild = true;
+            }
             for (const auto& [name, value] : new_sets) {
                 samples::RenderSettings changed = m_settings;
                 changed.sets[name] = value;

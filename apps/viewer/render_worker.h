@@ -69,6 +69,9 @@ class RenderWorker {
     void set_spp_limit(unsigned spp);
     /// The denoiser of the following frames (sessions that have one: status().denoises).
     void set_denoiser(samples::ViewDenoiser denoiser);
+    /// Renders the following frames at this size (the window's, with --fit-window): the
+    /// session is opened again at it, where the camera is.
+    void set_size(unsigned width, unsigned height);
 
     /// The newest finished frame when it is newer than `after`.
     std::optional<ShownFrame> frame_after(uint64_t after);
@@ -97,11 +100,13 @@ class RenderWorker {
     std::map<std::string, std::string> m_pending_sets;
     bool m_pending_reset = false;
     bool m_pending_denoiser = false;
+    std::optional<std::pair<unsigned, unsigned>> m_pending_size;
     bool m_converged = false;  // a still image is up to date, or the spp limit was reached
     ShownFrame m_latest;
     PartialFrame m_partial;
     uint64_t m_partial_version = 0;
     unsigned m_partial_rows = 0;  // rows of the current launch already copied
+    unsigned m_partial_width = 0, m_partial_height = 0;  // the current launch's size
     WorkerStatus m_status;
     std::thread m_thread;  // last: starts after everything above exists
 };

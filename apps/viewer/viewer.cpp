@@ -21,6 +21,7 @@
 #include "present/image_view.h"
 #include "render_worker.h"
 #include "screenshot.h"
+#include "soak.h"
 #include "window.h"
 
 namespace lucent::viewer {
@@ -84,8 +85,12 @@ class RateMeter {
 int run_viewer(const ViewerConfig& config) {
     const samples::Sample& sample = *config.sample;
     const bool headless_check = config.frames > 0;
+    // Its starting memory figure before the window's.
+    std::optional<Soak> soak;
+    if (config.soak > 0) soak.emplace(config.soak, sample, config.settings, config.denoiser);
+    const bool fit_window = config.fit_window || soak;
     Window window("lucent view: " + sample.name, int(config.settings.width),
-                  int(config.settings.height), /*exact=*/headless_check);
+                  int(config.settings.height), /*exact=*/headless_check || soak);
     Input input(window.handle());
     window.start_ui(config.ui_scale);
     ImageView view;
@@ -108,13 +113,18 @@ int run_viewer(const ViewerConfig& config) {
     std::vector<double> ui_frame_ms;  // intervals between window frames, for --verbose
     int exit_code = 0;
     int last_fb_width = 0, last_fb_height = 0;
+    // The size the render was last asked for (--fit-window): the window's at the start.
+    int render_width = int(config.settings.width), render_height = int(config.settings.height);
+    bool texture_holds_shown = false;  // no partial frame drawn over the shown one
 
     while (!window.should_close()) {
         // Up to 60 window frames/s while idle; input wakes it at once.
         window.wait_events(1.0 / 60.0);
         const Clock::time_point now = Clock::now();
         const float dt = float(seconds_between(last, now));
-        if (ui_frames > 0) ui_frame_ms.push_back(1000.0 * dt);
+        // Only for --verbose's figures at exit: kept for every frame, the list grew by 8 bytes a
+        // frame for as long as the window was open (the soak found it: 0.26 MiB in 10 minutes).
+        if (config.verbose && ui_frames > 0) ui_frame_ms.push_back(1000.0 * dt);
         last = now;
         ui_rate.tick(now);
         ++ui_frames;
@@ -207,6 +217,8 @@ int run_viewer(const ViewerConfig& config) {
             panel.message = "copied the camera as flags";
         }
         copy_flags = false;
+        if (soak && camera)
+            soak->drive(SoakTargets{window, worker, *camera, show_panel, show_keys}, status);
 
         if (std::optional<ShownFrame> frame = worker.frame_after(shown.number)) {
             shown = std::move(*frame);
@@ -215,16 +227,18 @@ int run_viewer(const ViewerConfig& config) {
             panel.present_ms = 1000.0 * seconds_between(before, Clock::now());
             panel.presentation = view.presentation();
             render_rate.tick(now);
+            texture_holds_shown = true;
         } else if (seconds_between(last_partial, now) >= kPartialInterval) {
             // A slow frame in progress (the CPU): its finished rows over the last frame, at
             // most 10 times a second (a 2048x2048 upload costs the window a frame).
             if (auto partial = worker.partial_after(shown.number, partial_version)) {
                 view.upload(partial->rgba.data(), partial->width, partial->height);
+                texture_holds_shown = false;
                 ++partial_uploads;
                 last_partial = now;
             }
         }
-        if (headless_check && !status.error.empty() && !status.busy) {
+        if ((headless_check || soak) && !status.error.empty() && !status.busy) {
             std::fprintf(stderr, "lucent view: error: %s\n", status.error.c_str());
             exit_code = 1;
             break;
@@ -234,6 +248,13 @@ int run_viewer(const ViewerConfig& config) {
         window.framebuffer_size(fb_width, fb_height);
         last_fb_width = fb_width;
         last_fb_height = fb_height;
+        if (fit_window && fb_width > 0 && fb_height > 0 &&
+            (fb_width != render_width || fb_height != render_height)) {
+            // Resizing the window resizes the render (a minimised one keeps its last).
+            render_width = fb_width;
+            render_height = fb_height;
+            worker.set_size(unsigned(fb_width), unsigned(fb_height));
+        }
         glViewport(0, 0, fb_width, fb_height);
         glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
@@ -253,6 +274,10 @@ int run_viewer(const ViewerConfig& config) {
         if (show_keys) draw_key_list();
         window.end_ui_frame();
 
+        if (soak) {
+            soak->check(shown, texture_holds_shown, fb_width, fb_height, show_panel || show_keys);
+            if (soak->done()) break;
+        }
         if (headless_check && shown.number >= config.frames) {
             // What the window shows now, before the swap: the back buffer just drawn.
             if (!config.screenshot.empty())
@@ -281,6 +306,7 @@ int run_viewer(const ViewerConfig& config) {
         if (camera)
             std::printf("lucent view: camera %s\n", cli::camera_flags(camera->camera()).c_str());
     }
+    if (soak && exit_code == 0) exit_code = soak->finish(ui_frames, shown.number);
     if (exit_code == 0 && !config.screenshot.empty())
         std::printf("wrote %s\n", config.screenshot.c_str());
     return exit_code;

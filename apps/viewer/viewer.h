@@ -17,10 +17,12 @@ struct ViewerConfig {
     float ui_scale = 0;  // 0: the window's content scale
     samples::ViewDenoiser denoiser = samples::ViewDenoiser::kOff;
     bool verbose = false;
+    bool fit_window = false;  // render at the window's size, following its resizes
+    double soak = 0;          // >0: drive the window this many seconds, checking (soak.h)
 };
 
-/// Opens the window and runs until it is closed (or `frames` were shown); returns the exit
-/// code. Throws lucent::Error when no window can be opened.
+/// Opens the window and runs until it is closed (or `frames` were shown, or the soak ended);
+/// returns the exit code. Throws lucent::Error when no window can be opened.
 int run_viewer(const ViewerConfig& config);
 
 }  // namespace lucent::viewer

@@ -108,4 +108,8 @@ void Window::framebuffer_size(int& width, int& height) const {
     glfwGetFramebufferSize(m_window, &width, &height);
 }
 
+void Window::set_size(int width, int height) {
+    glfwSetWindowSize(m_window, width, height);
+}
+
 }  // namespace lucent::viewer

@@ -31,6 +31,8 @@ class Window {
     void end_ui_frame();  // draws the ImGui lists
     void swap();
     void framebuffer_size(int& width, int& height) const;
+    /// Resizes the window's drawable area, as a user dragging its border would (the soak).
+    void set_size(int width, int height);
 
   private:
     GLFWwindow* m_window = nullptr;
