@@ -105,6 +105,8 @@ struct FrameResult {
 enum class ViewDenoiser { kOff, kAtrous, kSvgf };
 /// "off", "a-trous", "svgf": what the panel and the messages call them.
 const char* view_denoiser_name(ViewDenoiser denoiser);
+/// The switch's next position: off, a-trous, svgf, then off again.
+ViewDenoiser next_view_denoiser(ViewDenoiser denoiser);
 
 /// A sample's scene built once and rendered many times from a moving camera (`lucent view`).
 /// Not thread-safe: one thread opens it and calls everything.

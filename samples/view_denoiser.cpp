@@ -16,6 +16,12 @@ const char* view_denoiser_name(ViewDenoiser denoiser) {
     }
 }
 
+ViewDenoiser next_view_denoiser(ViewDenoiser denoiser) {
+    return denoiser == ViewDenoiser::kOff      ? ViewDenoiser::kAtrous
+           : denoiser == ViewDenoiser::kAtrous ? ViewDenoiser::kSvgf
+                                               : ViewDenoiser::kOff;
+}
+
 namespace {
 
 AtrousDenoiser::Guides guides_of(const GBufferPass& gbuffer) {

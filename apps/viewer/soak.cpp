@@ -15,9 +15,9 @@ namespace {
 /// change of the width alone and of the height alone (a texture resized by one side only
 /// would show the wrong pixels).
 constexpr CycleStep kCycle[] = {
-    {1, 1, false, false},   {1280, 720, true, false}, {17, 9, false, false},
-    {640, 9, false, false}, {640, 480, false, false}, {333, 211, true, true},
-    {64, 720, false, false}, {1024, 7, true, false},  {801, 599, false, false},
+    {1, 1, false, false},    {1280, 720, true, false}, {17, 9, false, false},
+    {640, 9, false, false},  {640, 480, false, false}, {333, 211, true, true},
+    {64, 720, false, false}, {1024, 7, true, false},   {801, 599, false, false},
 };
 
 /// Cycles before the memory baseline: every size, switch, denoiser and option value has been
@@ -33,10 +33,11 @@ constexpr uint64_t kMeasuredCycles = 1;
 /// measured at the end of a cycle: the same window size, camera and options, after
 /// malloc_trim). Measured without a leak (docs/testing.md): +0.01 MiB over 10 minutes of
 /// whitted, +0.03 over 2 minutes of the path tracer, the figures of single cycles within
-/// 0.03 of each other; the bound leaves room for small blocks' allocator slack. A leak of what a resize replaces fails it within a cycle: one cycle's sizes hold 1.84
-/// million pixels besides the home size, so the window's texture or pixel-buffer storage
-/// leaked at each resize is 7 MiB a cycle (RGBA8), the render's float4 output 28 MiB, and a
-/// leaked session (the scene, its BVH and compiled programs) more.
+/// 0.03 of each other; the bound leaves room for small blocks' allocator slack. A leak of what a
+/// resize replaces fails it within a cycle: one cycle's sizes hold 1.84 million pixels besides the
+/// home size, so the window's texture or pixel-buffer storage leaked at each resize is 7 MiB a
+/// cycle (RGBA8), the render's float4 output 28 MiB, and a leaked session (the scene, its BVH and
+/// compiled programs) more.
 constexpr uint64_t kMemoryBound = 4u << 20;
 
 /// A step's frame must reach the window within this (a render at 1280x720 on one slow
@@ -50,13 +51,6 @@ constexpr float kDragRadians = 0.02f;
 
 double mib(uint64_t bytes) {
     return double(bytes) / double(1u << 20);
-}
-
-samples::ViewDenoiser next_denoiser(samples::ViewDenoiser d) {
-    using samples::ViewDenoiser;
-    return d == ViewDenoiser::kOff      ? ViewDenoiser::kAtrous
-           : d == ViewDenoiser::kAtrous ? ViewDenoiser::kSvgf
-                                        : ViewDenoiser::kOff;
 }
 
 std::string size_text(int w, int h) {
@@ -135,7 +129,8 @@ void Soak::drive(const SoakTargets& targets, const WorkerStatus& status) {
         const CycleStep& step = m_steps_of_cycle[m_step_in_cycle];
         fail("the window is " + size_text(m_fb_width, m_fb_height) + " (asked for " +
              size_text(step.width, step.height) + ") but no frame of that size reached it in " +
-             std::to_string(int(kStepTimeoutSeconds)) + " s: the render does not follow the window");
+             std::to_string(int(kStepTimeoutSeconds)) +
+             " s: the render does not follow the window");
     }
 }
 
@@ -165,7 +160,8 @@ void Soak::start_step(const SoakTargets& targets, const WorkerStatus& status) {
         camera.pan(0.02f * sign, -0.01f);
         targets.show_panel = step.panel;
         targets.show_keys = step.keys;
-        if (status.denoises) targets.worker.set_denoiser(m_denoiser = next_denoiser(m_denoiser));
+        if (status.denoises)
+            targets.worker.set_denoiser(m_denoiser = samples::next_view_denoiser(m_denoiser));
         if (!m_options.empty()) {
             OptionFlip& o = m_options[m_steps % m_options.size()];
             o.current = o.current == o.initial ? o.other : o.initial;
@@ -188,8 +184,7 @@ void Soak::check(const ShownFrame& shown, bool texture_holds_shown, int fb_width
     ++m_fb_stable_frames;
     // The render follows the window: until a frame of its size arrives, the last one is
     // shown scaled.
-    if (shown.number == 0 || int(shown.width) != fb_width || int(shown.height) != fb_height)
-        return;
+    if (shown.number == 0 || int(shown.width) != fb_width || int(shown.height) != fb_height) return;
     // Mesa gives the drawable its new size at the swap after the resize.
     if (m_fb_stable_frames < 2) return;
     if (overlay_shown) {
@@ -231,8 +226,9 @@ void Soak::end_cycle() {
     const double figure_interval = std::max(1.0, m_seconds / 10);
     if (m_cycles == kWarmUpCycles) {
         m_rss_warm = m_rss_peak = rss;
-        std::printf("lucent view: soak: resident memory after warm-up (cycle %llu, %.1f s) %.2f MiB\n",
-                    (unsigned long long)m_cycles, t, mib(rss));
+        std::printf(
+            "lucent view: soak: resident memory after warm-up (cycle %llu, %.1f s) %.2f MiB\n",
+            (unsigned long long)m_cycles, t, mib(rss));
         m_next_figure = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(figure_interval));
     } else if (m_cycles > kWarmUpCycles) {
@@ -256,10 +252,11 @@ int Soak::finish(uint64_t window_frames, uint64_t frames_rendered) {
         fail("the window was closed after " + std::to_string(int(t)) + " s, before the soak ended");
     if (m_rss_end > 0) {
         const double growth = mib(m_rss_end) - mib(m_rss_warm);
-        std::printf("lucent view: soak: resident memory end (cycle %llu, %.1f s) %.2f MiB, peak "
-                    "after warm-up %.2f MiB, growth after warm-up %+.2f MiB (bound %.1f MiB)\n",
-                    (unsigned long long)m_cycles, t, mib(m_rss_end), mib(m_rss_peak), growth,
-                    mib(kMemoryBound));
+        std::printf(
+            "lucent view: soak: resident memory end (cycle %llu, %.1f s) %.2f MiB, peak "
+            "after warm-up %.2f MiB, growth after warm-up %+.2f MiB (bound %.1f MiB)\n",
+            (unsigned long long)m_cycles, t, mib(m_rss_end), mib(m_rss_peak), growth,
+            mib(kMemoryBound));
 #if defined(__SANITIZE_ADDRESS__)
         // AddressSanitizer's quarantine holds freed blocks (up to 256 MB) to catch uses after
         // free: resident memory grows with every free, so it says nothing about leaks here.
@@ -271,12 +268,13 @@ int Soak::finish(uint64_t window_frames, uint64_t frames_rendered) {
                  std::to_string(kMemoryBound >> 20) + " MiB: something leaks");
 #endif
     }
-    std::printf("lucent view: soak: %llu cycles, %llu window sizes followed, %llu window frames, "
-                "%llu frames rendered, %llu compared with the window, %llu back at the start "
-                "equal to the first cycle's\n",
-                (unsigned long long)m_cycles, (unsigned long long)m_sizes_followed,
-                (unsigned long long)window_frames, (unsigned long long)frames_rendered,
-                (unsigned long long)m_frames_compared, (unsigned long long)m_home_compared);
+    std::printf(
+        "lucent view: soak: %llu cycles, %llu window sizes followed, %llu window frames, "
+        "%llu frames rendered, %llu compared with the window, %llu back at the start "
+        "equal to the first cycle's\n",
+        (unsigned long long)m_cycles, (unsigned long long)m_sizes_followed,
+        (unsigned long long)window_frames, (unsigned long long)frames_rendered,
+        (unsigned long long)m_frames_compared, (unsigned long long)m_home_compared);
     if (!m_failure.empty()) {
         std::fflush(stdout);
         std::fprintf(stderr, "lucent view: soak: FAILED: %s\n", m_failure.c_str());

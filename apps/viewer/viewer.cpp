@@ -47,13 +47,6 @@ const char* toggled_option(KeyAction action) {
     }
 }
 
-samples::ViewDenoiser next_denoiser(samples::ViewDenoiser d) {
-    using samples::ViewDenoiser;
-    return d == ViewDenoiser::kOff      ? ViewDenoiser::kAtrous
-           : d == ViewDenoiser::kAtrous ? ViewDenoiser::kSvgf
-                                        : ViewDenoiser::kOff;
-}
-
 /// A file name in the working directory that does not exist yet.
 std::string next_screenshot_name(const std::string& sample) {
     for (int i = 1;; ++i) {
@@ -166,7 +159,7 @@ int run_viewer(const ViewerConfig& config) {
                         panel.message =
                             "the " + sample.name + " sample has no denoiser (pathtracer has)";
                     } else {
-                        const auto next = next_denoiser(status.denoiser);
+                        const auto next = samples::next_view_denoiser(status.denoiser);
                         worker.set_denoiser(next);
                         panel.message =
                             std::string("denoiser ") + samples::view_denoiser_name(next);

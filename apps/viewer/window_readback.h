@@ -13,6 +13,7 @@ std::vector<unsigned char> read_window_rgba(int width, int height);
 
 /// How many pixels of two RGBA8 images of the same size differ in red, green or blue (alpha
 /// is not compared: the window's is always opaque).
-size_t count_differing_rgb(const std::vector<unsigned char>& a, const std::vector<unsigned char>& b);
+size_t count_differing_rgb(const std::vector<unsigned char>& a,
+                           const std::vector<unsigned char>& b);
 
 }  // namespace lucent::viewer

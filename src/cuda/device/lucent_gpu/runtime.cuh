@@ -229,7 +229,14 @@ LUCENT_HD void raise_exception(int code, unsigned detail) {
 }
 LUCENT_HD void* out_of_bounds_scratch() {
     unsigned thread = blockIdx.x * blockDim.x + threadIdx.x;
-    return gpu::params.scratch + size_t(thread) * gpu::kGpuScratchBytes;
+    unsigned char* bytes = gpu::params.scratch + size_t(thread) * gpu::kGpuScratchBytes;
+    auto* slot = reinterpret_cast<uint4*>(bytes);
+    // After the exception is raised the program runs on until it returns: an out-of-bounds
+    // read gives zeros, never memory nobody wrote (compute-sanitizer initcheck) or what an
+    // earlier out-of-bounds write of this thread left there.
+    for (unsigned i = 0; i < gpu::kGpuScratchBytes / sizeof(uint4); ++i)
+        slot[i] = make_uint4(0, 0, 0, 0);
+    return slot;
 }
 LUCENT_HD bool print_enabled_here() {
 #if LUCENT_GPU_PRINT
