@@ -223,8 +223,7 @@ class SoakScene {
 
     /// Moves the context onto the next device list of the cycle.
     void move_devices() {
-        const auto cycle = device_cycle();
-        const std::vector<DeviceSpec>& next = cycle[m_moves++ % cycle.size()];
+        const std::vector<DeviceSpec>& next = m_cycle[m_moves++ % m_cycle.size()];
         m_ctx.set_devices(next);
         m_device_list = device_list_name(next);
     }
@@ -265,6 +264,7 @@ class SoakScene {
     std::vector<std::shared_ptr<Material>> m_materials;
     std::vector<std::shared_ptr<GeometryInstance>> m_instances;
     std::shared_ptr<Buffer> m_image;
+    const std::vector<std::vector<DeviceSpec>> m_cycle = device_cycle();
     unsigned m_moves = 0;
     std::string m_device_list = "the constructed backend";
 };

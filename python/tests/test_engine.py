@@ -167,9 +167,9 @@ def test_a_launch_of_the_query_module_matches_triangle_mesh(rng):
     assert not ctx.launch(0, len(o)).recompiled
 
 
-def test_the_first_program_from_python():
-    """docs/programming-model.md's first program, its host side written in Python."""
-    ctx = lucent.Context(backend=BACKEND)
+def first_program_scene(ctx, width, height):
+    """docs/programming-model.md's first program, its host side written in Python: one
+    triangle before the camera; returns the output image buffer (width x height float3)."""
     camera = ctx.create_program("camera", module="first_program")
     ctx.set_ray_type(0, "radiance", payload="first_program::Payload")
     ctx.set_ray_generation_program(0, camera)
@@ -186,10 +186,17 @@ def test_the_first_program_from_python():
     instance.add_material(material)
     scene = ctx.create_geometry_group()
     scene.add_child(instance)
-    image = ctx.create_buffer("output", "float3", (64, 48))
+    image = ctx.create_buffer("output", "float3", (width, height))
     ctx["eye"] = (0, 0, 0)
     ctx["scene"] = scene
     ctx["image"] = image
+    return image
+
+
+def test_the_first_program_from_python():
+    """docs/programming-model.md's first program, its host side written in Python."""
+    ctx = lucent.Context(backend=BACKEND)
+    image = first_program_scene(ctx, 64, 48)
     ctx.launch(0, 64, 48)
     pixels = image.numpy()
     assert pixels.shape == (48, 64, 3)
@@ -204,26 +211,7 @@ def test_moving_a_context_to_other_devices_keeps_its_scene_and_results():
     ctx = lucent.Context(backend=BACKEND)
     start = ctx.devices
     assert start == (["cuda:0"] if BACKEND == "cuda" else ["cpu"])
-    camera = ctx.create_program("camera", module="first_program")
-    ctx.set_ray_type(0, "radiance", payload="first_program::Payload")
-    ctx.set_ray_generation_program(0, camera)
-    ctx.set_miss_program(0, ctx.create_program("background"))
-    vertices = ctx.create_buffer("input", "float3", 3)
-    vertices.upload(np.array([[-1, -1, -2], [1, -1, -2.5], [0, 1, -1.5]], np.float32))
-    triangle = ctx.create_geometry_triangles()
-    triangle.vertices = vertices
-    material = ctx.create_material()
-    material.set_closest_hit(0, ctx.create_program("shade"))
-    material["color"] = (1, 0.5, 0.2)
-    instance = ctx.create_geometry_instance()
-    instance.geometry = triangle
-    instance.add_material(material)
-    scene = ctx.create_geometry_group()
-    scene.add_child(instance)
-    image = ctx.create_buffer("output", "float3", (32, 24))
-    ctx["eye"] = (0, 0, 0)
-    ctx["scene"] = scene
-    ctx["image"] = image
+    image = first_program_scene(ctx, 32, 24)
     ctx.launch(0, 32, 24)
     reference = image.numpy().copy()  # read on the device that launched
     assert (reference[..., 0] > 0.2).sum() > 50

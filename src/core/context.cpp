@@ -24,17 +24,20 @@ struct Context::Impl {
     LaunchReport last;
     std::string notice;  // why kAuto chose the CPU
     ContextOptions options;  // as constructed; devices as last set (set_devices)
-    int jit_check_sm = 0;
-    unsigned device_count = 1;
     unsigned seed = 0;
     std::vector<uint4> device_keys;  // per device slot, from the seed (set_random_seed)
     std::function<void(const LaunchProgress&)> on_progress;
     unsigned next_id = 0;
 
+    /// One device unless a list is set.
+    unsigned device_count() const {
+        return options.devices.empty() ? 1u : unsigned(options.devices.size());
+    }
+
     /// Sebald's Fig. 4: one key per device slot from the slot and the seed.
     void derive_device_keys() {
         device_keys.clear();
-        for (unsigned slot = 0; slot < device_count; ++slot)
+        for (unsigned slot = 0; slot < device_count(); ++slot)
             device_keys.push_back(generate_tea_key(zafar_tea_key(), make_uint2(slot, seed)));
     }
 
@@ -52,9 +55,7 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
-}  // namespace
 
-namespace {
 void check_device_count(const std::vector<DeviceSpec>& devices, const char* call) {
     if (devices.size() > kMaxDevices)
         throw Error(std::string(call) + ": " + std::to_string(devices.size()) +
@@ -68,7 +69,6 @@ void Context::Impl::use_backend(std::unique_ptr<core::Backend> next,
     core::Backend* raw = backend.get();
     shared->fetch_from_device = [raw](const Buffer& b) { raw->fetch(b); };
     options.devices = devices;
-    device_count = devices.empty() ? 1 : unsigned(devices.size());
     derive_device_keys();
 }
 
@@ -78,12 +78,8 @@ Context::Context(ContextOptions options) : m_impl(std::make_unique<Impl>()) {
     check_device_count(options.devices, "Context");
     m_impl->use_backend(core::make_backend(options, m_impl->notice), options.devices);
     m_impl->options = std::move(options);
-    if (m_impl->options.jit_check_sm) {
-        if (!core::can_jit_check())
-            throw Error(
-                "Context: the JIT check needs a build with the CUDA toolkit; drop the option");
-        m_impl->jit_check_sm = options.jit_check_sm;
-    }
+    if (m_impl->options.jit_check_sm && !core::can_jit_check())
+        throw Error("Context: the JIT check needs a build with the CUDA toolkit; drop the option");
 }
 
 const std::string& Context::backend_notice() const {
@@ -100,7 +96,7 @@ std::string Context::backend_name() const {
 }
 
 unsigned Context::device_count() const {
-    return m_impl->device_count;
+    return m_impl->device_count();
 }
 
 std::vector<DeviceSpec> Context::devices() const {
@@ -463,7 +459,8 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
         report.accel_ms = compiler.accel_ms();
         report.compile_ms = ms_since(t0) - report.accel_ms;
         report.recompiled = true;
-        if (m_impl->jit_check_sm) core::jit_check(*m_impl->compiled, m_impl->jit_check_sm, report);
+        if (const int sm = m_impl->options.jit_check_sm)
+            core::jit_check(*m_impl->compiled, sm, report);
     }
     const core::CompiledScene& scene = *m_impl->compiled;
     check_ray_generation(scene, entry);
