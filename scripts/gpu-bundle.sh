@@ -18,8 +18,10 @@ if [ -z "${LUCENT_BUNDLE_BUILD:-}" ]; then
         -DCMAKE_DISABLE_FIND_PACKAGE_embree=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON > /dev/null
 fi
 # Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
-suites="programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf spheres curves textures igi_dielectric scale soak gltf whitted backend igi radiosity direct emitters_textures
-        fog pathtracer multi_device gpu_bvh_builder display modules"
+# LUCENT_BUNDLE_SUITES="igi whitted" bundles those alone, LUCENT_BUNDLE_SUITES= none, and
+# LUCENT_BUNDLE_EXAMPLES=0 leaves the examples out: a quicker bundle for one measurement.
+suites=${LUCENT_BUNDLE_SUITES-"programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf spheres curves textures igi_dielectric scale soak gltf whitted backend igi radiosity direct emitters_textures
+        fog pathtracer multi_device gpu_bvh_builder display modules"}
 targets="lucent_cli lucent_embed_module"
 python=0  # the Python module: its objects travel, and gpu-check.sh's `python` step links it there
 if grep -q '^LUCENT_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then python=1; targets="$targets lucent_python"; fi
@@ -33,6 +35,7 @@ cp "$build/lucent" "$out/bin/"
 prefix="$PWD/$build/prefix"
 cmake --install "$build" --prefix "$prefix" > /dev/null
 for dir in examples/*/; do
+  [ "${LUCENT_BUNDLE_EXAMPLES:-1}" = 0 ] && break
   [ -f "$dir/CMakeLists.txt" ] || continue  # examples/python: scripts, run by gpu-check.sh python
   name=$(basename "$dir")
   cmake -S "$dir" -B "$build/examples/$name" -G Ninja -DCMAKE_BUILD_TYPE=Release \
