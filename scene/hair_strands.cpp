@@ -11,8 +11,8 @@ HairStrands make_hair_strands(const HairStyle& style) {
     const unsigned points_per_segment = curve_control_points(style.type);
     // Consecutive segments of a strand share all but one control point.
     const unsigned extra = points_per_segment - 1;
-    const unsigned strands = std::max(
-        1u, (style.segments + kHairSegmentsPerStrand - 1) / kHairSegmentsPerStrand);
+    const unsigned strands =
+        std::max(1u, (style.segments + kHairSegmentsPerStrand - 1) / kHairSegmentsPerStrand);
     std::mt19937 rng(style.seed);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f), jitter(-1.0f, 1.0f);
     const float step = 0.07f;
@@ -46,8 +46,7 @@ HairStrands make_hair_strands(const HairStyle& style) {
 }
 
 const std::vector<std::string>& curve_type_names() {
-    static const std::vector<std::string> names = {"linear", "quadratic", "cubic",
-                                                   "catmull-rom"};
+    static const std::vector<std::string> names = {"linear", "quadratic", "cubic", "catmull-rom"};
     return names;
 }
 

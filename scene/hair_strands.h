@@ -16,9 +16,9 @@ namespace lucent::scene {
 struct HairStyle {
     unsigned segments = 100000;  // curve segments in all (the last strand may be cut short)
     CurveType type = kCurveCubicBSpline;
-    float3 center{0, 0, 0};      // of the head
-    float head_radius = 1;       // the strands scale with it: lengths, radii, root height
-    unsigned seed = 7;           // of the roots and the noise
+    float3 center{0, 0, 0};  // of the head
+    float head_radius = 1;   // the strands scale with it: lengths, radii, root height
+    unsigned seed = 7;       // of the roots and the noise
 };
 
 /// The curves' buffers: control points, a radius per point, each segment's first point.

@@ -42,8 +42,8 @@ struct HairOptions {
             for (const std::string& n : scene::curve_type_names())
                 names += (names.empty() ? "" : ", ") + n;
             throw SettingsError("--set curve_type=" + type + ": no such curve type" +
-                                did_you_mean(type, scene::curve_type_names()) +
-                                "; the types are " + names);
+                                did_you_mean(type, scene::curve_type_names()) + "; the types are " +
+                                names);
         }
         shape.type = *named;
         if (!settings.scene.empty())

@@ -32,8 +32,8 @@ struct LinkedSurfaceRecord {
     lucent::Handle top_object;
     lucent::BufferView<const unsigned> light_masks;
 };
-LUCENT_RECORD(LinkedSurfaceRecord, Kd, Ks, Ke, diffuse_map, specular_map, alpha, ior,
-              area_lights, area_light_cdf, point_lights, scene_size, top_object, light_masks)
+LUCENT_RECORD(LinkedSurfaceRecord, Kd, Ks, Ke, diffuse_map, specular_map, alpha, ior, area_lights,
+              area_light_cdf, point_lights, scene_size, top_object, light_masks)
 
 /// The shadow test of pathtracer::next_event with light linking: light `light`'s shadow
 /// ray sees only the instances whose mask shares a bit with the light's.
@@ -52,10 +52,10 @@ struct LinkedShadows {
 template <unsigned Kind>
 LUCENT_HD inline void shade_linked(const LinkedSurfaceRecord& r, pathtracer::PathPayload& prd,
                                    float3 normal, float2 uv) {
-    const pathtracer::SurfaceRecord surface{
-        r.Kd,          r.Ks,           r.Ke,          r.diffuse_map,   r.specular_map,
-        r.alpha,       r.ior,          r.area_lights, r.area_light_cdf, r.point_lights,
-        r.scene_size, r.top_object};
+    const pathtracer::SurfaceRecord surface{r.Kd,           r.Ks,           r.Ke,
+                                            r.diffuse_map,  r.specular_map, r.alpha,
+                                            r.ior,          r.area_lights,  r.area_light_cdf,
+                                            r.point_lights, r.scene_size,   r.top_object};
     pathtracer::shade<Kind>(surface, prd, sample_common::MeshNormalUv{normal, uv},
                             LinkedShadows{r.light_masks});
 }

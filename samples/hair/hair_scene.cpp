@@ -20,9 +20,9 @@ scene::Mesh lat_long_sphere(float3 center, float radius, unsigned rings, unsigne
         const float theta = 3.14159265f * float(i) / float(rings);  // from the top
         for (unsigned j = 0; j <= sectors; ++j) {
             const float phi = 6.2831853f * float(j) / float(sectors);
-            mesh.positions.push_back(center + radius * make_float3(std::sin(theta) * std::cos(phi),
-                                                                   std::cos(theta),
-                                                                   std::sin(theta) * std::sin(phi)));
+            mesh.positions.push_back(
+                center + radius * make_float3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                              std::sin(theta) * std::sin(phi)));
             mesh.uvs.push_back(make_float2(float(j) / float(sectors), float(i) / float(rings)));
         }
     }
@@ -181,11 +181,11 @@ HairGraph build_hair_graph(Context& ctx, const HairSceneData& data, bool light_l
         radii.push_back(sphere.radius);
         sphere_materials.push_back(unsigned(sphere_materials.size()));
         const auto kind = sphere.material.kind;
-        auto hit = ctx.create_program(
-            kind == scene::MaterialKind::kMetal ? LUCENT_PROGRAM(hair_sample::linked_sphere_metal)
-            : kind == scene::MaterialKind::kDielectric
-                ? LUCENT_PROGRAM(hair_sample::linked_sphere_glass)
-                : LUCENT_PROGRAM(hair_sample::linked_sphere_coated));
+        auto hit = ctx.create_program(kind == scene::MaterialKind::kMetal
+                                          ? LUCENT_PROGRAM(hair_sample::linked_sphere_metal)
+                                      : kind == scene::MaterialKind::kDielectric
+                                          ? LUCENT_PROGRAM(hair_sample::linked_sphere_glass)
+                                          : LUCENT_PROGRAM(hair_sample::linked_sphere_coated));
         sphere_instance->add_material(make_material(sphere.material, hit));
     }
     spheres->set_centers(input(ctx, centers));
@@ -205,9 +205,9 @@ HairGraph build_hair_graph(Context& ctx, const HairSceneData& data, bool light_l
         curves->set_segment_indices(input(ctx, data.hair.segments));
         auto hair_instance = ctx.create_geometry_instance();
         hair_instance->set_geometry(curves);
-        hair_instance->add_material(make_material(
-            data.hair_material,
-            ctx.create_program(LUCENT_PROGRAM(hair_sample::linked_curve_coated))));
+        hair_instance->add_material(
+            make_material(data.hair_material,
+                          ctx.create_program(LUCENT_PROGRAM(hair_sample::linked_curve_coated))));
         top->add_child(masked_group(ctx, hair_instance, hair_sample::kHairMask));
     }
     ctx["top_object"] = top;
