@@ -4,6 +4,7 @@
 // scene is built in code (hair_scene.h): --scene is refused. `lucent view` accumulates one
 // sample per pixel per frame while the camera rests, as the path tracer's session does.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
