@@ -85,7 +85,7 @@ PY
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer modules; do
+    for t in programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer hair modules; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
@@ -115,7 +115,8 @@ samples)
     for args in "igi --size 512x512 --set vpls=64" \
                 "igi --size 512x512 --set downsample=4 --set interleave=3 --set imperfect_visibility=1" \
                 "radiosity --size 512x512" "direct --size 512x512" \
-                "pathtracer --size 256x256 --spp 64" "fog --size 512x384" \
+                "pathtracer --size 256x256 --spp 64" "hair --size 480x270 --spp 16" \
+                "fog --size 512x384" \
                 "fog --size 512x384 --set eye_height=1.2 --set eye_distance=9"; do
         name=$(echo "$args" | tr ' =' '__' | cut -c1-60)
         $R $B/bin/lucent render --sample $args --backend cuda --out "$out/$name.cuda.png" | tail -12
