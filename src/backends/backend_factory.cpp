@@ -89,8 +89,8 @@ void jit_check(const CompiledScene& scene, int sm, LaunchReport& report) {
 #if LUCENT_HAVE_CUDA
     cuda::Megakernel kernel = cuda::generate_megakernel(scene, cuda::build_program_table(scene));
     cuda::compile_megakernel(kernel, sm);
-    report.jit_ms = kernel.binary.ms;
-    report.jit_cached = kernel.binary.from_cache;
+    report.jit_ms = kernel.jit_ms;
+    report.jit_cached = kernel.from_cache;
 #else
     (void)scene, (void)sm, (void)report;
     throw Error("Context: the JIT check needs a build with the CUDA toolkit; drop the option");

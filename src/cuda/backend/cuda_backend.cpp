@@ -75,7 +75,7 @@ class CudaBackend final : public core::Backend {
             if (s) m_driver.cuStreamDestroy(s);
         if (m_start) m_driver.cuEventDestroy(m_start);
         if (m_stop) m_driver.cuEventDestroy(m_stop);
-        if (m_module) m_driver.cuModuleUnload(m_module);
+        unload_kernels();
         // Freed while the context is still ours: the members' own destructors run after the
         // release below, when the last release may already have destroyed the context (its
         // memory then goes with it, but compute-sanitizer's leak check reports every block).
@@ -141,7 +141,7 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuMemsetD32Async(m_exceptions.ptr(), 0, kExceptionBytes / 4, m_streams[0]),
               "clear the exception slots");
         *m_params_host = p;
-        check(m_driver.cuMemcpyHtoDAsync(m_params_global, m_params_host, sizeof p, m_streams[0]),
+        check(m_driver.cuMemcpyHtoDAsync(m_kernel->params, m_params_host, sizeof p, m_streams[0]),
               "upload launch parameters");
         m_size = spec.size;
         m_pieces = 0;
@@ -311,45 +311,53 @@ class CudaBackend final : public core::Backend {
                        : std::vector<std::shared_ptr<const Buffer>>{};
     }
 
-    /// Generates the kernel for this scene; compiles it only when the source changed.
+    /// Generates the kernels for this scene; compiles them only when the source changed.
     void prepare_kernel(const core::CompiledScene& scene, LaunchReport& report) {
         Megakernel kernel = generate_megakernel(scene, m_scene->programs());
-        if (kernel.source == m_source && m_module) return;  // same shape: keep the kernel
+        std::string text = kernel.text();
+        if (text == m_source && !m_kernels.empty()) return;  // same shape: keep the kernels
         compile_megakernel(kernel, m_sm);
-        report.jit_ms = kernel.binary.ms;
-        report.jit_cached = kernel.binary.from_cache;
+        report.jit_ms = kernel.jit_ms;
+        report.jit_cached = kernel.from_cache;
         const KernelShape& shape = kernel.shape;
-        const CompileResult& compiled = kernel.binary;
 
-        if (m_module) m_driver.cuModuleUnload(m_module);
-        m_module = nullptr;
-        check(m_driver.cuModuleLoadData(&m_module, compiled.cubin.data()), "load the megakernel");
-        check(m_driver.cuModuleGetFunction(&m_gather, m_module, "lucent_gather_tiles"),
-              "find lucent_gather_tiles");
-        size_t bytes = 0;
-        check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
-                                         "_ZN6lucent3gpu6paramsE"),
-              "find the launch parameters");
+        unload_kernels();
         const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
         m_fixed_shape = fixed != nullptr;
-        const size_t kernels = m_scene->programs().programs(ProgramKind::kRayGeneration).size();
-        m_kernels.assign(kernels, RayGenerationKernel{});
-        m_kernel = nullptr;
+        m_kernels.resize(kernel.binaries.size());
         m_largest_grid = 1;
-        for (size_t i = 0; i < kernels; ++i) {
+        for (size_t i = 0; i < m_kernels.size(); ++i) {
             RayGenerationKernel& k = m_kernels[i];
+            check(m_driver.cuModuleLoadData(&k.module, kernel.binaries[i].cubin.data()),
+                  "load the megakernel");
             const std::string name = ray_generation_kernel(int(i));
-            check(m_driver.cuModuleGetFunction(&k.function, m_module, name.c_str()),
+            check(m_driver.cuModuleGetFunction(&k.function, k.module, name.c_str()),
                   ("find " + name).c_str());
+            size_t bytes = 0;
+            check(m_driver.cuModuleGetGlobal(&k.params, &bytes, k.module,
+                                             "_ZN6lucent3gpu6paramsE"),
+                  "find the launch parameters");
             k.shapes = launch_shapes(k.function, fixed);
-            for (const LaunchShape& shape : k.shapes)
-                m_largest_grid = std::max(m_largest_grid, shape.grid);
+            for (const LaunchShape& s : k.shapes) m_largest_grid = std::max(m_largest_grid, s.grid);
         }
+        if (!m_kernels.empty())  // every module has it: the first's serves
+            check(m_driver.cuModuleGetFunction(&m_gather, m_kernels[0].module,
+                                               "lucent_gather_tiles"),
+                  "find lucent_gather_tiles");
         m_tuning.clear();
         // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
         size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
         check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
-        m_source = std::move(kernel.source);
+        m_source = std::move(text);
+    }
+
+    void unload_kernels() {
+        for (RayGenerationKernel& k : m_kernels)
+            if (k.module) m_driver.cuModuleUnload(k.module);
+        m_kernels.clear();
+        m_kernel = nullptr;
+        m_gather = nullptr;
+        m_source.clear();
     }
 
   private:
@@ -362,7 +370,9 @@ class CudaBackend final : public core::Backend {
 
     /// A ray-generation program's kernel and its launch shapes (launch_shapes.h).
     struct RayGenerationKernel {
+        CUmodule module = nullptr;  // its own (compile_megakernel's units)
         CUfunction function = nullptr;
+        CUdeviceptr params = 0;     // the module's launch parameters
         std::vector<LaunchShape> shapes{LaunchShape{}};  // shape 0: occupancy first
         LaunchShape applied{-1, 0};
     };
@@ -427,12 +437,10 @@ class CudaBackend final : public core::Backend {
     int m_shape = kOccupancyFirst;
     std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
     CUcontext m_context = nullptr;
-    CUmodule m_module = nullptr;
     std::vector<RayGenerationKernel> m_kernels;  // by ray-generation program (ProgramTable id)
     RayGenerationKernel* m_kernel = nullptr;      // the current launch's
     int m_largest_grid = 1;                       // of every kernel's shapes
     CUfunction m_gather = nullptr;
-    CUdeviceptr m_params_global = 0;
     std::string m_device_name, m_source;
     int m_sm = 0, m_sm_count = 0;
     std::unique_ptr<GpuScene> m_scene;

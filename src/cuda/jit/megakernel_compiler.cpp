@@ -1,8 +1,13 @@
 #include "cuda/jit/megakernel_compiler.h"
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
 #include <set>
+#include <thread>
 
 namespace lucent::cuda {
 
@@ -27,30 +32,71 @@ ProgramTable build_program_table(const core::CompiledScene& scene) {
     return table;
 }
 
+std::string Megakernel::text() const {
+    std::string all = source;
+    for (const std::string& k : kernels) all += k;
+    return all;
+}
+
 Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTable& table) {
     Megakernel k;
     k.shape = kernel_shape(scene);
     k.modules = bound_module_sources(table, scene.module_sources);
     k.source = generate_megakernel(table, k.shape, k.modules);
-    // LUCENT_DUMP_MEGAKERNEL=file: keep the generated source for inspection.
+    const size_t ray_generations = table.programs(ProgramKind::kRayGeneration).size();
+    for (size_t i = 0; i < ray_generations; ++i)
+        k.kernels.push_back(ray_generation_kernel_definition(table, int(i)));
+    // LUCENT_DUMP_MEGAKERNEL=file: keep the generated source (every kernel) for inspection.
     if (const char* dump = std::getenv("LUCENT_DUMP_MEGAKERNEL")) {
         std::ofstream out(dump);
-        out << k.source;
+        out << k.text();
     }
     return k;
 }
 
 void compile_megakernel(Megakernel& k, int sm) {
-    CompileRequest request =
-        embedded_request("lucent_megakernel.cu", k.source,
-                         {"--std=c++20", "-default-device", "--use_fast_math"}, sm);
-    std::set<std::string> names;  // two modules may include one file
-    for (const auto& module : k.modules)
-        for (const auto& [name, text] : module->files)
-            if (names.insert(name).second) request.headers.emplace_back(name, text);
-    // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
-    add_options_from_env(request, "LUCENT_NVRTC_OPTIONS");
-    k.binary = compile_cubin(request);
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    std::vector<CompileRequest> requests;
+    for (const std::string& kernel : k.kernels) {
+        CompileRequest request =
+            embedded_request("lucent_megakernel.cu", k.source + kernel,
+                             {"--std=c++20", "-default-device", "--use_fast_math"}, sm);
+        std::set<std::string> names;  // two modules may include one file
+        for (const auto& module : k.modules)
+            for (const auto& [name, text] : module->files)
+                if (names.insert(name).second) request.headers.emplace_back(name, text);
+        // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
+        add_options_from_env(request, "LUCENT_NVRTC_OPTIONS");
+        requests.push_back(std::move(request));
+    }
+    // The units are independent NVRTC programs: compiled side by side, a scene of several
+    // ray-generation programs takes about as long as its largest one on a machine with the
+    // cores (ptxas would otherwise compile trace_ray once per kernel, one after another).
+    k.binaries.assign(requests.size(), CompileResult{});
+    std::vector<std::exception_ptr> errors(requests.size());
+    std::atomic<size_t> next{0};
+    const auto work = [&] {
+        for (size_t i; (i = next++) < requests.size();) {
+            try {
+                k.binaries[i] = compile_cubin(requests[i]);
+            } catch (...) {
+                errors[i] = std::current_exception();
+            }
+        }
+    };
+    // At most 8 at once: each NVRTC program holds a few hundred megabytes while it compiles.
+    const size_t threads = std::min<size_t>(
+        {requests.size(), std::max(1u, std::thread::hardware_concurrency()), size_t(8)});
+    std::vector<std::thread> pool;
+    for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+    k.from_cache = !k.binaries.empty();
+    for (const CompileResult& b : k.binaries) k.from_cache = k.from_cache && b.from_cache;
+    k.jit_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 }  // namespace lucent::cuda

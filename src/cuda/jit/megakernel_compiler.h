@@ -3,6 +3,9 @@
 // compiles (`lucent render --jit-check sm_90`).
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "core/compiled_scene.h"
 #include "cuda/jit/megakernel_generator.h"
 #include "cuda/jit/nvrtc_compiler.h"
@@ -12,16 +15,26 @@ namespace lucent::cuda {
 /// Ids for every program the scene binds, in a fixed walk of the scene.
 ProgramTable build_program_table(const core::CompiledScene& scene);
 
+/// A scene's megakernel: one kernel per ray-generation program, each compiled as its own
+/// unit (the common source and that kernel's definition) into its own module, so the units
+/// compile in parallel and each kernel's code holds only what its program reaches.
 struct Megakernel {
-    std::string source;
+    std::string source;                // common to every unit
+    std::vector<std::string> kernels;  // per ray-generation program: its kernel's definition
     KernelShape shape;
     ModuleSourceList modules;  // the bound programs' module texts, headers of `source`
-    CompileResult binary;
+    std::vector<CompileResult> binaries;  // per kernel, after compile_megakernel
+    double jit_ms = 0;                    // the whole compile (or cache loads), wall time
+    bool from_cache = false;              // every unit came from the kernel cache
+
+    /// Everything that decides the binaries' code: whether a recompile is needed.
+    std::string text() const;
 };
 
-/// Generates the megakernel source of `scene` (binary left empty).
+/// Generates the megakernel source of `scene` (binaries left empty).
 Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTable& table);
-/// Compiles it for compute capability `sm` (e.g. 90) through the disk cache.
+/// Compiles its units for compute capability `sm` (e.g. 90) through the disk cache, on up to
+/// one thread per unit and processor (8 at most); throws the first unit's error.
 void compile_megakernel(Megakernel& kernel, int sm);
 
 }  // namespace lucent::cuda

@@ -185,6 +185,12 @@ std::string ray_generation_kernel(int id) {
     return "lucent_ray_generation_" + std::to_string(id);
 }
 
+std::string ray_generation_kernel_definition(const ProgramTable& table, int id) {
+    const ProgramDesc& program = *table.programs(ProgramKind::kRayGeneration).at(size_t(id));
+    return "LUCENT_GPU_RAY_GENERATION_KERNEL(" + ray_generation_kernel(id) + ", ::" +
+           std::string(program.scope) + std::string(program.name) + ")\n";
+}
+
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
                                 const ModuleSourceList& modules) {
     std::ostringstream out;
@@ -223,10 +229,6 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
     out << "}  // namespace lucent::gpu\n\n";
     generate_callables(out, table.programs(ProgramKind::kCallable));
     out << "\n#include \"lucent_gpu/trace.cuh\"\n\n";
-    const auto& ray_generations = table.programs(ProgramKind::kRayGeneration);
-    for (size_t i = 0; i < ray_generations.size(); ++i)
-        out << "LUCENT_GPU_RAY_GENERATION_KERNEL(" << ray_generation_kernel(int(i)) << ", ::"
-            << ray_generations[i]->scope << ray_generations[i]->name << ")\n";
     return out.str();
 }
 

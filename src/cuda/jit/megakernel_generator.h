@@ -56,10 +56,16 @@ ModuleSourceList bound_module_sources(
     const std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>>& given);
 
 /// The name of the kernel that runs ray-generation program `id` (ProgramTable's numbering):
-/// the megakernel has one per bound ray-generation program, each calling it directly.
+/// the megakernel has one per bound ray-generation program, each calling it directly, each
+/// compiled on its own (in parallel) into its own module.
 std::string ray_generation_kernel(int id);
 
-/// The megakernel source, including every module of `modules` (bound_module_sources).
+/// The line that defines ray-generation program `id`'s kernel, appended to the megakernel
+/// source to make the unit that compiles it.
+std::string ray_generation_kernel_definition(const ProgramTable& table, int id);
+
+/// The megakernel source without its kernels: the runtime, every module of `modules`
+/// (bound_module_sources) and the dispatch switches.
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
                                 const ModuleSourceList& modules);
 
