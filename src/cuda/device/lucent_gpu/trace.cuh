@@ -371,11 +371,10 @@ namespace lucent::gpu {
 /// `owners[tile]` for the tiles it takes, so each can gather the others' tiles (gather.cuh).
 ///
 /// `run_ray_generation(record)` calls one ray-generation program directly: the generator
-/// emits one kernel per bound ray-generation program (LUCENT_GPU_RAY_GENERATION_KERNEL
-/// below), so each kernel holds only the code its program reaches. trace_ray and
-/// occluded_ray are not inlined, so the traversal is compiled once for all of them; a
-/// program that traces nothing (a denoiser's filter) gets a kernel with its own, small
-/// register count and full occupancy instead of the tracing kernels' (docs/architecture.md,
+/// makes one kernel per bound ray-generation program (LUCENT_GPU_RAY_GENERATION_KERNEL
+/// below, each in its own compile unit), so each kernel holds only the code its program
+/// reaches, and a program that traces nothing (a denoiser's filter) gets its own small
+/// register count and high occupancy instead of the tracing kernels' (docs/architecture.md,
 /// "One kernel per ray-generation program").
 template <class RunRayGeneration>
 __device__ __forceinline__ void run_launch(RunRayGeneration run_ray_generation,
