@@ -24,7 +24,7 @@ MotionRay down(float x, float y, float time, unsigned occlusion = 0) {
 
 class MotionTest : public testing::Test {
   protected:
-    MotionTest() : ctx(test_context_options()) {
+    explicit MotionTest(const ContextOptions& options = test_context_options()) : ctx(options) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<MotionPayload>(0, "radiance");
         ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(motion_miss)));
@@ -339,6 +339,49 @@ TEST_F(MotionTest, ManyMovingSpheresAgreeWithTheirAnalyticPositions) {
         EXPECT_NEAR(r[i].t, best, 1e-3f) << "ray " << i;
     }
     EXPECT_GT(hits, 200);
+}
+
+// ---- the megakernel -------------------------------------------------------------------------
+
+/// The motion scenes also compile as CUDA megakernels for sm_90 (no GPU needed): the CPU
+/// suite proves the device code builds with NVRTC (the GPU suite launches it).
+class MotionJitTest : public MotionTest {
+  protected:
+    static ContextOptions jit_options() {
+        ContextOptions options = test_context_options();
+#if LUCENT_HAVE_CUDA
+        options.jit_check_sm = 90;  // a CPU-only build (the sanitized one) has no NVRTC
+#endif
+        return options;
+    }
+    MotionJitTest() : MotionTest(jit_options()) {}
+};
+
+TEST_F(MotionJitTest, EveryKindOfMotionCompilesAsAMegakernelForSm90) {
+#if !LUCENT_HAVE_CUDA
+    GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
+#else
+    if (test_backend() != BackendKind::kCpu) GTEST_SKIP() << "the GPU compiles them to launch";
+    auto spheres = ctx.create_geometry_spheres();
+    spheres->set_motion_centers({input_buffer(ctx, std::vector<float3>{make_float3(0, 0, 0)}),
+                                 input_buffer(ctx, std::vector<float3>{make_float3(2, 0, 0)})});
+    spheres->set_radii(input_buffer(ctx, std::vector<float>{0.5f}));
+    auto triangles = ctx.create_geometry_triangles();
+    triangles->set_motion_vertices({input_buffer(ctx, square_at(-1.0f)), input_buffer(ctx, square_at(-2.0f))});
+    auto srt_node = ctx.create_transform();
+    srt_node->set_child(sphere_group(spheres, 1));
+    const std::vector<SrtData> keys{srt(1, make_float3(0.0f), make_float4(0, 0, 0, 1)),
+                                    srt(1, make_float3(1, 0, 0), make_float4(0, 0, 0, 1))};
+    srt_node->set_motion_srt(keys);
+    auto group = beside_static(srt_node);
+    group->add_child(triangle_group(triangles, 2));
+    const auto r = cast(group, {down(1.5f, 0, 0.5f), down(8, 0, 0.5f)});
+    EXPECT_EQ(r[0].hit, 1);
+    EXPECT_NEAR(r[0].t, 4.5f, kEps);
+    EXPECT_EQ(r[1].hit, 1);
+    EXPECT_EQ(r[1].id, 2u);
+    EXPECT_NEAR(r[1].t, 6.5f, kEps);
+#endif
 }
 
 // ---- misuse ---------------------------------------------------------------------------------

@@ -40,10 +40,11 @@ LUCENT_HD inline bool motion_key(const MotionRange& m, float time, unsigned& key
     if (time < m.time_begin && (m.flags & kMotionFlagStartVanish)) return false;
     if (time > m.time_end && (m.flags & kMotionFlagEndVanish)) return false;
     const float last = float(m.keys - 1);
-    // Clamped into [0, keys - 1]; a NaN time lands on the first key (fmaxf drops NaN).
-    const float s = lc_min(fmaxf((time - m.time_begin) / (m.time_end - m.time_begin) * last, 0.0f),
+    // Clamped into [0, keys - 1]; a NaN time lands on the first key (lc_max(NaN, 0) is 0).
+    const float s = lc_min(lc_max((time - m.time_begin) / (m.time_end - m.time_begin) * last, 0.0f),
                            last);
-    key = lc_min(unsigned(s), m.keys - 2);
+    const unsigned whole = unsigned(s);
+    key = whole < m.keys - 2 ? whole : m.keys - 2;
     frac = s - float(key);
     return true;
 }

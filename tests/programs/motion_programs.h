@@ -3,6 +3,7 @@
 // ray_time() included.
 #pragma once
 
+#include "lucent/device/sphere_intersect.h"
 #include "tests/programs/common.h"
 
 namespace lucent_tests {
