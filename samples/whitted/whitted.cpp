@@ -421,8 +421,8 @@ const WhittedLayout& whitted_layout() {
         l.background = make_float3(0.38f, 0.5f, 0.68f);
         l.metal_center = make_float3(2.0f, 1.5f, -2.5f);
         l.metal_radius = 1.0f;
-        // Across the view, away from the glass sphere: 1.5 radii over the shutter.
-        l.metal_motion = make_float3(-0.8f, 0.0f, 1.3f);
+        // Up by 1.2 radii over the shutter (a bounce), clear of the glass sphere and the frame.
+        l.metal_motion = make_float3(0.0f, 1.2f, 0.0f);
         l.glass_center = make_float3(4.0f, 2.3f, -4.0f);
         l.glass_radius = 1.0f;
         l.glass_thickness = 0.04f;

@@ -312,9 +312,9 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
     uint3 index = lucent::launch_index();
     uint3 size = lucent::launch_size();
     float inv_w = 1.0f / float(size.x), inv_h = 1.0f / float(size.y);
-    // With motion, sample i of the pixel is at time (k_i + u) / 16 in the shutter [0, 1]:
-    // u from the pixel's TEA hash, k_i the bit-reversed i, so the first four samples spread
-    // over the shutter as the sixteen do (stratified time, one offset per pixel).
+    // With motion, the one sample of a pixel is at time u in the shutter [0, 1], u from the
+    // pixel's TEA hash; with antialiasing, sample i is at (k_i + u) / 16, k_i the bit-reversed
+    // i, so the first four samples spread over the shutter as the sixteen do (stratified).
     const float pixel_time =
         rec.motion ? lucent::tea_unit_float(lucent::tea<4>(make_uint2(index.x, index.y),
                                                            lucent::zafar_tea_key()).x)
@@ -324,7 +324,9 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
         float sx = 2.0f * (float(index.x) + fx) * inv_w - 1.0f;
         float sy = 1.0f - 2.0f * (float(index.y) + fy) * inv_h;
         const unsigned k = ((i & 1u) << 3) | ((i & 2u) << 1) | ((i & 4u) >> 1) | ((i & 8u) >> 3);
-        const float time = rec.motion ? (float(k) + pixel_time) * (1.0f / 16.0f) : 0.0f;
+        const float time = !rec.motion        ? 0.0f
+                           : rec.antialiasing ? (float(k) + pixel_time) * (1.0f / 16.0f)
+                                              : pixel_time;
         return whitted::camera_sample(rec, camera, sx, sy, time);
     };
 
