@@ -1,6 +1,7 @@
 // The edge-avoiding à-trous denoiser (samples/common/atrous_programs.h) on a sample's
-// Context: three entry points of the same program, ping-ponging between two images, each
-// pass's parameters uploaded into a 1-element buffer before its launch.
+// Context: three entry points, one preparing the filter's input, its guide and the mean
+// illumination's block sums, two of the same pass program ping-ponging between two images,
+// each pass's parameters uploaded into a 1-element buffer before its launch.
 #pragma once
 
 #include <memory>
@@ -31,11 +32,13 @@ class AtrousDenoiser {
     Context& m_ctx;
     Guides m_guides;
     unsigned m_first_entry, m_width, m_height;
-    std::shared_ptr<Buffer> m_colour, m_pass, m_ping, m_pong;
+    std::shared_ptr<Buffer> m_colour, m_pass, m_ping, m_pong, m_guide, m_sums;
 };
 
 /// The mean over the covered pixels of colour / albedo (as the filter demodulates it), its
-/// three channels averaged; the unit of sigma_colour. 1 when nothing is covered or it is 0.
-float mean_illumination(const Buffer& colour, const Buffer& albedo, bool demodulate);
+/// three channels averaged, from the prepare launch's block sums (float2: sum, pixels; every
+/// second pixel of every second row); the unit of sigma_colour. 1 when nothing is covered
+/// or it is 0.
+float mean_illumination(const Buffer& sums);
 
 }  // namespace lucent::samples

@@ -85,7 +85,7 @@ PY
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer modules; do
+    for t in programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer hair modules; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do
@@ -115,7 +115,8 @@ samples)
     for args in "igi --size 512x512 --set vpls=64" \
                 "igi --size 512x512 --set downsample=4 --set interleave=3 --set imperfect_visibility=1" \
                 "radiosity --size 512x512" "direct --size 512x512" \
-                "pathtracer --size 256x256 --spp 64" "fog --size 512x384" \
+                "pathtracer --size 256x256 --spp 64" "hair --size 480x270 --spp 16" \
+                "fog --size 512x384" \
                 "fog --size 512x384 --set eye_height=1.2 --set eye_distance=9"; do
         name=$(echo "$args" | tr ' =' '__' | cut -c1-60)
         $R $B/bin/lucent render --sample $args --backend cuda --out "$out/$name.cuda.png" | tail -12
@@ -264,7 +265,7 @@ SAMPLES
     ;;
 profile)
     echo "== ncu: the Whitted megakernel at 1024x1024"
-    ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
+    ncu --kernel-name regex:lucent_ray_generation_ --launch-skip 2 --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
         $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out "$work/p.png" 2>&1 | grep -vE "^==PROF==|^ +-+$" | tail -80
     ;;
@@ -272,7 +273,7 @@ profile_igi)
     echo "== ncu: the IGI indirect pass (canonical, 180 VPLs) on Sponza at 800x600"
     # Launches per frame: VPL generation, direct, indirect, composition; skip frame 1 and
     # the first two launches of frame 2.
-    LUCENT_SCENE_PATH=/work/shared/scenes ncu --kernel-name lucent_megakernel --launch-skip 6 \
+    LUCENT_SCENE_PATH=/work/shared/scenes ncu --kernel-name regex:lucent_ray_generation_ --launch-skip 6 \
         --launch-count 1 --section SpeedOfLight --section Occupancy --section LaunchStats \
         --section WarpStateStats --section MemoryWorkloadAnalysis \
         $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
@@ -286,7 +287,7 @@ profile_igi_pass)
     # its indirect pass.
     echo "== ncu: IGI launch ${IGI_LAUNCH:-22} with all three accelerations, Sponza 800x600"
     LUCENT_SCENE_PATH=/work/shared/scenes LUCENT_NVRTC_OPTIONS="-lineinfo" ncu \
-        --kernel-name lucent_megakernel --launch-skip ${IGI_LAUNCH:-22} --launch-count 1 \
+        --kernel-name regex:lucent_ray_generation_ --launch-skip ${IGI_LAUNCH:-22} --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section WarpStateStats \
         --section SourceCounters -f -o $work/igi_pass \
         $R $B/bin/lucent render --sample igi --backend cuda --scene bench/scenes/sponza-igi.json \
@@ -307,7 +308,7 @@ profile_cwbvh)
     ;;
 hotspots)
     echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"
-    LUCENT_NVRTC_OPTIONS="-lineinfo" ncu --kernel-name lucent_megakernel --launch-skip 2 --launch-count 1 \
+    LUCENT_NVRTC_OPTIONS="-lineinfo" ncu --kernel-name regex:lucent_ray_generation_ --launch-skip 2 --launch-count 1 \
         --section SourceCounters --section WarpStateStats -f -o $work/whitted \
         $R $B/bin/lucent render --sample whitted --backend cuda --size 1024x1024 --repeat 4 --out "$work/p.png" 2>&1 | tail -3
     ncu -i $work/whitted.ncu-rep --page source --print-source cuda --csv > "$out/source.csv" 2> "$out/source.err"

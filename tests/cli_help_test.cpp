@@ -110,7 +110,8 @@ TEST(CliHelp, EveryUsageErrorHasOneStyleAndMistypesAGuess) {
         {"render --size", "lucent render: --size: needs a value (WxH); run `lucent render --help`"},
         {"render stray", "lucent render: unexpected argument 'stray'; run `lucent render --help`"},
         {"render --sample ig", "lucent render: --sample ig: no such sample (did you mean 'igi'?); "
-                               "the samples are whitted, direct, igi, radiosity, pathtracer, fog"},
+                               "the samples are whitted, direct, igi, radiosity, pathtracer, hair, "
+                               "fog"},
     };
     for (const Case& c : cases) {
         const CliRun r = run_lucent(c.args);

@@ -61,7 +61,7 @@ TEST(Session, SamplesRegisterThemselvesInHelpOrder) {
     std::vector<std::string> names;
     for (const Sample* sample : all_samples()) names.push_back(sample->name);
     EXPECT_EQ(names, (std::vector<std::string>{"whitted", "direct", "igi", "radiosity",
-                                               "pathtracer", "fog"}));
+                                               "pathtracer", "hair", "fog"}));
 }
 
 TEST(Session, WhittedFromItsOwnCameraMatchesTheRender) {

@@ -1,15 +1,13 @@
-// A procedural head of hair: strands rooted on the upper part of a unit sphere, each a
-// chain of control points that leaves along the surface normal and bends under gravity
-// with a little noise, radius tapering from root to tip; the head itself is a built-in
-// sphere in the same group. Primary rays (entry 0) and one diffuse ray from each primary
-// hit (entry 1) are launched alternately after warm-ups, timed per launch (CUDA events on
-// the GPU, the launch on the CPU): Mrays/s as median and spread.
+// A procedural head of hair (scene/hair_strands.h: strands rooted on the upper part of a
+// unit sphere, bending under gravity, tapering); the head itself is a built-in sphere in the
+// same group. Primary rays (entry 0) and one diffuse ray from each primary hit (entry 1) are
+// launched alternately after warm-ups, timed per launch (CUDA events on the GPU, the launch
+// on the CPU): Mrays/s as median and spread.
 #include "bench/curves/curves_bench.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <vector>
 
 #include "bench/common/input_buffer.h"
@@ -17,14 +15,13 @@
 #include "bench/common/report.h"
 #include "bench/curves/curves_programs.h"
 #include "lucent/lucent.h"
+#include "scene/hair_strands.h"
 
 namespace lucent::bench {
 
 namespace {
 
 namespace programs = lucent_bench_curves;
-
-constexpr unsigned kSegmentsPerStrand = 12;
 
 const char* type_name(CurveType type) {
     switch (type) {
@@ -33,43 +30,6 @@ const char* type_name(CurveType type) {
         case kCurveCubicBSpline: return "cubic B-spline";
         default: return "Catmull-Rom";
     }
-}
-
-struct Hair {
-    std::vector<float3> vertices;
-    std::vector<float> radii;
-    std::vector<unsigned> segments;
-};
-
-Hair make_hair(unsigned segment_count, CurveType type) {
-    Hair hair;
-    const unsigned points_per_segment = curve_control_points(type);
-    // Consecutive segments of a strand share all but one control point.
-    const unsigned extra = points_per_segment - 1;
-    const unsigned strands = std::max(1u, (segment_count + kSegmentsPerStrand - 1) / kSegmentsPerStrand);
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f), jitter(-1.0f, 1.0f);
-    const float step = 0.07f;
-    for (unsigned s = 0; s < strands && hair.segments.size() < segment_count; ++s) {
-        // A root on the sphere above y = -0.3, uniform in area.
-        const float y = -0.3f + 1.3f * unit(rng), phi = 6.2831853f * unit(rng);
-        const float ring = std::sqrt(std::max(0.0f, 1.0f - y * y));
-        float3 p = make_float3(ring * std::cos(phi), y, ring * std::sin(phi));
-        float3 dir = p;
-        const unsigned first = unsigned(hair.vertices.size());
-        const unsigned points = kSegmentsPerStrand + extra;
-        for (unsigned k = 0; k < points; ++k) {
-            hair.vertices.push_back(p * 1.002f);
-            const float along = float(k) / float(points - 1);
-            hair.radii.push_back(0.004f * (1.0f - 0.75f * along));
-            dir = normalize(dir + make_float3(0.0f, -0.35f, 0.0f) +
-                            0.25f * make_float3(jitter(rng), jitter(rng), jitter(rng)));
-            p = p + step * dir;
-        }
-        for (unsigned k = 0; k < kSegmentsPerStrand && hair.segments.size() < segment_count; ++k)
-            hair.segments.push_back(first + k);
-    }
-    return hair;
 }
 
 double mrays(const LaunchReport& report, double rays, std::string& timing) {
@@ -82,7 +42,10 @@ double mrays(const LaunchReport& report, double rays, std::string& timing) {
 }  // namespace
 
 int run_curves_bench(const CurvesBenchOptions& options) {
-    const Hair hair = make_hair(options.segments, options.type);
+    scene::HairStyle style;  // the unit head at the origin
+    style.segments = options.segments;
+    style.type = options.type;
+    const scene::HairStrands hair = scene::make_hair_strands(style);
     ContextOptions context_options;
     context_options.backend = options.backend;
     context_options.threads = options.threads;

@@ -28,6 +28,7 @@ CASES = [
     ("igi", (64, 64), 0, {"vpls": 16, "downsample": 2, "interleave": 3, "imperfect_visibility": True}),
     ("radiosity", (48, 48), 0, {}),
     ("pathtracer", (32, 32), 4, {}),
+    ("hair", (48, 27), 2, {"strands": 500, "curve_type": "catmull-rom", "light_linking": False}),
     ("fog", (48, 36), 0, {}),
 ]
 
@@ -85,7 +86,7 @@ def test_a_bad_camera_is_a_value_error():
 
 def test_samples_lists_every_sample_with_its_options():
     listed = lucent.samples()
-    assert set(listed) >= {"whitted", "direct", "igi", "radiosity", "pathtracer", "fog"}
+    assert set(listed) >= {"whitted", "direct", "igi", "radiosity", "pathtracer", "hair", "fog"}
     igi = listed["igi"]
     assert igi["description"]
     vpls = igi["options"]["vpls"]

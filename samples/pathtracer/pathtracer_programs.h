@@ -129,11 +129,23 @@ LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 t
     return !lucent::occluded(rec.top_object, ray);
 }
 
+/// next_event's shadow test: is nothing between `from` and `to`? `light` is the index of the
+/// light sampled, area lights first, then point lights. This one, the path tracer's, is
+/// unoccluded() for every light; a sample that links lights to objects passes its own
+/// (samples/hair/hair_programs.h masks each light's shadow rays).
+struct SceneShadows {
+    LUCENT_HD bool operator()(const SurfaceRecord& rec, float3 from, float3 to, unsigned) const {
+        return unoccluded(rec, from, to);
+    }
+};
+
 /// Next-event estimation at p: one area light chosen in proportion to its power, a uniform
 /// point on its area, weighted by the power heuristic against BSDF sampling; every point
-/// light (delta: no MIS).
+/// light (delta: no MIS). `shadows` decides what blocks each light (SceneShadows: anything).
+template <class Shadows = SceneShadows>
 LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, const Frame& frame,
-                                   float3 wo, float3 p, unsigned& rng) {
+                                   float3 wo, float3 p, unsigned& rng,
+                                   const Shadows& shadows = Shadows()) {
     float3 sum = make_float3(0.0f);
     const unsigned n = rec.area_lights.count();
     if (n > 0) {
@@ -154,8 +166,8 @@ LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, c
             const float pdf_light = chosen * d2 / (cos_light * area);
             const float3 f = bsdf_eval(bsdf, wo, wi_local);
             if (max_component(f) > 0.0f &&
-                unoccluded(rec, p,
-                           sample_common::offset_ray_origin(q, light_normal, rec.scene_size))) {
+                shadows(rec, p,
+                        sample_common::offset_ray_origin(q, light_normal, rec.scene_size), l)) {
                 const float w = power_heuristic(pdf_light, bsdf_pdf(bsdf, wo, wi_local));
                 sum += f * light.emission * (wi_local.z * w / pdf_light);
             }
@@ -168,16 +180,19 @@ LUCENT_HD inline float3 next_event(const SurfaceRecord& rec, const Bsdf& bsdf, c
         const float3 wi = to / d, wi_local = to_local(frame, wi);
         if (wi_local.z <= 0.0f) continue;
         const float3 f = bsdf_eval(bsdf, wo, wi_local);
-        if (max_component(f) > 0.0f && unoccluded(rec, p, light.position))
+        if (max_component(f) > 0.0f && shadows(rec, p, light.position, n + l))
             sum += f * light.intensity * (wi_local.z / d2);
     }
     return sum;
 }
 
 /// The closest hit every material shares (CACM §6.2: a generic light loop; the BSDF of
-/// `Kind` samples and evaluates): emission, next-event estimation, the next ray.
-template <unsigned Kind>
-LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const HitAttributes& attr) {
+/// `Kind` samples and evaluates): emission, next-event estimation, the next ray. `attr`'s
+/// normal may be of any primitive (a sample shading built-in spheres or curves passes
+/// theirs, uv 0); `shadows` is next_event's.
+template <unsigned Kind, class Shadows = SceneShadows>
+LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const HitAttributes& attr,
+                            const Shadows& shadows = Shadows()) {
     const lucent::Ray& ray = lucent::current_ray();
     const float t = lucent::t_hit();
     const float3 x = ray.origin + t * ray.direction;
@@ -199,7 +214,8 @@ LUCENT_HD inline void shade(const SurfaceRecord& rec, PathPayload& prd, const Hi
     const float3 wo = to_local(frame, -ray.direction);
     const float3 above = sample_common::offset_ray_origin(x, n, rec.scene_size);
     prd.direct = make_float3(0.0f);
-    if (prd.nee && !is_delta(bsdf)) prd.direct = next_event(rec, bsdf, frame, wo, above, prd.rng);
+    if (prd.nee && !is_delta(bsdf))
+        prd.direct = next_event(rec, bsdf, frame, wo, above, prd.rng, shadows);
 
     const float u1 = next_random(prd.rng), u2 = next_random(prd.rng), u3 = next_random(prd.rng);
     const BsdfSample s = bsdf_sample(bsdf, wo, u1, u2, u3);

@@ -17,6 +17,7 @@
 #include "cuda/backend/gpu_scene.h"
 #include "cuda/backend/launch_shapes.h"
 #include "cuda/jit/megakernel_compiler.h"
+#include "cuda/jit/megakernel_generator.h"
 #include "lucent/error.h"
 
 namespace lucent::cuda {
@@ -30,6 +31,8 @@ constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
 constexpr unsigned kPiecesInFlight = 4, kMaxPiecesInFlight = 8;
 
 constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
+
+constexpr size_t kExceptionBytes = sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots;
 
 class CudaBackend final : public core::Backend {
   public:
@@ -54,6 +57,14 @@ class CudaBackend final : public core::Backend {
         for (CUevent& e : m_piece_done) check(d.cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate");
         check(d.cuEventCreate(&m_start, CU_EVENT_DEFAULT), "cuEventCreate");
         check(d.cuEventCreate(&m_stop, CU_EVENT_DEFAULT), "cuEventCreate");
+        // Page-locked staging for what every launch sends and reads back, so both are
+        // queued on the launch's stream and the launch waits for the GPU once.
+        void* params = nullptr;
+        void* slots = nullptr;
+        check(d.cuMemAllocHost(&params, sizeof(gpu::LaunchParams)), "cuMemAllocHost");
+        m_params_host = static_cast<gpu::LaunchParams*>(params);
+        check(d.cuMemAllocHost(&slots, kExceptionBytes), "cuMemAllocHost");
+        m_slots_host = static_cast<gpu::GpuExceptionSlot*>(slots);
     }
     ~CudaBackend() override {
         m_driver.cuCtxSetCurrent(m_context);
@@ -71,6 +82,8 @@ class CudaBackend final : public core::Backend {
         m_counters.reset();
         m_exceptions.reset();
         m_scratch.reset();
+        if (m_params_host) m_driver.cuMemFreeHost(m_params_host);
+        if (m_slots_host) m_driver.cuMemFreeHost(m_slots_host);
         m_driver.cuDevicePrimaryCtxRelease(m_device);
     }
 
@@ -103,25 +116,33 @@ class CudaBackend final : public core::Backend {
         p.device_slots = unsigned(spec.device_keys.size());
         for (size_t i = 0; i < spec.device_keys.size(); ++i) p.device_keys[i] = spec.device_keys[i];
         m_counters.alloc(m_in_flight * sizeof(unsigned long long));  // one per stream
-        m_exceptions.alloc(sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots);
-        m_exceptions.fill(0);
+        m_exceptions.alloc(kExceptionBytes);
         p.exceptions = const_cast<gpu::GpuExceptionSlot*>(m_exceptions.as<gpu::GpuExceptionSlot>());
-        // The launch shape: fixed by LUCENT_GPU_CARVEOUT, else tuned per entry and size.
+        // The kernel of the entry's ray-generation program (the context refuses a launch of
+        // an entry without one), and its launch shape: fixed by LUCENT_GPU_CARVEOUT, else
+        // tuned per entry and size.
+        m_kernel = &m_kernels.at(size_t(p.ray_generation.id));
         m_tuning_key = {spec.entry, p.launch_count};
         if (m_fixed_shape) {
             m_shape = kOccupancyFirst;
         } else {
-            auto tuning = m_tuning.try_emplace(m_tuning_key, m_shapes.size()).first;
+            auto tuning = m_tuning.try_emplace(m_tuning_key, m_kernel->shapes.size()).first;
             m_shape = tuning->second.next_shape();
         }
-        apply_shape(m_shapes[size_t(m_shape)]);
-        int largest_grid = 0;
-        for (const LaunchShape& shape : m_shapes) largest_grid = std::max(largest_grid, shape.grid);
-        const unsigned threads = unsigned(largest_grid) * kBlock;
+        apply_shape(*m_kernel, m_kernel->shapes[size_t(m_shape)]);
+        // Scratch for the largest grid of any kernel, so launches that alternate between
+        // kernels never reallocate it.
+        const unsigned threads = unsigned(m_largest_grid) * kBlock;
         if (m_scratch.size() != size_t(threads) * gpu::kGpuScratchBytes)
             m_scratch.alloc(size_t(threads) * gpu::kGpuScratchBytes);
         p.scratch = const_cast<unsigned char*>(m_scratch.as<unsigned char>());
-        check(m_driver.cuMemcpyHtoD(m_params_global, &p, sizeof p), "upload launch parameters");
+        // Queued on the first stream ahead of the start event, which the others wait for:
+        // the exception slots cleared and the parameters uploaded, without a wait here.
+        check(m_driver.cuMemsetD32Async(m_exceptions.ptr(), 0, kExceptionBytes / 4, m_streams[0]),
+              "clear the exception slots");
+        *m_params_host = p;
+        check(m_driver.cuMemcpyHtoDAsync(m_params_global, m_params_host, sizeof p, m_streams[0]),
+              "upload launch parameters");
         m_size = spec.size;
         m_pieces = 0;
         m_indices = 0;
@@ -146,7 +167,8 @@ class CudaBackend final : public core::Backend {
         void* no_owners = nullptr;
         unsigned device = 0;
         void* args[] = {&first, &last, &counter_arg, &no_owners, &device};
-        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+        check(m_driver.cuLaunchKernel(m_kernel->function, unsigned(m_kernel->applied.grid), 1, 1,
+                                      kBlock, 1, 1, 0,
                                       stream, args, nullptr),
               "launch the megakernel");
         check(m_driver.cuEventRecord(m_piece_done[slot], stream), "cuEventRecord");
@@ -166,7 +188,8 @@ class CudaBackend final : public core::Backend {
         void* counter_arg = reinterpret_cast<void*>(counter);
         void* owners_arg = reinterpret_cast<void*>(owners);
         void* args[] = {&first, &last, &counter_arg, &owners_arg, &device};
-        check(m_driver.cuLaunchKernel(m_kernel, unsigned(m_applied.grid), 1, 1, kBlock, 1, 1, 0,
+        check(m_driver.cuLaunchKernel(m_kernel->function, unsigned(m_kernel->applied.grid), 1, 1,
+                                      kBlock, 1, 1, 0,
                                       m_streams[0], args, nullptr),
               "launch the megakernel");
     }
@@ -205,6 +228,9 @@ class CudaBackend final : public core::Backend {
             check(m_driver.cuStreamWaitEvent(m_streams[0], m_piece_done[i], 0), "cuStreamWaitEvent");
         }
         check(m_driver.cuEventRecord(m_stop, m_streams[0]), "cuEventRecord");
+        check(m_driver.cuMemcpyDtoHAsync(m_slots_host, m_exceptions.ptr(), kExceptionBytes,
+                                         m_streams[0]),
+              "read the exception slots");
         check(m_driver.cuStreamSynchronize(m_streams[0]), "run the megakernel");
         float kernel_ms = 0;
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
@@ -212,10 +238,9 @@ class CudaBackend final : public core::Backend {
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
-        std::vector<gpu::GpuExceptionSlot> slots(gpu::kGpuExceptionSlots);
-        m_exceptions.download(slots.data(), slots.size() * sizeof slots[0]);
         const uint3 size = m_size;
-        for (const auto& s : slots) {
+        for (unsigned i = 0; i < gpu::kGpuExceptionSlots; ++i) {
+            const gpu::GpuExceptionSlot& s = m_slots_host[i];
             if (s.code == 0) continue;
             uint64_t linear = ~s.first_linear_inverted;
             uint3 first{unsigned(linear % size.x), unsigned(linear / size.x % size.y),
@@ -299,38 +324,27 @@ class CudaBackend final : public core::Backend {
         if (m_module) m_driver.cuModuleUnload(m_module);
         m_module = nullptr;
         check(m_driver.cuModuleLoadData(&m_module, compiled.cubin.data()), "load the megakernel");
-        check(m_driver.cuModuleGetFunction(&m_kernel, m_module, "lucent_megakernel"),
-              "find lucent_megakernel");
         check(m_driver.cuModuleGetFunction(&m_gather, m_module, "lucent_gather_tiles"),
               "find lucent_gather_tiles");
         size_t bytes = 0;
         check(m_driver.cuModuleGetGlobal(&m_params_global, &bytes, m_module,
                                          "_ZN6lucent3gpu6paramsE"),
               "find the launch parameters");
-        // The launch shapes (launch_shapes.h): for each count of blocks per SM up to what the
-        // registers allow, just the shared memory those blocks need (the runtime's per-thread
-        // state, 5 KB a block) and the rest as L1 for the trace frames in local memory.
         const char* fixed = std::getenv("LUCENT_GPU_CARVEOUT");  // tuning experiments
         m_fixed_shape = fixed != nullptr;
-        int static_shared = 0, reserved = 0, shared_per_sm = 0;
-        m_driver.cuFuncGetAttribute(&static_shared, CU_FUNC_ATTRIBUTE_SHARED_SIZE_BYTES, m_kernel);
-        m_driver.cuDeviceGetAttribute(
-            &reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK, m_device);
-        m_driver.cuDeviceGetAttribute(
-            &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
-        const int by_registers = resident_blocks(100);  // shared memory is no limit at 100 %
-        m_shapes.clear();
-        if (fixed) {
-            m_shapes.push_back({std::atoi(fixed), 0});
-        } else {
-            const SharedMemoryNeeds needs{static_shared, reserved, shared_per_sm};
-            for (int carveout : launch_shape_carveouts(
-                     by_registers, needs, [&](int c) { return resident_blocks(c); }))
-                m_shapes.push_back({carveout, 0});
+        const size_t kernels = m_scene->programs().programs(ProgramKind::kRayGeneration).size();
+        m_kernels.assign(kernels, RayGenerationKernel{});
+        m_kernel = nullptr;
+        m_largest_grid = 1;
+        for (size_t i = 0; i < kernels; ++i) {
+            RayGenerationKernel& k = m_kernels[i];
+            const std::string name = ray_generation_kernel(int(i));
+            check(m_driver.cuModuleGetFunction(&k.function, m_module, name.c_str()),
+                  ("find " + name).c_str());
+            k.shapes = launch_shapes(k.function, fixed);
+            for (const LaunchShape& shape : k.shapes)
+                m_largest_grid = std::max(m_largest_grid, shape.grid);
         }
-        for (LaunchShape& shape : m_shapes)
-            shape.grid = resident_blocks(shape.carveout) * m_sm_count;
-        m_applied = {-1, 0};
         m_tuning.clear();
         // Recursion (trace from closest hit) runs on the thread's stack: one frame per depth.
         size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
@@ -346,24 +360,59 @@ class CudaBackend final : public core::Backend {
         return ptr;
     }
 
-    /// Blocks of the megakernel resident per SM with this carveout.
-    int resident_blocks(int carveout) {
+    /// A ray-generation program's kernel and its launch shapes (launch_shapes.h).
+    struct RayGenerationKernel {
+        CUfunction function = nullptr;
+        std::vector<LaunchShape> shapes{LaunchShape{}};  // shape 0: occupancy first
+        LaunchShape applied{-1, 0};
+    };
+
+    /// The launch shapes of `kernel` (launch_shapes.h): for each count of blocks per SM up to
+    /// what its registers allow, just the shared memory those blocks need (the runtime's
+    /// per-thread state, 6 KB a block) and the rest as L1 for the trace frames in local
+    /// memory; only `fixed` (LUCENT_GPU_CARVEOUT) when it is set.
+    std::vector<LaunchShape> launch_shapes(CUfunction kernel, const char* fixed) {
+        int static_shared = 0, reserved = 0, shared_per_sm = 0;
+        m_driver.cuFuncGetAttribute(&static_shared, CU_FUNC_ATTRIBUTE_SHARED_SIZE_BYTES, kernel);
+        m_driver.cuDeviceGetAttribute(
+            &reserved, CU_DEVICE_ATTRIBUTE_RESERVED_SHARED_MEMORY_PER_BLOCK, m_device);
+        m_driver.cuDeviceGetAttribute(
+            &shared_per_sm, CU_DEVICE_ATTRIBUTE_MAX_SHARED_MEMORY_PER_MULTIPROCESSOR, m_device);
+        std::vector<LaunchShape> shapes;
+        if (fixed) {
+            shapes.push_back({std::atoi(fixed), 0});
+        } else {
+            // Shared memory is no limit at a carveout of 100 %.
+            const int by_registers = resident_blocks(kernel, 100);
+            const SharedMemoryNeeds needs{static_shared, reserved, shared_per_sm};
+            for (int carveout : launch_shape_carveouts(
+                     by_registers, needs, [&](int c) { return resident_blocks(kernel, c); }))
+                shapes.push_back({carveout, 0});
+        }
+        for (LaunchShape& shape : shapes)
+            shape.grid = resident_blocks(kernel, shape.carveout) * m_sm_count;
+        return shapes;
+    }
+
+    /// Blocks of `kernel` resident per SM with this carveout (which it leaves set: the
+    /// kernel's applied shape is reset by launch_shapes' caller).
+    int resident_blocks(CUfunction kernel, int carveout) {
         check(m_driver.cuFuncSetAttribute(
-                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, carveout),
+                  kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, carveout),
               "set the shared memory carveout");
-        m_applied = {-1, 0};
         int blocks = 0;
-        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, m_kernel, kBlock, 0),
+        check(m_driver.cuOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, kernel, kBlock, 0),
               "occupancy");
         return std::max(1, blocks);
     }
 
-    void apply_shape(const LaunchShape& shape) {
-        if (shape.carveout == m_applied.carveout) return;
-        check(m_driver.cuFuncSetAttribute(
-                  m_kernel, CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT, shape.carveout),
+    void apply_shape(RayGenerationKernel& kernel, const LaunchShape& shape) {
+        if (shape.carveout == kernel.applied.carveout) return;
+        check(m_driver.cuFuncSetAttribute(kernel.function,
+                                          CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
+                                          shape.carveout),
               "set the shared memory carveout");
-        m_applied = shape;
+        kernel.applied = shape;
     }
 
     const DriverApi& m_driver;
@@ -379,20 +428,23 @@ class CudaBackend final : public core::Backend {
     std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
     CUcontext m_context = nullptr;
     CUmodule m_module = nullptr;
-    CUfunction m_kernel = nullptr, m_gather = nullptr;
+    std::vector<RayGenerationKernel> m_kernels;  // by ray-generation program (ProgramTable id)
+    RayGenerationKernel* m_kernel = nullptr;      // the current launch's
+    int m_largest_grid = 1;                       // of every kernel's shapes
+    CUfunction m_gather = nullptr;
     CUdeviceptr m_params_global = 0;
     std::string m_device_name, m_source;
     int m_sm = 0, m_sm_count = 0;
     std::unique_ptr<GpuScene> m_scene;
     std::unique_ptr<DisplayEncoder> m_display;  // made by the first display_frame
-    std::vector<LaunchShape> m_shapes{LaunchShape{}};  // shape 0: occupancy first
-    LaunchShape m_applied{-1, 0};
     bool m_fixed_shape = false;
     std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
     const core::CompiledScene* m_last_scene = nullptr;
     uint64_t m_last_generation = 0;
     DeviceBuffer m_counters, m_exceptions, m_scratch;
     CUevent m_start = nullptr, m_stop = nullptr;
+    gpu::LaunchParams* m_params_host = nullptr;      // page-locked
+    gpu::GpuExceptionSlot* m_slots_host = nullptr;  // page-locked, kGpuExceptionSlots
 };
 
 /// The tile counter and the tile owners live on the first GPU; the others reach them by

@@ -57,6 +57,7 @@ Loaded load() {
     LUCENT_LOAD(cuMemAllocHost, "cuMemAllocHost_v2")
     LUCENT_LOAD(cuMemFreeHost, "cuMemFreeHost")
     LUCENT_LOAD(cuMemcpyDtoHAsync, "cuMemcpyDtoHAsync_v2")
+    LUCENT_LOAD(cuMemcpyHtoDAsync, "cuMemcpyHtoDAsync_v2")
     LUCENT_LOAD(cuMemcpyDtoDAsync, "cuMemcpyDtoDAsync_v2")
     LUCENT_LOAD(cuEventCreate, "cuEventCreate")
     LUCENT_LOAD(cuEventDestroy, "cuEventDestroy_v2")

@@ -34,6 +34,7 @@ struct DriverApi {
     LUCENT_CU_FN(cuMemAllocHost)
     LUCENT_CU_FN(cuMemFreeHost)
     LUCENT_CU_FN(cuMemcpyDtoHAsync)
+    LUCENT_CU_FN(cuMemcpyHtoDAsync)
     LUCENT_CU_FN(cuMemcpyDtoDAsync)
     LUCENT_CU_FN(cuEventCreate)
     LUCENT_CU_FN(cuEventDestroy)

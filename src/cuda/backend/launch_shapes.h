@@ -35,9 +35,11 @@ struct SharedMemoryNeeds {
 std::vector<int> launch_shape_carveouts(int by_registers, const SharedMemoryNeeds& needs,
                                         const std::function<int(int)>& resident_blocks);
 
-/// Per entry point and launch size: launch 1 runs shape 0 (and warms up), launches 2 to n
-/// shapes 1 to n - 1, launch n + 1 shape 0 again; from then on, the fastest of those n, per
-/// launch index (a device of several runs a different share of each launch).
+/// Per entry point and launch size: launches 1 and 2 run shape 0 (the first warms up, the
+/// second is timed), launches 3 to n + 1 shapes 1 to n - 1; from then on, the fastest of
+/// those n, per launch index (a device of several runs a different share of each launch).
+/// Trials start at the third launch so that a job launching an entry twice (a denoiser's
+/// ping-pong passes in one render) never runs a trial shape.
 class ShapeTuning {
   public:
     explicit ShapeTuning(size_t shapes = 1) : m_ms(shapes == 0 ? 1 : shapes, 0.0) {}

@@ -47,8 +47,7 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
 namespace {
 const char* kind_function(ProgramKind kind) {
     switch (kind) {
-        case ProgramKind::kRayGeneration:
-            return "__device__ void dispatch_ray_generation(int id, const void* rec)";
+        // Ray generation has no switch: a kernel per program (ray_generation_kernel).
         case ProgramKind::kException:
             return "__device__ void dispatch_exception(int id, const void* rec, const "
                    "ExceptionInfo& ex)";
@@ -74,8 +73,6 @@ const char* kind_function(ProgramKind kind) {
 }
 const char* kind_call(ProgramKind kind) {
     switch (kind) {
-        case ProgramKind::kRayGeneration:
-            return "invoke(&::%s, rec)";
         case ProgramKind::kException:
             return "invoke(&::%s, rec, ex)";
         case ProgramKind::kMiss:
@@ -185,6 +182,10 @@ ModuleSourceList bound_module_sources(
     return modules;
 }
 
+std::string ray_generation_kernel(int id) {
+    return "lucent_ray_generation_" + std::to_string(id);
+}
+
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
                                 const ModuleSourceList& modules) {
     std::ostringstream out;
@@ -223,7 +224,11 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
     }
     out << "}  // namespace lucent::gpu\n\n";
     generate_callables(out, table.programs(ProgramKind::kCallable));
-    out << "\n#include \"lucent_gpu/trace.cuh\"\n";
+    out << "\n#include \"lucent_gpu/trace.cuh\"\n\n";
+    const auto& ray_generations = table.programs(ProgramKind::kRayGeneration);
+    for (size_t i = 0; i < ray_generations.size(); ++i)
+        out << "LUCENT_GPU_RAY_GENERATION_KERNEL(" << ray_generation_kernel(int(i)) << ", ::"
+            << ray_generations[i]->scope << ray_generations[i]->name << ")\n";
     return out.str();
 }
 

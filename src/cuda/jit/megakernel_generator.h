@@ -56,6 +56,10 @@ ModuleSourceList bound_module_sources(
     const ProgramTable& table,
     const std::map<const ModuleInfo*, std::shared_ptr<const ModuleSource>>& given);
 
+/// The name of the kernel that runs ray-generation program `id` (ProgramTable's numbering):
+/// the megakernel has one per bound ray-generation program, each calling it directly.
+std::string ray_generation_kernel(int id);
+
 /// The megakernel source, including every module of `modules` (bound_module_sources).
 std::string generate_megakernel(const ProgramTable& table, const KernelShape& shape,
                                 const ModuleSourceList& modules);

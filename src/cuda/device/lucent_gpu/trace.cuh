@@ -393,18 +393,28 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion 
 
 }  // namespace lucent
 
-/// The megakernel: persistent threads take launch indices from a global counter, a warp's
-/// worth at a time (Aila and Laine 2009), and run the ray-generation program on each. One
-/// kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole rows
-/// (row = z * height + y) when the launch has more than one, counted by its own `counter`
-/// (pieces may run at once, one filling the SMs another's tail leaves idle). Several GPUs
-/// may share one counter (peer atomics): each then writes `device` into `owners[tile]` for
-/// the tiles it takes, so each can gather the others' tiles (gather.cuh).
-extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)
-    lucent_megakernel(unsigned long long piece_first, unsigned long long piece_last,
-                      unsigned long long* counter, unsigned char* owners, unsigned device) {
-    using namespace lucent;
-    using namespace lucent::gpu;
+namespace lucent::gpu {
+/// The megakernel's body: persistent threads take launch indices from a global counter, a
+/// warp's worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
+/// One kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole
+/// rows (row = z * height + y) when the launch has more than one, counted by its own
+/// `counter` (pieces may run at once, one filling the SMs another's tail leaves idle).
+/// Several GPUs may share one counter (peer atomics): each then writes `device` into
+/// `owners[tile]` for the tiles it takes, so each can gather the others' tiles (gather.cuh).
+///
+/// `run_ray_generation(record)` calls one ray-generation program directly: the generator
+/// emits one kernel per bound ray-generation program (LUCENT_GPU_RAY_GENERATION_KERNEL
+/// below), so each kernel holds only the code its program reaches. trace_ray and
+/// occluded_ray are not inlined, so the traversal is compiled once for all of them; a
+/// program that traces nothing (a denoiser's filter) gets a kernel with its own, small
+/// register count and full occupancy instead of the tracing kernels' (docs/architecture.md,
+/// "One kernel per ray-generation program").
+template <class RunRayGeneration>
+__device__ __forceinline__ void run_launch(RunRayGeneration run_ray_generation,
+                                           unsigned long long piece_first,
+                                           unsigned long long piece_last,
+                                           unsigned long long* counter, unsigned char* owners,
+                                           unsigned device) {
     ThreadState& s = self();
     const LaunchParams& p = params;
     const unsigned lane = threadIdx.x & 31u;
@@ -458,7 +468,7 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
 #else
         s.print_here = 0;
 #endif
-        dispatch_ray_generation(p.ray_generation.id, record(p.ray_generation));
+        run_ray_generation(record(p.ray_generation));
         if (s.exception_code) {
             int code = s.exception_code;
             count_exception(code, linear);
@@ -476,5 +486,17 @@ extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BL
         }
     }
 }
+}  // namespace lucent::gpu
+
+/// The kernel of one ray-generation program `program` (its qualified name), named `kernel`;
+/// the backend launches the kernel of the entry point's program.
+#define LUCENT_GPU_RAY_GENERATION_KERNEL(kernel, program)                                      \
+    extern "C" __global__ void __launch_bounds__(LUCENT_GPU_BLOCK, LUCENT_GPU_MIN_BLOCKS)      \
+        kernel(unsigned long long piece_first, unsigned long long piece_last,                  \
+               unsigned long long* counter, unsigned char* owners, unsigned device) {          \
+        ::lucent::gpu::run_launch(                                                              \
+            [](const void* rec) { ::lucent::gpu::invoke(&program, rec); }, piece_first,         \
+            piece_last, counter, owners, device);                                              \
+    }
 
 #include "lucent_gpu/gather.cuh"
