@@ -445,6 +445,33 @@ TEST_F(MotionTest, SetMatrixAndSetCentersMakeTheObjectStaticAgain) {
     const auto r = cast(t, {down(5, 0, 0.5f), down(1, 0, 0.5f)});
     EXPECT_EQ(r[0].hit, 1);
     EXPECT_EQ(r[1].hit, 0);
+
+    auto g = ctx.create_geometry_spheres();
+    g->set_motion_centers({input_buffer(ctx, std::vector<float3>{make_float3(0, 0, 0)}),
+                           input_buffer(ctx, std::vector<float3>{make_float3(2, 0, 0)})});
+    g->set_radii(input_buffer(ctx, std::vector<float>{0.5f}));
+    EXPECT_EQ(g->motion_buffers().size(), 2u);
+    g->set_centers(input_buffer(ctx, std::vector<float3>{make_float3(3, 0, 0)}));
+    EXPECT_TRUE(g->motion_buffers().empty());
+    const auto s = cast(sphere_group(g, 1), {down(3, 0, 0.5f), down(1, 0, 0.5f)});
+    EXPECT_EQ(s[0].hit, 1);
+    EXPECT_EQ(s[1].hit, 0);
+}
+
+TEST_F(MotionTest, MovingGeometryRebuildsWhenAKeyBufferChanges) {
+    // The BVH boxes the keys: new contents in a key buffer must rebuild it, or the sphere
+    // would be culled where it now is.
+    auto k1 = input_buffer(ctx, std::vector<float3>{make_float3(2, 0, 0)});
+    auto g = ctx.create_geometry_spheres();
+    g->set_motion_centers({input_buffer(ctx, std::vector<float3>{make_float3(0, 0, 0)}), k1});
+    g->set_radii(input_buffer(ctx, std::vector<float>{0.5f}));
+    auto top = beside_static(sphere_group(g, 1));
+    EXPECT_EQ(cast(top, {down(1, 0, 0.5f)})[0].hit, 1);
+    k1->upload(std::vector<float3>{make_float3(0, 6, 0)});
+    const auto r = cast(top, {down(1, 0, 0.5f), down(0, 3, 0.5f), down(0, 6, 1.0f)});
+    EXPECT_EQ(r[0].hit, 0);
+    EXPECT_EQ(r[1].hit, 1);
+    EXPECT_EQ(r[2].hit, 1);
 }
 
 }  // namespace

@@ -196,7 +196,7 @@ class GeometryBase : public ContextObject, public VariableScope {
     /// Stores checked motion keys (two or more buffers, a valid time range).
     void set_motion_buffers(std::vector<std::shared_ptr<Buffer>> keys, const MotionOptions& options,
                             const char* what);
-    void set_motion_buffers_static() { m_motion_buffers.clear(); }
+    void clear_motion_buffers() { m_motion_buffers.clear(); }
 
   private:
     unsigned m_flags = kGeometryFlagNone;

@@ -282,7 +282,7 @@ void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     require(vertices, *this, "vertex buffer");
     require_1d_buffer_of(*vertices, type_info_of<float3>(), *this, "vertices", "float3");
     m_vertices = std::move(vertices);
-    set_motion_buffers_static();
+    clear_motion_buffers();
     changed();
 }
 void GeometryTriangles::set_motion_vertices(std::vector<std::shared_ptr<Buffer>> keys,
@@ -326,7 +326,7 @@ void GeometrySpheres::set_centers(std::shared_ptr<Buffer> centers) {
     require(centers, *this, "centre buffer");
     require_1d_buffer_of(*centers, type_info_of<float3>(), *this, "centres", "float3");
     m_centers = std::move(centers);
-    set_motion_buffers_static();
+    clear_motion_buffers();
     changed();
 }
 void GeometrySpheres::set_motion_centers(std::vector<std::shared_ptr<Buffer>> keys,
