@@ -39,13 +39,15 @@ class MotionTest : public testing::Test {
     }
     std::shared_ptr<GeometryGroup> sphere_group(std::shared_ptr<GeometryBase> g, unsigned id) {
         return make_geometry_group(
-            ctx, {make_instance(ctx, std::move(g),
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(motion_sphere_hit)), id))});
+            ctx, {make_instance(
+                     ctx, std::move(g),
+                     make_material(ctx, program(ctx, LUCENT_PROGRAM(motion_sphere_hit)), id))});
     }
     std::shared_ptr<GeometryGroup> triangle_group(std::shared_ptr<GeometryBase> g, unsigned id) {
         return make_geometry_group(
-            ctx, {make_instance(ctx, std::move(g),
-                                make_material(ctx, program(ctx, LUCENT_PROGRAM(motion_triangle_hit)), id))});
+            ctx, {make_instance(
+                     ctx, std::move(g),
+                     make_material(ctx, program(ctx, LUCENT_PROGRAM(motion_triangle_hit)), id))});
     }
     /// A Group holding `node` and, far away, a static sphere: the Group's BVH must bound
     /// the motion for `node` to be found.
@@ -106,10 +108,10 @@ TEST_F(MotionTest, MatrixKeysMoveTheChildLinearlyAndClampOutsideTheRange) {
     t->set_child(sphere_group(spheres({make_float3(0, 0, 0)}, 0.5f), 7));
     const std::vector<Matrix4x3> keys{translation(0, 0, 0), translation(2, 0, 0)};
     t->set_motion_matrices(keys);
-    const auto r = cast(beside_static(t), {down(1, 0, 0.5f), down(1, 0, 0.0f), down(1, 0, 1.0f),
-                                           down(0, 0, 0.0f), down(2, 0, 1.0f),
-                                           down(0, 0, -1.0f), down(2, 0, 2.0f), down(0, 0, 0.5f),
-                                           down(1.4f, 0, 0.5f)});
+    const auto r =
+        cast(beside_static(t), {down(1, 0, 0.5f), down(1, 0, 0.0f), down(1, 0, 1.0f),
+                                down(0, 0, 0.0f), down(2, 0, 1.0f), down(0, 0, -1.0f),
+                                down(2, 0, 2.0f), down(0, 0, 0.5f), down(1.4f, 0, 0.5f)});
     EXPECT_EQ(r[0].hit, 1);
     EXPECT_EQ(r[0].id, 7u);
     EXPECT_NEAR(r[0].t, 4.5f, kEps);
@@ -240,10 +242,10 @@ TEST_F(MotionTest, MovingSphereCentresInterpolateAtTheRayTime) {
                            input_buffer(ctx, std::vector<float3>{make_float3(2, 0, 0)})},
                           MotionOptions{0.0f, 1.0f, kMotionFlagEndVanish});
     g->set_radii(input_buffer(ctx, std::vector<float>{0.5f}));
-    const auto r = cast(beside_static(sphere_group(g, 5)),
-                        {down(1, 0, 0.5f), down(1, 0, 0.0f), down(1.4f, 0, 0.5f),
-                         down(0, 0, -2.0f), down(2, 0, 1.0f), down(2, 0, 1.01f),
-                         down(1, 0, 0.5f, 1), down(1, 0, 0.0f, 1)});
+    const auto r =
+        cast(beside_static(sphere_group(g, 5)),
+             {down(1, 0, 0.5f), down(1, 0, 0.0f), down(1.4f, 0, 0.5f), down(0, 0, -2.0f),
+              down(2, 0, 1.0f), down(2, 0, 1.01f), down(1, 0, 0.5f, 1), down(1, 0, 0.0f, 1)});
     EXPECT_EQ(r[0].hit, 1);
     EXPECT_EQ(r[0].id, 5u);
     EXPECT_NEAR(r[0].t, 4.5f, kEps);
@@ -280,8 +282,10 @@ TEST_F(MotionTest, MovingTrianglesInterpolateTheirVerticesAtTheRayTime) {
 
 TEST_F(MotionTest, MovingTriangleNormalsFollowTheInterpolatedVertices) {
     // One triangle whose third vertex rises: at time 0.5 its plane has slope 1 in y.
-    const std::vector<float3> k0{make_float3(-1, -1, 0), make_float3(1, -1, 0), make_float3(0, 1, 0)};
-    const std::vector<float3> k1{make_float3(-1, -1, 0), make_float3(1, -1, 0), make_float3(0, 1, 4)};
+    const std::vector<float3> k0{make_float3(-1, -1, 0), make_float3(1, -1, 0),
+                                 make_float3(0, 1, 0)};
+    const std::vector<float3> k1{make_float3(-1, -1, 0), make_float3(1, -1, 0),
+                                 make_float3(0, 1, 4)};
     auto g = ctx.create_geometry_triangles();
     g->set_motion_vertices({input_buffer(ctx, k0), input_buffer(ctx, k1)});
     const auto r = cast(triangle_group(g, 4), {down(0, 0, 0.5f)});
@@ -314,7 +318,8 @@ TEST_F(MotionTest, ManyMovingSpheresAgreeWithTheirAnalyticPositions) {
     const std::vector<Matrix4x3> keys{translation(0, 0, 0), translation(0, 3, 0)};
     t->set_motion_matrices(keys);
     std::vector<MotionRay> rays;
-    for (int i = 0; i < 2000; ++i) rays.push_back(down(u(rng) * 1.5f, u(rng) * 1.5f + 1.5f, time(rng)));
+    for (int i = 0; i < 2000; ++i)
+        rays.push_back(down(u(rng) * 1.5f, u(rng) * 1.5f + 1.5f, time(rng)));
     const auto r = cast(beside_static(t), rays);
     int hits = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
@@ -367,7 +372,8 @@ TEST_F(MotionJitTest, EveryKindOfMotionCompilesAsAMegakernelForSm90) {
                                  input_buffer(ctx, std::vector<float3>{make_float3(2, 0, 0)})});
     spheres->set_radii(input_buffer(ctx, std::vector<float>{0.5f}));
     auto triangles = ctx.create_geometry_triangles();
-    triangles->set_motion_vertices({input_buffer(ctx, square_at(-1.0f)), input_buffer(ctx, square_at(-2.0f))});
+    triangles->set_motion_vertices(
+        {input_buffer(ctx, square_at(-1.0f)), input_buffer(ctx, square_at(-2.0f))});
     auto srt_node = ctx.create_transform();
     srt_node->set_child(sphere_group(spheres, 1));
     const std::vector<SrtData> keys{srt(1, make_float3(0.0f), make_float4(0, 0, 0, 1)),
@@ -391,11 +397,17 @@ TEST_F(MotionTest, BadMotionKeysAndRangesAreRefusedWithTheFix) {
     const std::vector<Matrix4x3> one{translation(0, 0, 0)};
     expect_error([&] { t->set_motion_matrices(one); }, {"at least 2 keys"});
     const std::vector<Matrix4x3> two{translation(0, 0, 0), translation(1, 0, 0)};
-    expect_error([&] { t->set_motion_matrices(two, MotionOptions{1.0f, 1.0f}); },
-                 {"time_begin < time_end"});
+    expect_error(
+        [&] {
+            t->set_motion_matrices(two, MotionOptions{1.0f, 1.0f});
+        },
+        {"time_begin < time_end"});
     expect_error([&] { t->set_motion_matrices(two, MotionOptions{0.0f, NAN}); }, {"finite times"});
-    expect_error([&] { t->set_motion_matrices(two, MotionOptions{0.0f, 1.0f, 4u}); },
-                 {"unknown flag"});
+    expect_error(
+        [&] {
+            t->set_motion_matrices(two, MotionOptions{0.0f, 1.0f, 4u});
+        },
+        {"unknown flag"});
     const std::vector<Matrix4x3> nan{translation(0, 0, 0), translation(NAN, 0, 0)};
     expect_error([&] { t->set_motion_matrices(nan); }, {"non-finite"});
     const std::vector<SrtData> zero_q{srt(1, make_float3(0.0f), make_float4(0, 0, 0, 1)),

@@ -148,8 +148,8 @@ void bind_nodes(py::module_& m) {
             [](Transform& t, const py::handle& keys, float time_begin, float time_end,
                unsigned flags) {
                 py::ssize_t count = 0;
-                py::array_t<float> a = float32_array(keys, "Transform.set_motion_matrices",
-                                                     "keys", {-1, 3, 4}, "K", count);
+                py::array_t<float> a = float32_array(keys, "Transform.set_motion_matrices", "keys",
+                                                     {-1, 3, 4}, "K", count);
                 std::vector<Matrix4x3> m(static_cast<size_t>(count));
                 std::memcpy(m.data(), a.data(), m.size() * sizeof(Matrix4x3));
                 t.set_motion_matrices(m, MotionOptions{time_begin, time_end, flags});
@@ -163,8 +163,8 @@ void bind_nodes(py::module_& m) {
             [](Transform& t, const py::handle& keys, float time_begin, float time_end,
                unsigned flags) {
                 py::ssize_t count = 0;
-                py::array_t<float> a = float32_array(keys, "Transform.set_motion_srt", "keys",
-                                                     {-1, 16}, "K", count);
+                py::array_t<float> a =
+                    float32_array(keys, "Transform.set_motion_srt", "keys", {-1, 16}, "K", count);
                 std::vector<SrtData> k(static_cast<size_t>(count));
                 std::memcpy(k.data(), a.data(), k.size() * sizeof(SrtData));
                 t.set_motion_srt(k, MotionOptions{time_begin, time_end, flags});

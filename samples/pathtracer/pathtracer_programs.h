@@ -255,9 +255,9 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
         prd.nee = rec.nee && depth + 1 < rec.max_depth ? 1u : 0u;
         prd.done = 0;
         prd.delta = 0;
-        lucent::trace(rec.top_object,
-                      lucent::make_ray(origin, direction, kRadianceRay, 0.0f, lucent::kInfinity, time),
-                      prd);
+        lucent::trace(
+            rec.top_object,
+            lucent::make_ray(origin, direction, kRadianceRay, 0.0f, lucent::kInfinity, time), prd);
         rng = prd.rng;
         if (max_component(prd.emitted) > 0.0f) {
             // An emitter found by BSDF sampling: MIS against light sampling from the last

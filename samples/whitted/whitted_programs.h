@@ -244,10 +244,10 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
             // To the point light itself: no surface there to stop short of.
             const float3 origin =
                 sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
-            lucent::trace(rec.top_shadower,
-                          lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance,
-                                           lucent::ray_time()),
-                          shadow_prd);
+            lucent::trace(
+                rec.top_shadower,
+                lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance, lucent::ray_time()),
+                shadow_prd);
             light_attenuation = shadow_prd.attenuation;
         }
         if (max_component(light_attenuation) <= 0.0f) continue;
@@ -288,8 +288,9 @@ LUCENT_HD inline float3 facing_world_normal(const HitAttributes& attr) {
 
 /// Colour seen along the camera ray through image-plane point (sx, sy) in [-1, 1]^2.
 /// At `time` (the secondary rays inherit it: the whole ray tree sees one instant).
-LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, const sample_common::PinholeCamera& c,
-                                      float sx, float sy, float time) {
+LUCENT_HD inline float3 camera_sample(const CameraRecord& rec,
+                                      const sample_common::PinholeCamera& c, float sx, float sy,
+                                      float time) {
     float3 direction = normalize(sx * c.U + sy * c.V + c.W);
     RadiancePayload prd;
     prd.result = make_float3(0.0f);

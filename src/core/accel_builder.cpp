@@ -162,7 +162,7 @@ Aabb motion_transform_bounds(const runtime::MotionRange& m, const float* motion,
         float radius = 0.0f;
         for (const float* key : {a, b}) {
             Matrix4x3 s{};  // S alone: the scale/shear with the pivot
-            const float entries[12] = {key[0], key[1], key[2], key[3], 0.0f, key[4],
+            const float entries[12] = {key[0], key[1], key[2], key[3], 0.0f,   key[4],
                                        key[5], key[6], 0.0f,   0.0f,   key[7], key[8]};
             std::memcpy(s.m, entries, sizeof s.m);
             const Aabb scaled = transformed_box(s, child);

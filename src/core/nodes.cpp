@@ -179,7 +179,7 @@ void Transform::set_motion_srt(std::span<const SrtData> keys, const MotionOption
     std::vector<float> flat;
     for (size_t k = 0; k < keys.size(); ++k) {
         const SrtData& d = keys[k];
-        const float v[16] = {d.sx, d.a,  d.b,  d.pvx, d.sy, d.c,  d.pvy, d.sz,
+        const float v[16] = {d.sx,  d.a,  d.b,  d.pvx, d.sy, d.c,  d.pvy, d.sz,
                              d.pvz, d.qx, d.qy, d.qz,  d.qw, d.tx, d.ty,  d.tz};
         for (float x : v)
             if (!std::isfinite(x))

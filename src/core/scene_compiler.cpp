@@ -31,8 +31,8 @@ void compile_transform_motion(const Transform& t, CompiledScene& scene, Compiled
     for (unsigned k = 0; k < count; ++k) {
         Matrix4x3 key, inverse;
         if (srt)
-            key = runtime::srt_to_matrix(runtime::srt_at(keys.data(), std::min(k, count - 2),
-                                                         k == count - 1 ? 1.0f : 0.0f));
+            key = runtime::srt_to_matrix(
+                runtime::srt_at(keys.data(), std::min(k, count - 2), k == count - 1 ? 1.0f : 0.0f));
         else
             std::copy(keys.begin() + 12 * k, keys.begin() + 12 * (k + 1), key.m);
         if (!invert_affine(key, inverse))

@@ -41,8 +41,8 @@ LUCENT_HD inline bool motion_key(const MotionRange& m, float time, unsigned& key
     if (time > m.time_end && (m.flags & kMotionFlagEndVanish)) return false;
     const float last = float(m.keys - 1);
     // Clamped into [0, keys - 1]; a NaN time lands on the first key (lc_max(NaN, 0) is 0).
-    const float s = lc_min(lc_max((time - m.time_begin) / (m.time_end - m.time_begin) * last, 0.0f),
-                           last);
+    const float s =
+        lc_min(lc_max((time - m.time_begin) / (m.time_end - m.time_begin) * last, 0.0f), last);
     const unsigned whole = unsigned(s);
     key = whole < m.keys - 2 ? whole : m.keys - 2;
     frac = s - float(key);
@@ -76,9 +76,10 @@ LUCENT_HD inline bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
     const float det = m[0] * c00 + m[1] * c01 + m[2] * c02;
     if (!(fabsf(det) > 1e-20f)) return false;
     const float id = 1.0f / det;
-    const float r[9] = {c00 * id, (m[2] * m[9] - m[1] * m[10]) * id, (m[1] * m[6] - m[2] * m[5]) * id,
-                        c01 * id, (m[0] * m[10] - m[2] * m[8]) * id, (m[2] * m[4] - m[0] * m[6]) * id,
-                        c02 * id, (m[1] * m[8] - m[0] * m[9]) * id,  (m[0] * m[5] - m[1] * m[4]) * id};
+    const float r[9] = {
+        c00 * id, (m[2] * m[9] - m[1] * m[10]) * id, (m[1] * m[6] - m[2] * m[5]) * id,
+        c01 * id, (m[0] * m[10] - m[2] * m[8]) * id, (m[2] * m[4] - m[0] * m[6]) * id,
+        c02 * id, (m[1] * m[8] - m[0] * m[9]) * id,  (m[0] * m[5] - m[1] * m[4]) * id};
     for (int row = 0; row < 3; ++row) {
         inv.m[row * 4 + 0] = r[row * 3 + 0];
         inv.m[row * 4 + 1] = r[row * 3 + 1];
@@ -92,9 +93,11 @@ LUCENT_HD inline bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
 LUCENT_HD inline Matrix4x3 srt_to_matrix(const SrtData& k) {
     // R of the unit quaternion (x, y, z, w).
     const float x = k.qx, y = k.qy, z = k.qz, w = k.qw;
-    const float r[9] = {1.0f - 2.0f * (y * y + z * z), 2.0f * (x * y - z * w), 2.0f * (x * z + y * w),
-                        2.0f * (x * y + z * w), 1.0f - 2.0f * (x * x + z * z), 2.0f * (y * z - x * w),
-                        2.0f * (x * z - y * w), 2.0f * (y * z + x * w), 1.0f - 2.0f * (x * x + y * y)};
+    const float r[9] = {1.0f - 2.0f * (y * y + z * z), 2.0f * (x * y - z * w),
+                        2.0f * (x * z + y * w),        2.0f * (x * y + z * w),
+                        1.0f - 2.0f * (x * x + z * z), 2.0f * (y * z - x * w),
+                        2.0f * (x * z - y * w),        2.0f * (y * z + x * w),
+                        1.0f - 2.0f * (x * x + y * y)};
     // S, upper triangular, with the pivot as its translation.
     const float s[12] = {k.sx, k.a, k.b, k.pvx, 0.0f, k.sy, k.c, k.pvy, 0.0f, 0.0f, k.sz, k.pvz};
     const float t[3] = {k.tx, k.ty, k.tz};

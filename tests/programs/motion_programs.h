@@ -17,12 +17,12 @@ struct MotionRay {
 };
 
 struct MotionPayload {
-    int hit;          // -1: neither program ran, 0: miss, 1: closest hit
-    unsigned id;      // the closest hit's `id` variable
-    float t;          // t_hit() in the closest hit
-    float time;       // ray_time() in the closest hit or the miss program
-    unsigned prim;    // primitive_index()
-    float3 normal;    // the attributes' object-space normal
+    int hit;        // -1: neither program ran, 0: miss, 1: closest hit
+    unsigned id;    // the closest hit's `id` variable
+    float t;        // t_hit() in the closest hit
+    float time;     // ray_time() in the closest hit or the miss program
+    unsigned prim;  // primitive_index()
+    float3 normal;  // the attributes' object-space normal
     unsigned occluded;
     float generation_time;  // ray_time() in the ray-generation program (outside a trace)
 };
