@@ -20,7 +20,7 @@ fi
 # Only the suites scripts/gpu-check.sh runs on the GPU (the carry is 64 MiB).
 # LUCENT_BUNDLE_SUITES="igi whitted" bundles those alone, LUCENT_BUNDLE_SUITES= none, and
 # LUCENT_BUNDLE_EXAMPLES=0 leaves the examples out: a quicker bundle for one measurement.
-suites=${LUCENT_BUNDLE_SUITES-"programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf spheres curves textures igi_dielectric scale soak gltf whitted backend igi radiosity direct emitters_textures
+suites=${LUCENT_BUNDLE_SUITES-"programs device_api nodes variables exceptions validation occlusion ray_control motion denoise svgf spheres curves textures igi_dielectric scale soak gltf whitted backend igi radiosity direct emitters_textures
         fog pathtracer hair multi_device gpu_bvh_builder display modules"}
 targets="lucent_cli lucent_embed_module"
 python=0  # the Python module: its objects travel, and gpu-check.sh's `python` step links it there

@@ -85,7 +85,7 @@ PY
     ;;
 tests)
     # Each test alone, so a crash is pinned on one test and the others still run.
-    for t in programs device_api nodes variables exceptions validation occlusion ray_control denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer hair modules; do
+    for t in programs device_api nodes variables exceptions validation occlusion ray_control motion denoise svgf gltf whitted backend igi radiosity direct emitters_textures fog pathtracer hair modules; do
         echo "== ${t}_test on the GPU"
         pass=0; fail=0
         for name in $($R $B/bin/${t}_test --gtest_list_tests | awk '/^[^ ]/ {s=$1} /^  / {print s $1}'); do

@@ -177,5 +177,46 @@ TEST(Whitted, EveryOptionValueRendersWithoutExceptions) {
     }
 }
 
+TEST(Whitted, MotionBlursTheMetalSphereAlongItsPath) {
+    // motion=1 moves the metal sphere by layout.metal_motion over the shutter [0, 1] and
+    // samples a time per camera ray. The point where the sphere's centre ends lies outside
+    // the still sphere (|motion| = 1.2 radii) but inside the moving one for the last two
+    // thirds of the shutter: the pixels around it change. The sky does not, and the render
+    // repeats exactly (times come from a hash of the pixel, not from a clock or a thread).
+    constexpr unsigned kSize = 96;
+    const RenderResult still = render(kSize, {});
+    const RenderResult moving = render(kSize, {{"motion", "1"}});
+    const RenderResult again = render(kSize, {{"motion", "1"}});
+    EXPECT_EQ(moving.report.exception_count(), 0u) << moving.report.summary();
+    ASSERT_EQ(moving.image.pixels.size(), again.image.pixels.size());
+    for (size_t i = 0; i < moving.image.pixels.size(); ++i) {
+        ASSERT_EQ(moving.image.pixels[i].x, again.image.pixels[i].x) << "pixel " << i;
+        ASSERT_EQ(moving.image.pixels[i].y, again.image.pixels[i].y) << "pixel " << i;
+        ASSERT_EQ(moving.image.pixels[i].z, again.image.pixels[i].z) << "pixel " << i;
+    }
+    const float3 sky_still = still.image.pixels[2 * kSize + kSize / 2];
+    const float3 sky_moving = moving.image.pixels[2 * kSize + kSize / 2];
+    EXPECT_EQ(sky_moving.x, sky_still.x);
+    EXPECT_EQ(sky_moving.z, sky_still.z);
+    const WhittedLayout& layout = whitted_layout();
+    const float2 end = whitted_project(layout.metal_center + layout.metal_motion, kSize, kSize);
+    double difference = 0.0;
+    int count = 0;
+    for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+            const float2 p = make_float2(end.x + float(dx), end.y + float(dy));
+            const float3 d = pixel_at(moving.image, p) - pixel_at(still.image, p);
+            difference += std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+            ++count;
+        }
+    EXPECT_GT(difference / count, 0.1) << "the moving sphere does not reach its end point";
+    size_t changed = 0;
+    for (size_t i = 0; i < still.image.pixels.size(); ++i)
+        changed += luminance(still.image.pixels[i]) != luminance(moving.image.pixels[i]);
+    // The sphere, its shadow and its reflections: a part of the image, not all of it.
+    EXPECT_GT(changed, still.image.pixels.size() / 100);
+    EXPECT_LT(changed, still.image.pixels.size() / 3);
+}
+
 }  // namespace
 }  // namespace lucent::samples

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "lucent/buffer.h"
@@ -113,16 +114,44 @@ class Selector : public NodeWithChildren {
     std::shared_ptr<Program> m_visit;
 };
 
-/// One child moved by an affine 4x3 matrix (object to world).
+/// The time range of an object's motion keys (OptiX's OptixMotionOptions; the key count is
+/// the number of keys given): keys are spaced evenly over [time_begin, time_end], and a ray
+/// time outside it sees the first or last key unless `flags` (MotionFlags) say the object
+/// vanishes there. time_begin < time_end, both finite.
+struct MotionOptions {
+    float time_begin = 0.0f;
+    float time_end = 1.0f;
+    unsigned flags = kMotionFlagNone;
+};
+
+/// How a Transform moves its child.
+enum class TransformMotion { kNone, kMatrix, kSrt };
+
+/// One child moved by an affine 4x3 matrix (object to world), or by keys over time.
 class Transform : public Node {
   public:
     Transform(detail::OwnerRef owner, std::string name);
     void set_child(std::shared_ptr<Node> child);
     const std::shared_ptr<Node>& child() const { return m_child; }
     /// Row-major 3x4 (the last row 0 0 0 1 is implied); `transpose` for column-major input.
+    /// Makes the transform static (drops motion keys).
     void set_matrix(const float m[12], bool transpose = false);
     void set_matrix(const Matrix4x3& m) { set_matrix(m.m); }
     const Matrix4x3& matrix() const { return m_matrix; }
+    /// A matrix motion transform (OptiX's OptixMatrixMotionTransform): two or more
+    /// object-to-world keys over `options`' time range, interpolated entry by entry at the
+    /// ray's time (ray_time()) and then inverted. Fewer than two keys, a non-finite entry or
+    /// a bad time range is an Error; a singular key is reported at launch.
+    void set_motion_matrices(std::span<const Matrix4x3> keys, const MotionOptions& options = {});
+    /// A scale-rotation-translation motion transform (OptiX's OptixSRTMotionTransform): two
+    /// or more SrtData keys, interpolated per component, the quaternion by normalised linear
+    /// interpolation. A key whose quaternion has length 0 is an Error, as above.
+    void set_motion_srt(std::span<const SrtData> keys, const MotionOptions& options = {});
+    TransformMotion motion() const { return m_motion; }
+    const MotionOptions& motion_options() const { return m_motion_options; }
+    /// The keys as given: 12 floats per matrix key, 16 per SRT key.
+    const std::vector<float>& motion_keys() const { return m_motion_keys; }
+    unsigned motion_key_count() const;
     /// A user id that hit programs below read with instance_id() (default 0; OptiX's
     /// OptixInstance::instanceId). Of nested Transforms, the innermost's is read.
     void set_instance_id(unsigned id);
@@ -132,6 +161,9 @@ class Transform : public Node {
     std::shared_ptr<Node> m_child;
     Matrix4x3 m_matrix;
     unsigned m_instance_id = 0;
+    TransformMotion m_motion = TransformMotion::kNone;
+    MotionOptions m_motion_options;
+    std::vector<float> m_motion_keys;
 };
 
 class Material;
@@ -154,12 +186,22 @@ class GeometryBase : public ContextObject, public VariableScope {
     /// kRayFlagEnforceAnyHit. An unknown flag is an error.
     void set_flags(unsigned flags);
     unsigned flags() const { return m_flags; }
+    /// Motion keys of a built-in primitive (GeometryTriangles' vertices, GeometrySpheres'
+    /// centres): one buffer per key, empty when static.
+    const std::vector<std::shared_ptr<Buffer>>& motion_buffers() const { return m_motion_buffers; }
+    const MotionOptions& motion_options() const { return m_motion_options; }
 
   protected:
     void variables_changed() override { changed(); }
+    /// Stores checked motion keys (two or more buffers, a valid time range).
+    void set_motion_buffers(std::vector<std::shared_ptr<Buffer>> keys, const MotionOptions& options,
+                            const char* what);
+    void clear_motion_buffers() { m_motion_buffers.clear(); }
 
   private:
     unsigned m_flags = kGeometryFlagNone;
+    std::vector<std::shared_ptr<Buffer>> m_motion_buffers;
+    MotionOptions m_motion_options;
 };
 
 /// Custom primitives: a bounding-box and an intersection program shared by all of them.
@@ -191,6 +233,12 @@ class GeometryTriangles : public GeometryBase {
     void set_indices(std::shared_ptr<Buffer> indices);
     void set_material_indices(std::shared_ptr<Buffer> material_indices);
     void set_attribute_program(std::shared_ptr<Program> program);
+    /// Motion triangles (OptiX's vertexBuffers with numKeys > 1): one float3 vertex buffer
+    /// per key, each as long as the first, spaced evenly over `options`' time range; a ray
+    /// meets the vertices interpolated linearly at its time. The first key becomes
+    /// vertices(); set_vertices makes the geometry static again.
+    void set_motion_vertices(std::vector<std::shared_ptr<Buffer>> keys,
+                             const MotionOptions& options = {});
     const std::shared_ptr<Buffer>& vertices() const { return m_vertices; }
     const std::shared_ptr<Buffer>& indices() const { return m_indices; }
     const std::shared_ptr<Buffer>& material_indices() const { return m_material_indices; }
@@ -215,6 +263,12 @@ class GeometrySpheres : public GeometryBase {
     void set_centers(std::shared_ptr<Buffer> centers);
     void set_radii(std::shared_ptr<Buffer> radii);
     void set_material_indices(std::shared_ptr<Buffer> material_indices);
+    /// Moving spheres (OptiX's vertexBuffers with numKeys > 1): one float3 centre buffer per
+    /// key, each as long as the first, spaced evenly over `options`' time range; a ray meets
+    /// the centres interpolated linearly at its time (the radii stay those of set_radii).
+    /// The first key becomes centers(); set_centers makes the spheres static again.
+    void set_motion_centers(std::vector<std::shared_ptr<Buffer>> keys,
+                            const MotionOptions& options = {});
     const std::shared_ptr<Buffer>& centers() const { return m_centers; }
     const std::shared_ptr<Buffer>& radii() const { return m_radii; }
     const std::shared_ptr<Buffer>& material_indices() const { return m_material_indices; }

@@ -74,6 +74,9 @@ void bind_nodes(py::module_& m) {
         .def("__repr__", [](const TextureSampler& t) { return repr(t); });
 
     // The device API's constants, for records and for Python code that builds flags.
+    m.attr("MOTION_FLAG_NONE") = unsigned(kMotionFlagNone);
+    m.attr("MOTION_FLAG_START_VANISH") = unsigned(kMotionFlagStartVanish);
+    m.attr("MOTION_FLAG_END_VANISH") = unsigned(kMotionFlagEndVanish);
     m.attr("GEOMETRY_FLAG_NONE") = unsigned(kGeometryFlagNone);
     m.attr("GEOMETRY_FLAG_DISABLE_ANYHIT") = unsigned(kGeometryFlagDisableAnyHit);
     m.attr("VISIBILITY_MASK_ALL") = kVisibilityMaskAll;
@@ -139,7 +142,38 @@ void bind_nodes(py::module_& m) {
             },
             "Row-major (3, 4) float32 (a (4, 4) matrix gives its top three rows)")
         .def_property("instance_id", &Transform::instance_id, &Transform::set_instance_id,
-                      "User id that hit programs below read with instance_id() (default 0)");
+                      "User id that hit programs below read with instance_id() (default 0)")
+        .def(
+            "set_motion_matrices",
+            [](Transform& t, const py::handle& keys, float time_begin, float time_end,
+               unsigned flags) {
+                py::ssize_t count = 0;
+                py::array_t<float> a = float32_array(keys, "Transform.set_motion_matrices", "keys",
+                                                     {-1, 3, 4}, "K", count);
+                std::vector<Matrix4x3> m(static_cast<size_t>(count));
+                std::memcpy(m.data(), a.data(), m.size() * sizeof(Matrix4x3));
+                t.set_motion_matrices(m, MotionOptions{time_begin, time_end, flags});
+            },
+            py::arg("keys"), py::arg("time_begin") = 0.0f, py::arg("time_end") = 1.0f,
+            py::arg("flags") = unsigned(kMotionFlagNone),
+            "Matrix motion: (K, 3, 4) float32 object-to-world keys, K >= 2, spaced evenly over "
+            "[time_begin, time_end]; MOTION_FLAG_* say whether the child vanishes outside it")
+        .def(
+            "set_motion_srt",
+            [](Transform& t, const py::handle& keys, float time_begin, float time_end,
+               unsigned flags) {
+                py::ssize_t count = 0;
+                py::array_t<float> a =
+                    float32_array(keys, "Transform.set_motion_srt", "keys", {-1, 16}, "K", count);
+                std::vector<SrtData> k(static_cast<size_t>(count));
+                std::memcpy(k.data(), a.data(), k.size() * sizeof(SrtData));
+                t.set_motion_srt(k, MotionOptions{time_begin, time_end, flags});
+            },
+            py::arg("keys"), py::arg("time_begin") = 0.0f, py::arg("time_end") = 1.0f,
+            py::arg("flags") = unsigned(kMotionFlagNone),
+            "SRT motion: (K, 16) float32 keys (sx, a, b, pvx, sy, c, pvy, sz, pvz, qx, qy, qz, "
+            "qw, tx, ty, tz), K >= 2, as OptiX's OptixSRTData")
+        .def_property_readonly("motion_key_count", &Transform::motion_key_count);
 
     py::class_<GeometryBase, std::shared_ptr<GeometryBase>> geometry_base(m, "GeometryBase");
     geometry_base.def_property_readonly("primitive_count", &GeometryBase::primitive_count)
@@ -166,7 +200,17 @@ void bind_nodes(py::module_& m) {
         .def_property("material_indices", &GeometryTriangles::material_indices,
                       &GeometryTriangles::set_material_indices)
         .def_property("attribute_program", &GeometryTriangles::attribute_program,
-                      &GeometryTriangles::set_attribute_program);
+                      &GeometryTriangles::set_attribute_program)
+        .def(
+            "set_motion_vertices",
+            [](GeometryTriangles& g, std::vector<std::shared_ptr<Buffer>> keys, float time_begin,
+               float time_end, unsigned flags) {
+                g.set_motion_vertices(std::move(keys), MotionOptions{time_begin, time_end, flags});
+            },
+            py::arg("keys"), py::arg("time_begin") = 0.0f, py::arg("time_end") = 1.0f,
+            py::arg("flags") = unsigned(kMotionFlagNone),
+            "Motion triangles: a list of float3 vertex Buffers, one per key (2 or more, equal "
+            "lengths), spaced evenly over [time_begin, time_end]");
 
     py::class_<GeometrySpheres, GeometryBase, std::shared_ptr<GeometrySpheres>>(
         m, "GeometrySpheres",
@@ -176,7 +220,17 @@ void bind_nodes(py::module_& m) {
         .def_property("centers", &GeometrySpheres::centers, &GeometrySpheres::set_centers)
         .def_property("radii", &GeometrySpheres::radii, &GeometrySpheres::set_radii)
         .def_property("material_indices", &GeometrySpheres::material_indices,
-                      &GeometrySpheres::set_material_indices);
+                      &GeometrySpheres::set_material_indices)
+        .def(
+            "set_motion_centers",
+            [](GeometrySpheres& g, std::vector<std::shared_ptr<Buffer>> keys, float time_begin,
+               float time_end, unsigned flags) {
+                g.set_motion_centers(std::move(keys), MotionOptions{time_begin, time_end, flags});
+            },
+            py::arg("keys"), py::arg("time_begin") = 0.0f, py::arg("time_end") = 1.0f,
+            py::arg("flags") = unsigned(kMotionFlagNone),
+            "Moving spheres: a list of float3 centre Buffers, one per key (2 or more, equal "
+            "lengths), spaced evenly over [time_begin, time_end]; the radii stay those of radii");
 
     py::class_<GeometryCurves, GeometryBase, std::shared_ptr<GeometryCurves>>(
         m, "GeometryCurves",

@@ -124,7 +124,9 @@ LUCENT_RECORD(MissRecord, environment)
 /// (sample_common::offset_ray_origin) or `to` a point light: an occlusion query (every
 /// surface opaque, no programs run).
 LUCENT_HD inline bool unoccluded(const SurfaceRecord& rec, float3 from, float3 to) {
-    return !lucent::occluded(rec.top_object, sample_common::segment_ray(from, to, kShadowRay));
+    lucent::Ray ray = sample_common::segment_ray(from, to, kShadowRay);
+    ray.time = lucent::ray_time();  // the path's instant (motion blur)
+    return !lucent::occluded(rec.top_object, ray);
 }
 
 /// next_event's shadow test: is nothing between `from` and `to`? `light` is the index of the
@@ -239,6 +241,9 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
     // A uniformly jittered position in the pixel: the box filter's antialiasing.
     const float sx = 2.0f * (float(i.x) + next_random(rng)) / float(n.x) - 1.0f;
     const float sy = 1.0f - 2.0f * (float(i.y) + next_random(rng)) / float(n.y);
+    // The path's time, uniform over the shutter [0, 1]: every ray of the path sees the scene
+    // at that instant, so moving geometry blurs (a static scene ignores it).
+    const float time = next_random(rng);
     const sample_common::PinholeCamera camera = rec.camera[0u];
     float3 origin = camera.eye, direction = sample_common::camera_direction(camera, sx, sy);
     float3 radiance = make_float3(0.0f), throughput = make_float3(1.0f);
@@ -250,7 +255,9 @@ LUCENT_HD inline void trace_pixel(const CameraRecord& rec) {
         prd.nee = rec.nee && depth + 1 < rec.max_depth ? 1u : 0u;
         prd.done = 0;
         prd.delta = 0;
-        lucent::trace(rec.top_object, lucent::make_ray(origin, direction, kRadianceRay, 0.0f), prd);
+        lucent::trace(
+            rec.top_object,
+            lucent::make_ray(origin, direction, kRadianceRay, 0.0f, lucent::kInfinity, time), prd);
         rng = prd.rng;
         if (max_component(prd.emitted) > 0.0f) {
             // An emitter found by BSDF sampling: MIS against light sampling from the last

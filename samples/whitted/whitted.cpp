@@ -55,13 +55,15 @@ struct WhittedOptions {
     int max_depth = 6;
     int shadows = 1;
     int lights = 1;
+    int motion = 0;
 
     explicit WhittedOptions(const OptionValues& v)
         : antialiasing(v.on("aa")),
           aa_threshold(v.number("aa_threshold")),
           max_depth(v.integer("max_depth")),
           shadows(v.on("shadows")),
-          lights(v.integer("lights")) {}
+          lights(v.integer("lights")),
+          motion(v.on("motion")) {}
 };
 
 /// Up to three white point lights; their colours share one unit of intensity so the
@@ -98,6 +100,7 @@ void check_scene(const RenderSettings& settings) {
 void set_variables(Context& ctx, Program& camera, const WhittedOptions& options) {
     camera["antialiasing"] = options.antialiasing;
     camera["aa_threshold"] = options.aa_threshold;
+    camera["motion"] = options.motion;
     // Radiance rays nest max_depth deep below the camera's; each may cast shadow rays.
     ctx.set_max_recursion_depth(unsigned(options.max_depth) + 2);
     ctx["max_depth"] = options.max_depth;
@@ -247,9 +250,11 @@ Materials create_materials(Context& ctx, const WhittedLayout& layout) {
     return {floor_material, metal_material, glass_material};
 }
 
-/// One instance per shape with its material, in one GeometryGroup.
-std::shared_ptr<GeometryGroup> scene_group(Context& ctx, const WhittedLayout& layout,
-                                           const Shapes& shapes, const Materials& materials) {
+/// One instance per shape with its material, in one GeometryGroup; with motion, the metal
+/// sphere in a GeometryGroup of its own under a matrix motion Transform that moves it by
+/// layout.metal_motion over the shutter [0, 1], beside the rest in a Group.
+std::shared_ptr<Node> scene_group(Context& ctx, const WhittedLayout& layout, const Shapes& shapes,
+                                  const Materials& materials, bool motion) {
     auto floor_instance = ctx.create_geometry_instance();
     floor_instance->set_name("floor");
     floor_instance->set_geometry(shapes.floor);
@@ -270,9 +275,26 @@ std::shared_ptr<GeometryGroup> scene_group(Context& ctx, const WhittedLayout& la
     auto group = ctx.create_geometry_group();
     group->set_name("whitted scene");
     group->add_child(floor_instance);
-    group->add_child(metal_instance);
     group->add_child(glass_instance);
-    return group;
+    if (!motion) {
+        group->add_child(metal_instance);
+        return group;
+    }
+    auto metal_group = ctx.create_geometry_group();
+    metal_group->set_name("moving metal sphere");
+    metal_group->add_child(metal_instance);
+    auto moving = ctx.create_transform();
+    moving->set_name("metal sphere motion");
+    moving->set_child(metal_group);
+    const float3 d = layout.metal_motion;
+    const std::vector<Matrix4x3> keys{identity_matrix(),
+                                      Matrix4x3{{1, 0, 0, d.x, 0, 1, 0, d.y, 0, 0, 1, d.z}}};
+    moving->set_motion_matrices(keys, MotionOptions{0.0f, 1.0f});
+    auto top = ctx.create_group();
+    top->set_name("whitted scene with motion");
+    top->add_child(group);
+    top->add_child(moving);
+    return top;
 }
 
 /// Builds the whole scene of `layout` into `ctx`, the camera program reading `camera` at entry
@@ -282,7 +304,7 @@ std::shared_ptr<Buffer> build_scene(Context& ctx, const WhittedLayout& layout,
                                     unsigned height, const CameraBuffer& camera_buffer) {
     auto output = create_programs(ctx, layout, options, width, height, camera_buffer);
     const Shapes shapes = create_shapes(ctx, layout);
-    auto group = scene_group(ctx, layout, shapes, create_materials(ctx, layout));
+    auto group = scene_group(ctx, layout, shapes, create_materials(ctx, layout), options.motion);
     const std::vector<whitted::BasicLight> lights = make_lights(layout, options.lights);
     auto light_buffer =
         ctx.create_buffer<whitted::BasicLight>(BufferType::kInput, unsigned(lights.size()));
@@ -305,7 +327,7 @@ class WhittedSession final : public CameraSession {
   public:
     WhittedSession(const Sample& sample, const RenderSettings& settings,
                    const WhittedOptions& options)
-        : CameraSession(sample, settings), m_lights(options.lights) {
+        : CameraSession(sample, settings), m_lights(options.lights), m_motion(options.motion) {
         const WhittedLayout& layout = whitted_layout();
         set_output(
             build_scene(context(), layout, options, settings.width, settings.height, camera()));
@@ -316,12 +338,13 @@ class WhittedSession final : public CameraSession {
   private:
     bool apply_options(const OptionValues& values) override {
         const WhittedOptions o(values);
-        if (o.lights != m_lights) return false;
+        if (o.lights != m_lights || o.motion != m_motion) return false;  // a new scene
         set_variables(context(), *m_camera, o);
         return true;
     }
 
     int m_lights;
+    int m_motion;
     std::shared_ptr<Program> m_camera;
 };
 
@@ -346,6 +369,10 @@ class WhittedSample final : public Sample {
                          "shadow rays: 0 = off, 1 = on (glass casts a lighter shadow)"),
                      SampleOption::integer("lights", 1, 1, 3,
                                            "number of point lights, sharing one intensity"),
+                     SampleOption::toggle(
+                         "motion", false,
+                         "motion blur: the metal sphere moves during the shutter (a matrix "
+                         "motion transform) and each camera ray samples a time in it"),
                  }) {}
 
     RenderResult render(const RenderSettings& settings) const override {
@@ -394,6 +421,8 @@ const WhittedLayout& whitted_layout() {
         l.background = make_float3(0.38f, 0.5f, 0.68f);
         l.metal_center = make_float3(2.0f, 1.5f, -2.5f);
         l.metal_radius = 1.0f;
+        // Up by 1.2 radii over the shutter (a bounce), clear of the glass sphere and the frame.
+        l.metal_motion = make_float3(0.0f, 1.2f, 0.0f);
         l.glass_center = make_float3(4.0f, 2.3f, -4.0f);
         l.glass_radius = 1.0f;
         l.glass_thickness = 0.04f;
@@ -425,6 +454,7 @@ WhittedLayout whitted_layout(const Placement& placement) {
     l.floor_height = l.floor_anchor.y;
     l.floor_edge1 = placement.vector(l.floor_edge1);
     l.floor_edge2 = placement.vector(l.floor_edge2);
+    l.metal_motion = placement.vector(l.metal_motion);
     for (float* length : {&l.metal_radius, &l.glass_radius, &l.glass_thickness, &l.size})
         *length = placement.length(*length);
     l.glass_extinction = placement.per_length(l.glass_extinction);

@@ -18,6 +18,7 @@ struct WhittedLayout {
     float3 background;   // the miss program's colour
     float3 metal_center;
     float metal_radius;
+    float3 metal_motion;  // motion=1: the metal sphere's displacement over the shutter [0, 1]
     float3 glass_center;
     float glass_radius;     // outer radius of the shell
     float glass_thickness;  // inner radius = glass_radius - glass_thickness

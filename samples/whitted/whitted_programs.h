@@ -78,8 +78,9 @@ struct CameraRecord {
     Handle top_object;
     int antialiasing;    // 0: one ray per pixel; 1: adaptive 4 → 16 samples
     float aa_threshold;  // colour difference (max channel) that triggers supersampling
+    int motion;          // 1: each camera ray samples a time in the shutter [0, 1]
 };
-LUCENT_RECORD(CameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold)
+LUCENT_RECORD(CameraRecord, camera, output_buffer, top_object, antialiasing, aa_threshold, motion)
 
 struct ExceptionRecord {
     BufferView<float4> output_buffer;
@@ -243,9 +244,10 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
             // To the point light itself: no surface there to stop short of.
             const float3 origin =
                 sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
-            lucent::trace(rec.top_shadower,
-                          lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance),
-                          shadow_prd);
+            lucent::trace(
+                rec.top_shadower,
+                lucent::make_ray(origin, L, kShadowRay, 0.0f, light_distance, lucent::ray_time()),
+                shadow_prd);
             light_attenuation = shadow_prd.attenuation;
         }
         if (max_component(light_attenuation) <= 0.0f) continue;
@@ -268,7 +270,9 @@ LUCENT_HD inline void phong_shade(const Rec& rec, RadiancePayload& prd, float3 K
             float3 R = reflect(dir, normal);
             const float3 origin =
                 sample_common::offset_along_normal(hit_point, normal, rec.scene_size);
-            lucent::trace(rec.top_object, lucent::make_ray(origin, R, kRadianceRay, 0.0f),
+            lucent::trace(rec.top_object,
+                          lucent::make_ray(origin, R, kRadianceRay, 0.0f, lucent::kInfinity,
+                                           lucent::ray_time()),
                           reflected);
             result += reflectivity * reflected.result;
         }
@@ -283,14 +287,18 @@ LUCENT_HD inline float3 facing_world_normal(const HitAttributes& attr) {
 }
 
 /// Colour seen along the camera ray through image-plane point (sx, sy) in [-1, 1]^2.
-LUCENT_HD inline float3 camera_sample(const CameraRecord& rec, const sample_common::PinholeCamera& c,
-                                      float sx, float sy) {
+/// At `time` (the secondary rays inherit it: the whole ray tree sees one instant).
+LUCENT_HD inline float3 camera_sample(const CameraRecord& rec,
+                                      const sample_common::PinholeCamera& c, float sx, float sy,
+                                      float time) {
     float3 direction = normalize(sx * c.U + sy * c.V + c.W);
     RadiancePayload prd;
     prd.result = make_float3(0.0f);
     prd.importance = 1.0f;
     prd.depth = 0;
-    lucent::trace(rec.top_object, lucent::make_ray(c.eye, direction, kRadianceRay, 0.0f), prd);
+    lucent::trace(rec.top_object,
+                  lucent::make_ray(c.eye, direction, kRadianceRay, 0.0f, lucent::kInfinity, time),
+                  prd);
     return prd.result;
 }
 
@@ -305,24 +313,36 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
     uint3 index = lucent::launch_index();
     uint3 size = lucent::launch_size();
     float inv_w = 1.0f / float(size.x), inv_h = 1.0f / float(size.y);
+    // With motion, the one sample of a pixel is at time u in the shutter [0, 1], u from the
+    // pixel's TEA hash; with antialiasing, sample i is at (k_i + u) / 16, k_i the bit-reversed
+    // i, so the first four samples spread over the shutter as the sixteen do (stratified).
+    // 16 rounds: TEA with 4 (Zafar et al.'s cheapest) left horizontal streaks in the time.
+    const float pixel_time =
+        rec.motion ? lucent::tea_unit_float(
+                         lucent::tea<16>(make_uint2(index.x, index.y), lucent::zafar_tea_key()).x)
+                   : 0.0f;
     // Pixel-relative (fx, fy) in [0, 1]^2 → image plane, y up (row 0 at the top).
-    auto sample = [&](float fx, float fy) {
+    auto sample = [&](float fx, float fy, unsigned i) {
         float sx = 2.0f * (float(index.x) + fx) * inv_w - 1.0f;
         float sy = 1.0f - 2.0f * (float(index.y) + fy) * inv_h;
-        return whitted::camera_sample(rec, camera, sx, sy);
+        const unsigned k = ((i & 1u) << 3) | ((i & 2u) << 1) | ((i & 4u) >> 1) | ((i & 8u) >> 3);
+        const float time = !rec.motion        ? 0.0f
+                           : rec.antialiasing ? (float(k) + pixel_time) * (1.0f / 16.0f)
+                                              : pixel_time;
+        return whitted::camera_sample(rec, camera, sx, sy, time);
     };
 
     float3 color;
     if (!rec.antialiasing) {
-        color = sample(0.5f, 0.5f);
+        color = sample(0.5f, 0.5f, 0u);
     } else {
         // Cells (column, row) of the 4x4 grid; the first four form the rotated grid.
         const int kCells[16][2] = {{1, 0}, {3, 1}, {0, 2}, {2, 3}, {0, 0}, {2, 0}, {3, 0}, {0, 1},
                                    {1, 1}, {2, 1}, {1, 2}, {2, 2}, {3, 2}, {0, 3}, {1, 3}, {3, 3}};
         float3 samples[4];
         for (int i = 0; i < 4; ++i)
-            samples[i] =
-                sample((float(kCells[i][0]) + 0.5f) * 0.25f, (float(kCells[i][1]) + 0.5f) * 0.25f);
+            samples[i] = sample((float(kCells[i][0]) + 0.5f) * 0.25f,
+                                (float(kCells[i][1]) + 0.5f) * 0.25f, unsigned(i));
         // Summed in pairs: four equal samples then average to exactly their value.
         float3 sum = (samples[0] + samples[1]) + (samples[2] + samples[3]);
         float3 mean = sum * 0.25f;
@@ -334,7 +354,7 @@ LUCENT_HD inline void render_pixel(const CameraRecord& rec) {
         if (difference > rec.aa_threshold) {
             for (int i = 4; i < 16; ++i)
                 sum += sample((float(kCells[i][0]) + 0.5f) * 0.25f,
-                              (float(kCells[i][1]) + 0.5f) * 0.25f);
+                              (float(kCells[i][1]) + 0.5f) * 0.25f, unsigned(i));
             color = sum * (1.0f / 16.0f);
         } else {
             color = mean;
@@ -532,7 +552,8 @@ LUCENT_CLOSEST_HIT(whitted_glass_radiance, whitted::GlassRecord, whitted::Radian
                 float3 origin =
                     sample_common::offset_along_normal(hit_point, -facing, rec.scene_size);
                 lucent::trace(rec.top_object,
-                              lucent::make_ray(origin, transmitted, whitted::kRadianceRay, 0.0f),
+                              lucent::make_ray(origin, transmitted, whitted::kRadianceRay, 0.0f,
+                                               lucent::kInfinity, lucent::ray_time()),
                               refr);
                 refracted = refr.result;
             }
@@ -551,7 +572,8 @@ LUCENT_CLOSEST_HIT(whitted_glass_radiance, whitted::GlassRecord, whitted::Radian
             refl.depth = prd.depth + 1;
             float3 origin = sample_common::offset_along_normal(hit_point, facing, rec.scene_size);
             lucent::trace(rec.top_object,
-                          lucent::make_ray(origin, reflect(i, n), whitted::kRadianceRay, 0.0f),
+                          lucent::make_ray(origin, reflect(i, n), whitted::kRadianceRay, 0.0f,
+                                           lucent::kInfinity, lucent::ray_time()),
                           refl);
             reflected = refl.result;
         }

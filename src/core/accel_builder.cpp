@@ -1,5 +1,6 @@
 // Acceleration structures of the compiled scene: GeometryGroups are built (or refitted)
 // only when what they are made of changed; Groups are rebuilt each compile (few children).
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <set>
@@ -45,7 +46,34 @@ uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
     return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
 }
 
-Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
+/// The box of a moving triangle or sphere over its whole time range: the union of its keys'
+/// boxes holds it, since each point moves linearly between keys (OptiX's motion AABBs are
+/// per key; one box over all of them trades some culling for one BVH of the usual kind).
+Aabb motion_primitive_box(const CompiledInstance& inst, const float* motion, unsigned prim) {
+    Aabb box = empty_box();
+    const runtime::MotionRange& m = inst.motion;
+    for (unsigned k = 0; k < m.keys; ++k) {
+        // Key k is (k - 1, frac 1) for the last one.
+        const unsigned key = k + 1 < m.keys ? k : k - 1;
+        const float frac = k + 1 < m.keys ? 0.0f : 1.0f;
+        auto point = [&](unsigned i) {
+            return runtime::motion_point(motion, m, inst.motion_points, i, key, frac);
+        };
+        if (inst.triangles()) {
+            const uint3 t = triangle_of(inst, prim);
+            grow(box, point(t.x));
+            grow(box, point(t.y));
+            grow(box, point(t.z));
+        } else {
+            const float3 c = point(prim), r = make_float3(inst.radius(prim));
+            grow(box, Aabb{c - r, c + r});
+        }
+    }
+    return box;
+}
+
+Aabb primitive_box(const CompiledInstance& inst, const float* motion, unsigned prim) {
+    if (runtime::moving(inst.motion)) return motion_primitive_box(inst, motion, prim);
     Aabb box = empty_box();
     if (inst.triangles()) {
         uint3 t = triangle_of(inst, prim);
@@ -90,6 +118,68 @@ Aabb primitive_box(const CompiledInstance& inst, unsigned prim) {
     return box;
 }
 
+/// The box of `child` moved by `m`: the box of its eight corners.
+Aabb transformed_box(const Matrix4x3& m, const Aabb& child) {
+    Aabb box = empty_box();
+    for (int c = 0; c < 8; ++c)
+        grow(box, transform_point(m, make_float3(c & 1 ? child.hi.x : child.lo.x,
+                                                 c & 2 ? child.hi.y : child.lo.y,
+                                                 c & 4 ? child.hi.z : child.lo.z)));
+    return box;
+}
+
+/// The box of `child` under a motion transform, over the whole time range (OptiX's motion
+/// transforms are bounded the same way for the instance above them).
+/// Matrix keys: between two keys every point moves linearly (M(t) x is linear in t), so the
+/// union of the keys' transformed boxes holds it exactly enough.
+/// SRT keys: S(t) and T(t) are linear, but the rotation of the normalised quaternion is not.
+/// Per key interval: when both keys have the same quaternion, R is fixed and the union of
+/// the two keys' boxes holds it as above. Otherwise, conservatively: S(t) x lies in the
+/// union B of the box moved by the two keys' S; a rotation keeps |y|, so R(t) S(t) x lies in
+/// the ball of radius max |corner of B| about the origin; then T(t) adds the box of the two
+/// translations.
+Aabb motion_transform_bounds(const runtime::MotionRange& m, const float* motion,
+                             const Aabb& child) {
+    Aabb box = empty_box();
+    const float* keys = motion + m.offset;
+    for (unsigned k = 0; k + 1 < m.keys; ++k) {
+        if (m.kind == runtime::kMotionMatrix) {
+            for (unsigned j = k; j <= k + 1; ++j) {
+                Matrix4x3 key;
+                std::memcpy(key.m, keys + 12 * j, sizeof key.m);
+                grow(box, transformed_box(key, child));
+            }
+            continue;
+        }
+        const float* a = keys + 16 * k;
+        const float* b = a + 16;
+        if (std::memcmp(a + 9, b + 9, 4 * sizeof(float)) == 0) {
+            for (float frac : {0.0f, 1.0f})
+                grow(box, transformed_box(runtime::srt_to_matrix(runtime::srt_at(keys, k, frac)),
+                                          child));
+            continue;
+        }
+        float radius = 0.0f;
+        for (const float* key : {a, b}) {
+            Matrix4x3 s{};  // S alone: the scale/shear with the pivot
+            const float entries[12] = {key[0], key[1], key[2], key[3], 0.0f,   key[4],
+                                       key[5], key[6], 0.0f,   0.0f,   key[7], key[8]};
+            std::memcpy(s.m, entries, sizeof s.m);
+            const Aabb scaled = transformed_box(s, child);
+            for (int c = 0; c < 8; ++c)
+                radius = std::max(radius, length(make_float3(c & 1 ? scaled.hi.x : scaled.lo.x,
+                                                             c & 2 ? scaled.hi.y : scaled.lo.y,
+                                                             c & 4 ? scaled.hi.z : scaled.lo.z)));
+        }
+        radius *= 1.0f + 0x1p-20f;  // the rotation's roundings
+        for (const float* key : {a, b}) {
+            const float3 t = make_float3(key[13], key[14], key[15]);
+            grow(box, Aabb{t - make_float3(radius), t + make_float3(radius)});
+        }
+    }
+    return box;
+}
+
 const GeometryTriangles* triangles_of(const CompiledInstance& inst) {
     return inst.triangles() ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
                           : nullptr;
@@ -108,6 +198,15 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = m_scene->instances[i];
         structure.add(inst.source).add(inst.type).add(inst.primitive_count).add(inst.bvh_references());
+        // Moving primitives go through the generic BVH, boxed over their keys.
+        structure.add(inst.motion.kind).add(inst.motion.keys);
+        if (runtime::moving(inst.motion)) {
+            triangles_only = false;
+            for (const auto& b : inst.source->geometry()->motion_buffers()) {
+                content.add(b.get()).add(b->version());
+                m_rebuild_inputs.push_back(b.get());
+            }
+        }
         if (const GeometryTriangles* tris = triangles_of(inst)) {
             structure.add(tris->indices().get())
                 .add(tris->indices() ? tris->indices()->version() : 0);
@@ -201,7 +300,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         for (unsigned i : node.instances) {
             const CompiledInstance& inst = m_scene->instances[i];
             for (unsigned p = 0; p < inst.bvh_references(); ++p) {
-                boxes.push_back(primitive_box(inst, p));
+                boxes.push_back(primitive_box(inst, m_scene->motion.data(), p));
                 if (!is_empty(boxes.back())) grow(all, boxes.back());
             }
         }
@@ -227,12 +326,9 @@ Aabb SceneCompiler::node_bounds(unsigned index, std::vector<int>& state) {
         case NodeKind::kTransform: {
             Aabb child = node_bounds(node.children[0], state);
             if (!is_empty(child))
-                for (int c = 0; c < 8; ++c) {
-                    float3 corner = make_float3(c & 1 ? child.hi.x : child.lo.x,
-                                                c & 2 ? child.hi.y : child.lo.y,
-                                                c & 4 ? child.hi.z : child.lo.z);
-                    grow(box, transform_point(node.to_world, corner));
-                }
+                box = runtime::moving(node.motion)
+                          ? motion_transform_bounds(node.motion, m_scene->motion.data(), child)
+                          : transformed_box(node.to_world, child);
             break;
         }
         case NodeKind::kGroup:

@@ -13,6 +13,7 @@
 #include "lucent/device/curve_intersect.h"
 #include "lucent/device/program.h"
 #include "lucent/module.h"
+#include "runtime/motion.h"
 
 namespace lucent::core {
 
@@ -78,6 +79,10 @@ struct CompiledInstance {
     // control point.
     const unsigned* segments = nullptr;
     CurveType curve_type = kCurveCubicBSpline;
+    /// Motion keys (kMotionVertices: triangles' vertices or spheres' centres per key, in
+    /// CompiledScene::motion), or kMotionNone; `motion_points` per key.
+    runtime::MotionRange motion{};
+    unsigned motion_points = 0;
     bool triangles() const { return type == PrimitiveType::kTriangles; }
     /// The primitives of the group's BVH this instance adds: one per primitive, but
     /// curve_references(type) per curve segment, each boxing part of it.
@@ -110,7 +115,8 @@ struct CompiledNode {
     std::shared_ptr<GeometryAccel> geometry;  // GeometryGroup
     accel::Bvh child_bvh;                     // Group: over children's boxes
     bool brute_force = false;                 // Builder::kNone
-    Matrix4x3 to_world{}, to_object{};        // Transform
+    Matrix4x3 to_world{}, to_object{};        // Transform (a motion Transform: its first key)
+    runtime::MotionRange motion{};            // Transform: its keys, or kMotionNone
     CompiledProgram visit;                    // Selector
     Aabb bounds{};
     unsigned visibility_mask = kVisibilityMaskAll;
@@ -149,6 +155,10 @@ struct CompiledScene {
     std::vector<CompiledProgram> miss;  // per ray type
     std::vector<CompiledNode> nodes;
     std::vector<CompiledInstance> instances;
+    /// Every motion key of the scene's Transforms and built-in primitives, as floats
+    /// (runtime::MotionRange::offset points in here).
+    std::vector<float> motion;
+    bool has_motion() const { return !motion.empty(); }
     std::vector<CompiledProgram> callables;  // bound through variables; their records are the
                                              // targets of Callable::record
     unsigned max_depth = 8;

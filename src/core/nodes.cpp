@@ -51,6 +51,23 @@ void require_visibility_mask(const ContextObject& owner, unsigned mask) {
         throw Error(owner.describe() + ": visibility mask 0x" + hex(mask) +
                     " has more than 8 bits; pass a mask in 0x00..0xff");
 }
+/// Error unless `options` is a usable motion time range.
+void require_motion_options(const ContextObject& owner, const MotionOptions& options) {
+    if (!std::isfinite(options.time_begin) || !std::isfinite(options.time_end) ||
+        !(options.time_begin < options.time_end))
+        throw Error(owner.describe() + ": the motion time range [" +
+                    std::to_string(options.time_begin) + ", " + std::to_string(options.time_end) +
+                    "] is not valid; give finite times with time_begin < time_end");
+    if (options.flags & ~unsigned(kMotionFlagStartVanish | kMotionFlagEndVanish))
+        throw Error(owner.describe() + ": motion flags 0x" + hex(options.flags) +
+                    " include an unknown flag; the flags are kMotionFlagNone, "
+                    "kMotionFlagStartVanish and kMotionFlagEndVanish");
+}
+void require_motion_key_count(const ContextObject& owner, size_t count) {
+    if (count < 2)
+        throw Error(owner.describe() + ": motion needs at least 2 keys, got " +
+                    std::to_string(count) + "; for a static object set it without motion");
+}
 std::string index_error(const ContextObject& owner, const char* what, unsigned index,
                         size_t count) {
     return owner.describe() + ": " + what + " index " + std::to_string(index) +
@@ -139,7 +156,58 @@ void Transform::set_child(std::shared_ptr<Node> child) {
     m_child = std::move(child);
     changed();
 }
+void Transform::set_motion_matrices(std::span<const Matrix4x3> keys, const MotionOptions& options) {
+    require_motion_key_count(*this, keys.size());
+    require_motion_options(*this, options);
+    std::vector<float> flat;
+    for (size_t k = 0; k < keys.size(); ++k)
+        for (float v : keys[k].m) {
+            if (!std::isfinite(v))
+                throw Error(describe() + ": motion key " + std::to_string(k) +
+                            " has a non-finite entry (NaN or infinity); give finite matrices");
+            flat.push_back(v);
+        }
+    m_motion = TransformMotion::kMatrix;
+    m_motion_options = options;
+    m_motion_keys = std::move(flat);
+    m_matrix = keys[0];
+    changed();
+}
+void Transform::set_motion_srt(std::span<const SrtData> keys, const MotionOptions& options) {
+    require_motion_key_count(*this, keys.size());
+    require_motion_options(*this, options);
+    std::vector<float> flat;
+    for (size_t k = 0; k < keys.size(); ++k) {
+        const SrtData& d = keys[k];
+        const float v[16] = {d.sx,  d.a,  d.b,  d.pvx, d.sy, d.c,  d.pvy, d.sz,
+                             d.pvz, d.qx, d.qy, d.qz,  d.qw, d.tx, d.ty,  d.tz};
+        for (float x : v)
+            if (!std::isfinite(x))
+                throw Error(describe() + ": SRT key " + std::to_string(k) +
+                            " has a non-finite component (NaN or infinity); give finite keys");
+        if (!(d.qx * d.qx + d.qy * d.qy + d.qz * d.qz + d.qw * d.qw > 0.0f))
+            throw Error(describe() + ": SRT key " + std::to_string(k) +
+                        " has a zero quaternion; give a unit quaternion (qw = 1 for none)");
+        flat.insert(flat.end(), v, v + 16);
+    }
+    m_motion = TransformMotion::kSrt;
+    m_motion_options = options;
+    m_motion_keys = std::move(flat);
+    changed();
+}
+unsigned Transform::motion_key_count() const {
+    switch (m_motion) {
+        case TransformMotion::kMatrix:
+            return unsigned(m_motion_keys.size() / 12);
+        case TransformMotion::kSrt:
+            return unsigned(m_motion_keys.size() / 16);
+        default:
+            return 0;
+    }
+}
 void Transform::set_matrix(const float m[12], bool transpose) {
+    m_motion = TransformMotion::kNone;
+    m_motion_keys.clear();
     // Non-finite or singular matrices are reported at validate/launch, where the message
     // can say which node in the graph it is; here we only store.
     if (!transpose) {
@@ -163,6 +231,24 @@ void GeometryBase::set_flags(unsigned flags) {
                     "kGeometryFlagDisableAnyHit");
     m_flags = flags;
     changed();
+}
+
+void GeometryBase::set_motion_buffers(std::vector<std::shared_ptr<Buffer>> keys,
+                                      const MotionOptions& options, const char* what) {
+    require_motion_key_count(*this, keys.size());
+    require_motion_options(*this, options);
+    for (size_t k = 0; k < keys.size(); ++k) {
+        const std::string label = std::string(what) + " of motion key " + std::to_string(k);
+        require(keys[k], *this, label.c_str());
+        require_same_context(keys[k], *this);
+        require_1d_buffer_of(*keys[k], type_info_of<float3>(), *this, label.c_str(), "float3");
+        if (keys[k]->count() != keys[0]->count())
+            throw Error(describe() + ": motion key " + std::to_string(k) + " has " +
+                        std::to_string(keys[k]->count()) + " " + what + " but key 0 has " +
+                        std::to_string(keys[0]->count()) + "; give every key the same count");
+    }
+    m_motion_buffers = std::move(keys);
+    m_motion_options = options;
 }
 
 std::string Geometry::describe() const {
@@ -196,6 +282,13 @@ void GeometryTriangles::set_vertices(std::shared_ptr<Buffer> vertices) {
     require(vertices, *this, "vertex buffer");
     require_1d_buffer_of(*vertices, type_info_of<float3>(), *this, "vertices", "float3");
     m_vertices = std::move(vertices);
+    clear_motion_buffers();
+    changed();
+}
+void GeometryTriangles::set_motion_vertices(std::vector<std::shared_ptr<Buffer>> keys,
+                                            const MotionOptions& options) {
+    set_motion_buffers(std::move(keys), options, "vertices");
+    m_vertices = motion_buffers()[0];
     changed();
 }
 void GeometryTriangles::set_indices(std::shared_ptr<Buffer> indices) {
@@ -233,6 +326,13 @@ void GeometrySpheres::set_centers(std::shared_ptr<Buffer> centers) {
     require(centers, *this, "centre buffer");
     require_1d_buffer_of(*centers, type_info_of<float3>(), *this, "centres", "float3");
     m_centers = std::move(centers);
+    clear_motion_buffers();
+    changed();
+}
+void GeometrySpheres::set_motion_centers(std::vector<std::shared_ptr<Buffer>> keys,
+                                         const MotionOptions& options) {
+    set_motion_buffers(std::move(keys), options, "centres");
+    m_centers = motion_buffers()[0];
     changed();
 }
 void GeometrySpheres::set_radii(std::shared_ptr<Buffer> radii) {

@@ -14,25 +14,70 @@ std::string ray_type_label(const ContextState& s, unsigned r) {
     return "ray type " + std::to_string(r) + " ('" + s.ray_types[r].name + "')";
 }
 
-/// Inverse of an affine 4x3 matrix; false when singular.
-bool invert_affine(const Matrix4x3& a, Matrix4x3& inv) {
-    const float* m = a.m;
-    float c00 = m[5] * m[10] - m[6] * m[9], c01 = m[6] * m[8] - m[4] * m[10],
-          c02 = m[4] * m[9] - m[5] * m[8];
-    float det = m[0] * c00 + m[1] * c01 + m[2] * c02;
-    if (!(std::fabs(det) > 1e-20f)) return false;
-    float id = 1.0f / det;
-    float r[9] = {c00 * id, (m[2] * m[9] - m[1] * m[10]) * id, (m[1] * m[6] - m[2] * m[5]) * id,
-                  c01 * id, (m[0] * m[10] - m[2] * m[8]) * id, (m[2] * m[4] - m[0] * m[6]) * id,
-                  c02 * id, (m[1] * m[8] - m[0] * m[9]) * id,  (m[0] * m[5] - m[1] * m[4]) * id};
-    for (int row = 0; row < 3; ++row) {
-        float t = -(r[row * 3] * m[3] + r[row * 3 + 1] * m[7] + r[row * 3 + 2] * m[11]);
-        inv.m[row * 4 + 0] = r[row * 3 + 0];
-        inv.m[row * 4 + 1] = r[row * 3 + 1];
-        inv.m[row * 4 + 2] = r[row * 3 + 2];
-        inv.m[row * 4 + 3] = t;
+using runtime::invert_affine;
+
+/// Appends `values` to the scene's motion array; returns where they start.
+unsigned append_motion(CompiledScene& scene, const float* values, size_t count) {
+    const unsigned offset = unsigned(scene.motion.size());
+    scene.motion.insert(scene.motion.end(), values, values + count);
+    return offset;
+}
+
+/// A motion Transform's keys into the scene: each key must be invertible.
+void compile_transform_motion(const Transform& t, CompiledScene& scene, CompiledNode& c) {
+    const std::vector<float>& keys = t.motion_keys();
+    const unsigned count = t.motion_key_count();
+    const bool srt = t.motion() == TransformMotion::kSrt;
+    for (unsigned k = 0; k < count; ++k) {
+        Matrix4x3 key, inverse;
+        if (srt)
+            key = runtime::srt_to_matrix(
+                runtime::srt_at(keys.data(), std::min(k, count - 2), k == count - 1 ? 1.0f : 0.0f));
+        else
+            std::copy(keys.begin() + 12 * k, keys.begin() + 12 * (k + 1), key.m);
+        if (!invert_affine(key, inverse))
+            throw Error(t.describe() + ": motion key " + std::to_string(k) +
+                        " is singular (scale 0?); give invertible keys");
+        if (k == 0) c.to_world = key, c.to_object = inverse;
     }
-    return true;
+    const MotionOptions& o = t.motion_options();
+    c.motion.kind = srt ? runtime::kMotionSrt : runtime::kMotionMatrix;
+    c.motion.keys = count;
+    c.motion.flags = o.flags;
+    c.motion.time_begin = o.time_begin;
+    c.motion.time_end = o.time_end;
+    c.motion.offset = append_motion(scene, keys.data(), keys.size());
+}
+
+/// A built-in primitive's motion keys (vertices or centres) into the scene: every key as
+/// long as the first, every coordinate finite.
+void compile_geometry_motion(const GeometryBase& g, CompiledScene& scene, CompiledInstance& out) {
+    const auto& buffers = g.motion_buffers();
+    if (buffers.empty()) return;
+    const size_t points = buffers[0]->count();
+    std::vector<float> flat;
+    flat.reserve(points * 3 * buffers.size());
+    for (size_t k = 0; k < buffers.size(); ++k) {
+        if (buffers[k]->count() != points)
+            throw Error(g.describe() + ": motion key " + std::to_string(k) + " has " +
+                        std::to_string(buffers[k]->count()) + " points but key 0 has " +
+                        std::to_string(points) + "; give every key the same count");
+        const float3* p = buffers[k]->data<float3>();
+        for (size_t i = 0; i < points; ++i) {
+            if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y) || !std::isfinite(p[i].z))
+                throw Error(g.describe() + ": point " + std::to_string(i) + " of motion key " +
+                            std::to_string(k) + " is not finite; fix the key's buffer");
+            flat.insert(flat.end(), {p[i].x, p[i].y, p[i].z});
+        }
+    }
+    const MotionOptions& o = g.motion_options();
+    out.motion.kind = runtime::kMotionVertices;
+    out.motion.keys = unsigned(buffers.size());
+    out.motion.flags = o.flags;
+    out.motion.time_begin = o.time_begin;
+    out.motion.time_end = o.time_end;
+    out.motion.offset = append_motion(scene, flat.data(), flat.size());
+    out.motion_points = unsigned(points);
 }
 }  // namespace
 
@@ -158,6 +203,7 @@ void SceneCompiler::compile_node(unsigned index) {
             c.to_world = t.matrix();
             c.to_object = inverse;
             c.instance_id = t.instance_id();
+            if (t.motion() != TransformMotion::kNone) compile_transform_motion(t, *m_scene, c);
             break;
         }
         case NodeKind::kGeometryGroup: {
@@ -224,6 +270,7 @@ void SceneCompiler::compile_instance(unsigned index) {
         out.bounding_box = pack(custom.bounding_box_program(), geometry_scope, gi.describe());
         out.attributes = out.intersection.desc->attributes;
     }
+    compile_geometry_motion(geometry, *m_scene, out);
     if (out.attributes->size > kMaxAttributeBytes)
         throw Error(gi.describe() + ": attribute type " + std::string(out.attributes->name) +
                     " is " + std::to_string(out.attributes->size) + " bytes; the engine allows " +

@@ -55,6 +55,10 @@ struct CpuPolicy {
     }
     void triangle(const Instance& inst, unsigned prim, float3& p0, float3& p1, float3& p2) const {
         const uint3 t = triangle_of(inst, prim);
+        if (runtime::moving(inst.motion)) {  // at the time of the trace being shaded
+            moving_triangle(inst, t, frame_time(), p0, p1, p2);
+            return;
+        }
         p0 = inst.vertices[t.x];
         p1 = inst.vertices[t.y];
         p2 = inst.vertices[t.z];
@@ -101,6 +105,19 @@ struct CpuPolicy {
     }
     void traverse_frame(runtime::TraceFrame<CpuPolicy>& frame, Handle root) const;
 
+    inline float frame_time() const;  // the innermost trace's ray time
+    /// A moving triangle's vertices at `time`; false when it is absent then.
+    bool moving_triangle(const Instance& inst, uint3 t, float time, float3& p0, float3& p1,
+                         float3& p2) const {
+        unsigned key;
+        float frac;
+        const bool present = runtime::motion_key(inst.motion, time, key, frac);
+        const float* motion = scene().motion.data();
+        p0 = runtime::motion_point(motion, inst.motion, inst.motion_points, t.x, key, frac);
+        p1 = runtime::motion_point(motion, inst.motion, inst.motion_points, t.y, key, frac);
+        p2 = runtime::motion_point(motion, inst.motion, inst.motion_points, t.z, key, frac);
+        return present;
+    }
     static uint3 triangle_of(const Instance& inst, unsigned prim) {
         return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
     }
@@ -134,6 +151,9 @@ inline void set_launch_index(ThreadState& ts, uint3 index) {
 
 inline const core::CompiledScene& CpuPolicy::scene() const {
     return *ts->scene;
+}
+inline float CpuPolicy::frame_time() const {
+    return ts->frame->world_ray.time;
 }
 
 /// The calling thread's state (set by the launch loop).

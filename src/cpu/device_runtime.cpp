@@ -40,19 +40,19 @@ namespace detail {
 // (called out of line, it re-read the ray just stored here with wider loads: the same
 // store-forwarding stall as across the program's call).
 [[gnu::flatten]] void trace_fields(Handle root, float3 origin, float3 direction, float tmin,
-                                   float tmax, unsigned ray_type, void* payload,
+                                   float tmax, unsigned ray_type, float time, void* payload,
                                    const void* payload_tag, unsigned ray_flags,
                                    unsigned visibility_mask) {
-    const Ray ray{origin, tmin, direction, tmax, ray_type};
+    const Ray ray{origin, tmin, direction, tmax, ray_type, time};
     if ((ray_flags | (visibility_mask ^ kVisibilityMaskAll)) != 0) cpu::require_ray_flags_declared();
     runtime::trace(runtime::backend(), root, ray, payload, payload_tag, ray_flags,
                    visibility_mask);
 }
 
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type, unsigned occlusion, unsigned ray_flags,
+                     unsigned ray_type, float time, unsigned occlusion, unsigned ray_flags,
                      unsigned visibility_mask) {
-    const Ray ray{origin, tmin, direction, tmax, ray_type};
+    const Ray ray{origin, tmin, direction, tmax, ray_type, time};
     if ((ray_flags | (visibility_mask ^ kVisibilityMaskAll)) != 0) cpu::require_ray_flags_declared();
     return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion), ray_flags,
                          visibility_mask);

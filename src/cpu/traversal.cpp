@@ -57,10 +57,22 @@ class Traverser {
     }
 
     void transform(const CompiledNode& n, float3 origin, float3 direction) {
+        if (runtime::moving(n.motion)) {
+            // The keys interpolated at the ray's time; nothing below when it vanished.
+            Matrix4x3 to_world, to_object;
+            if (runtime::motion_transform_at(m_scene.motion.data(), n.motion,
+                                             m_frame.world_ray.time, to_world, to_object))
+                enter(n, to_world, to_object, origin, direction);
+            return;
+        }
+        enter(n, n.to_world, n.to_object, origin, direction);
+    }
+    void enter(const CompiledNode& n, const Matrix4x3& to_world, const Matrix4x3& to_object,
+               float3 origin, float3 direction) {
         const runtime::SavedTransform saved =
-            runtime::enter_transform(m_frame, n.to_world, n.to_object, n.instance_id);
-        node(n.children[0], transform_point(n.to_object, origin),
-             transform_vector(n.to_object, direction));
+            runtime::enter_transform(m_frame, to_world, to_object, n.instance_id);
+        node(n.children[0], transform_point(to_object, origin),
+             transform_vector(to_object, direction));
         runtime::leave_transform(m_frame, saved);
     }
 
@@ -111,15 +123,23 @@ class Traverser {
             const CompiledInstance& inst = m_scene.instances[n.instances[k]];
             if (inst.triangles()) {
                 uint3 tri = CpuPolicy::triangle_of(inst, local);
+                float3 p0 = inst.vertices[tri.x], p1 = inst.vertices[tri.y],
+                       p2 = inst.vertices[tri.z];
+                if (runtime::moving(inst.motion) &&
+                    !m_policy.moving_triangle(inst, tri, m_frame.world_ray.time, p0, p1, p2))
+                    return false;
                 float t, u, v;
-                if (intersect_triangle_watertight(wray, inst.vertices[tri.x], inst.vertices[tri.y],
-                                                  inst.vertices[tri.z], tmin, m_frame.closest, t, u,
-                                                  v))
+                if (intersect_triangle_watertight(wray, p0, p1, p2, tmin, m_frame.closest, t, u, v))
                     runtime::triangle_candidate(m_policy, m_frame, n.instances[k], local, t,
                                                 make_float2(u, v));
             } else if (inst.type == PrimitiveType::kSpheres) {
+                float3 center = inst.centers[local];
+                if (runtime::moving(inst.motion) &&
+                    !runtime::motion_center(m_scene.motion.data(), inst.motion, inst.motion_points,
+                                            local, m_frame.world_ray.time, center))
+                    return false;
                 runtime::sphere_candidates(m_policy, m_frame, n.instances[k], local, origin,
-                                           direction, inst.centers[local], inst.radius(local));
+                                           direction, center, inst.radius(local));
             } else if (inst.type == PrimitiveType::kCurves) {
                 runtime::curve_candidates(m_policy, m_frame, n.instances[k], local, origin,
                                           direction, inst.curve_type, inst.vertices, inst.radii,

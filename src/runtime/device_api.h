@@ -10,6 +10,9 @@ namespace lucent {
 LUCENT_HD const Ray& current_ray() {
     return runtime::current_ray(runtime::backend());
 }
+LUCENT_HD float ray_time() {
+    return runtime::current_ray(runtime::backend()).time;
+}
 LUCENT_HD float t_hit() {
     return runtime::t_hit(runtime::backend());
 }

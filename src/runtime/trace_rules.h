@@ -27,6 +27,7 @@
 #include "lucent/device/api.h"
 #include "lucent/device/curve_intersect.h"
 #include "lucent/device/sphere_intersect.h"
+#include "runtime/motion.h"
 #include "runtime/trace_frame.h"
 
 // The GPU's tuning: these run inside trace_ray's frame (inlined, as they were written

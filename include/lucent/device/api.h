@@ -69,10 +69,10 @@ LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const vo
 // the caller's stores cannot be forwarded from the store buffer: that stall cost about a
 // tenth of a primary ray's time on Sponza (perf, 2026-12).
 void trace_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                  unsigned ray_type, void* payload, const void* payload_tag, unsigned ray_flags,
+                  unsigned ray_type, float time, void* payload, const void* payload_tag, unsigned ray_flags,
                   unsigned visibility_mask);
 bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
-                     unsigned ray_type, unsigned occlusion, unsigned ray_flags,
+                     unsigned ray_type, float time, unsigned occlusion, unsigned ray_flags,
                      unsigned visibility_mask);
 #endif
 #if LUCENT_GPU_CODE
@@ -99,6 +99,10 @@ LUCENT_HD uint4 device_tea_key();
 /// The ray being traced, in the space of the current program (object space in
 /// intersection, any-hit and visit programs below a Transform; world space elsewhere).
 LUCENT_HD const Ray& current_ray();
+/// The current ray's time (OptiX's optixGetRayTime): the `time` its trace() or occluded()
+/// was given, at which moving geometry and motion transforms were intersected. 0 outside a
+/// trace. Pass it on to secondary rays (make_ray's `time`) so they see the same instant.
+LUCENT_HD float ray_time();
 /// Parametric distance of the current hit (closest so far inside intersection programs).
 LUCENT_HD float t_hit();
 /// Primitive index of the current hit, or of the primitive being intersected.
@@ -139,7 +143,7 @@ LUCENT_HD void trace(Handle root, const Ray& ray, Payload& payload, unsigned ray
                          ray_flags, visibility_mask);
 #else
     detail::trace_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax, ray.ray_type,
-                         &payload, &detail::TypeTag<Payload>::id, ray_flags, visibility_mask);
+                         ray.time, &payload, &detail::TypeTag<Payload>::id, ray_flags, visibility_mask);
 #endif
 }
 /// trace() with no ray flags, visiting everything.
@@ -220,7 +224,8 @@ inline bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kE
                      unsigned ray_flags = kRayFlagNone,
                      unsigned visibility_mask = kVisibilityMaskAll) {
     return detail::occluded_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
-                                   ray.ray_type, unsigned(test), ray_flags, visibility_mask);
+                                   ray.ray_type, ray.time, unsigned(test), ray_flags,
+                                   visibility_mask);
 }
 #endif
 

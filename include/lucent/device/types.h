@@ -8,23 +8,27 @@ namespace lucent {
 
 constexpr float kInfinity = 1e30f;  // "no upper bound" for ray intervals
 
-/// A ray: origin, direction (not necessarily unit), ray type and the interval [tmin, tmax].
+/// A ray: origin, direction (not necessarily unit), ray type, the interval [tmin, tmax] and
+/// its time (OptiX's rayTime): where moving geometry and motion transforms are taken. Time
+/// 0 by default; scenes without motion ignore it.
 struct Ray {
     float3 origin;
     float tmin;
     float3 direction;
     float tmax;
     unsigned ray_type;
+    float time;
 };
 
 LUCENT_HD inline Ray make_ray(float3 origin, float3 direction, unsigned ray_type, float tmin,
-                              float tmax = kInfinity) {
+                              float tmax = kInfinity, float time = 0.0f) {
     Ray r;
     r.origin = origin;
     r.direction = direction;
     r.tmin = tmin;
     r.tmax = tmax;
     r.ray_type = ray_type;
+    r.time = time;
     return r;
 }
 
@@ -66,6 +70,26 @@ LUCENT_HD inline float3 transform_normal_by_inverse(const Matrix4x3& inv, float3
                        inv.m[1] * n.x + inv.m[5] * n.y + inv.m[9] * n.z,
                        inv.m[2] * n.x + inv.m[6] * n.y + inv.m[10] * n.z);
 }
+
+/// Flags of a motion range (MotionOptions, OptiX's OptixMotionFlags): outside [time_begin,
+/// time_end] an object is held at its first or last key (clamped) unless its flag says it
+/// vanishes there.
+enum MotionFlags : unsigned {
+    kMotionFlagNone = 0,
+    kMotionFlagStartVanish = 1u << 0,  // absent for times before time_begin
+    kMotionFlagEndVanish = 1u << 1,    // absent for times after time_end
+};
+
+/// One key of a scale-rotation-translation motion transform (OptiX's OptixSRTData): the
+/// key's object-to-world transform is T * R * S, where S is the upper-triangular
+/// scale/shear matrix with the pivot as its translation column,
+///     S = [sx a b pvx; 0 sy c pvy; 0 0 sz pvz],
+/// R rotates by the unit quaternion (qx, qy, qz, qw) and T translates by (tx, ty, tz).
+/// Between keys every component is interpolated linearly, the quaternion by normalised
+/// linear interpolation (nlerp), as OptiX does.
+struct SrtData {
+    float sx, a, b, pvx, sy, c, pvy, sz, pvz, qx, qy, qz, qw, tx, ty, tz;
+};
 
 /// Engine exception codes; user codes start at kUserExceptionBase.
 enum ExceptionCode : int {

@@ -221,6 +221,8 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
             g.material_indices =
                 reinterpret_cast<const unsigned*>(device_pointer(curves.material_indices()));
         }
+        g.motion = inst.motion;
+        g.motion_points = inst.motion_points;
         g.material_offset = unsigned(flat.materials.size() / std::max(1u, ray_types));
         g.material_count = unsigned(inst.materials.size());
         for (const core::CompiledMaterial& m : inst.materials)
@@ -242,6 +244,7 @@ void GpuScene::flatten_nodes(const core::CompiledScene& scene, FlatScene& flat) 
         g.visit = add_program(n.visit);
         g.to_world = n.to_world;
         g.to_object = n.to_object;
+        g.motion = n.motion;
         g.visibility_mask = n.visibility_mask;
         g.instance_id = n.instance_id;
         g.accel = ~0u;
@@ -319,6 +322,7 @@ void GpuScene::upload(const core::CompiledScene& scene, const FlatScene& flat) {
     for (const RayTypeDesc& r : scene.ray_types)
         signatures.push_back(unsigned(r.payload->size << 8 | r.payload->align));
     put(m_payload_signatures, signatures);
+    put(m_motion, scene.motion);
 }
 
 void GpuScene::set_params(const core::CompiledScene& scene) {
@@ -338,6 +342,7 @@ void GpuScene::set_params(const core::CompiledScene& scene) {
     m_params.miss = m_miss.as<gpu::ProgramRef>();
     m_params.ray_type_count = unsigned(scene.ray_types.size());
     m_params.payload_signatures = m_payload_signatures.as<unsigned>();
+    m_params.motion = m_motion.as<float>();
     m_params.node_count = unsigned(scene.nodes.size());
     m_params.max_depth = scene.max_depth;
     m_params.print_enabled = scene.print_enabled;

@@ -92,7 +92,7 @@ class GpuScene {
     // Device copies of the flat arrays.
     DeviceBuffer m_nodes, m_children, m_bvh_nodes, m_prim_order, m_prim_refs, m_bvhs, m_accels,
         m_accel_instances, m_accel_prim_first, m_instances, m_materials, m_record_blob, m_miss,
-        m_payload_signatures;
+        m_payload_signatures, m_motion;
 };
 
 }  // namespace lucent::cuda

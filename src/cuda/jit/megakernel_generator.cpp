@@ -39,6 +39,7 @@ KernelShape kernel_shape(const core::CompiledScene& scene) {
     shape.print = scene.print_enabled;
     shape.occlusion = scene.uses_occluded;
     shape.ray_control = scene.needs_ray_control();
+    shape.motion = scene.has_motion();
     shape.max_depth = scene.max_depth;
     return shape;
 }
@@ -206,6 +207,7 @@ std::string generate_megakernel(const ProgramTable& table, const KernelShape& sh
         << "#define LUCENT_GPU_PRINT " << shape.print << "\n"
         << "#define LUCENT_GPU_OCCLUSION " << shape.occlusion << "\n"
         << "#define LUCENT_GPU_RAY_CONTROL " << shape.ray_control << "\n"
+        << "#define LUCENT_GPU_MOTION " << shape.motion << "\n"
         << "#define LUCENT_GPU_MAX_DEPTH " << shape.max_depth << "\n"
         << "#define LUCENT_GPU_ATTRIBUTE_BYTES " << shape.attribute_bytes << "\n"
         << "#include \"lucent_gpu/runtime.cuh\"\n"

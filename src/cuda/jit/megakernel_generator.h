@@ -41,6 +41,7 @@ struct KernelShape {
     bool print = false;
     bool occlusion = false;  // some bound module declares kUsesOccluded
     bool ray_control = false;  // ray flags, masks, ids or opaque geometry (needs_ray_control)
+    bool motion = false;       // motion transforms or moving primitives (has_motion)
     unsigned max_depth = 1;
     unsigned attribute_bytes = 16;
 };

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "lucent/device/types.h"
+#include "runtime/motion.h"
 #include "lucent_gpu/triangle_bvh.cuh"
 
 namespace lucent::gpu {
@@ -30,6 +31,7 @@ struct GpuNode {
     unsigned instance_id;  // Transform: its user id (instance_id())
     ProgramRef visit;
     Matrix4x3 to_world, to_object;
+    runtime::MotionRange motion;  // Transform: keys in LaunchParams::motion, or kMotionNone
 };
 
 /// Binary BVH node, the layout of lucent::accel::BvhNode.
@@ -94,6 +96,8 @@ struct GpuInstance {
     unsigned curve_type;               // curves: CurveType
     unsigned material_offset;  // materials[(material_offset + m) * ray_type_count + r]
     unsigned material_count;
+    runtime::MotionRange motion;  // triangles' vertex or spheres' centre keys, or kMotionNone
+    unsigned motion_points;       // points per key
 };
 
 struct GpuMaterialSlot {
@@ -128,6 +132,7 @@ struct LaunchParams {
     const unsigned char* records;
     const ProgramRef* miss;
     const unsigned* payload_signatures;  // per ray type: sizeof(payload) << 8 | alignof(payload)
+    const float* motion;  // every motion key (core::CompiledScene::motion)
     unsigned ray_type_count;
     unsigned node_count;
     unsigned max_depth;

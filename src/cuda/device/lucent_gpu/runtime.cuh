@@ -37,6 +37,9 @@
 #ifndef LUCENT_GPU_RAY_CONTROL
 #define LUCENT_GPU_RAY_CONTROL 1  // ray flags, visibility masks, instance ids, opaque geometry
 #endif
+#ifndef LUCENT_GPU_MOTION
+#define LUCENT_GPU_MOTION 1  // motion transforms or moving primitives: the ray's time is read
+#endif
 #ifndef LUCENT_GPU_MIN_BLOCKS
 #define LUCENT_GPU_MIN_BLOCKS 1  // __launch_bounds__ hint: blocks per SM to fit in registers
 #endif
@@ -110,10 +113,30 @@ struct GpuPolicy {
     __device__ __forceinline__ void triangle(const GpuInstance& inst, unsigned prim, float3& p0,
                                              float3& p1, float3& p2) const {
         const uint3 t = triangle_of(inst, prim);
+#if LUCENT_GPU_MOTION
+        if (runtime::moving(inst.motion)) {  // at the time of the trace being shaded
+            moving_triangle(inst, t, frame_time(), p0, p1, p2);
+            return;
+        }
+#endif
         p0 = inst.vertices[t.x];
         p1 = inst.vertices[t.y];
         p2 = inst.vertices[t.z];
     }
+#if LUCENT_GPU_MOTION
+    __device__ __forceinline__ float frame_time() const;
+    /// A moving triangle's vertices at `time`; false when it is absent then.
+    __device__ __forceinline__ bool moving_triangle(const GpuInstance& inst, uint3 t, float time,
+                                                    float3& p0, float3& p1, float3& p2) const {
+        unsigned key;
+        float frac;
+        const bool present = runtime::motion_key(inst.motion, time, key, frac);
+        p0 = runtime::motion_point(params.motion, inst.motion, inst.motion_points, t.x, key, frac);
+        p1 = runtime::motion_point(params.motion, inst.motion, inst.motion_points, t.y, key, frac);
+        p2 = runtime::motion_point(params.motion, inst.motion, inst.motion_points, t.z, key, frac);
+        return present;
+    }
+#endif
     __device__ __forceinline__ ProgramRef any_hit(const GpuInstance& inst, unsigned material,
                                                   unsigned ray_type) const {
         return material_slot(inst, material, ray_type).any;
@@ -206,6 +229,11 @@ __device__ __forceinline__ ThreadState& self() {
 __device__ __forceinline__ ThreadState& GpuPolicy::thread() const {
     return self();
 }
+#if LUCENT_GPU_MOTION
+__device__ __forceinline__ float GpuPolicy::frame_time() const {
+    return self().frame->world_ray.time;
+}
+#endif
 __device__ __forceinline__ bool GpuPolicy::exception_pending() const {
     return self().exception_code != 0;
 }

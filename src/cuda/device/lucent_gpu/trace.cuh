@@ -118,16 +118,33 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
         const GpuInstance& inst = params.instances[instance_index];
         if (inst.type == kGpuTriangles) {
             uint3 t = GpuPolicy::triangle_of(inst, local);
+            float3 p0, p1, p2;
+#if LUCENT_GPU_MOTION
+            if (runtime::moving(inst.motion)) {
+                if (!GpuPolicy{}.moving_triangle(inst, t, f.world_ray.time, p0, p1, p2))
+                    return false;
+            } else
+#endif
+            {
+                p0 = inst.vertices[t.x];
+                p1 = inst.vertices[t.y];
+                p2 = inst.vertices[t.z];
+            }
             float th, u, v;
-            if (intersect_triangle_watertight(wray, inst.vertices[t.x], inst.vertices[t.y],
-                                              inst.vertices[t.z], tmin, f.closest, th, u, v))
+            if (intersect_triangle_watertight(wray, p0, p1, p2, tmin, f.closest, th, u, v))
                 triangle_candidate(f, instance_index, local, th, make_float2(u, v));
         }
 #if LUCENT_GPU_SPHERES
         else if (inst.type == kGpuSpheres) {
+            float3 center = inst.centers[local];
+#if LUCENT_GPU_MOTION
+            if (runtime::moving(inst.motion) &&
+                !runtime::motion_center(params.motion, inst.motion, inst.motion_points, local,
+                                        f.world_ray.time, center))
+                return false;
+#endif
             runtime::sphere_candidates(GpuPolicy{}, f, instance_index, local, origin, direction,
-                                       inst.centers[local],
-                                       inst.radii[inst.single_radius ? 0 : local]);
+                                       center, inst.radii[inst.single_radius ? 0 : local]);
         }
 #endif
 #if LUCENT_GPU_CURVES
@@ -217,6 +234,21 @@ __device__ void traverse_node(Frame& f, unsigned index, float3 origin, float3 di
             return;
 #if LUCENT_GPU_TRANSFORMS
         case kGpuTransform: {
+#if LUCENT_GPU_MOTION
+            if (runtime::moving(n.motion)) {
+                // The keys interpolated at the ray's time; nothing below when it vanished.
+                Matrix4x3 to_world, to_object;
+                if (!runtime::motion_transform_at(params.motion, n.motion, f.world_ray.time,
+                                                  to_world, to_object))
+                    return;
+                const runtime::SavedTransform saved =
+                    runtime::enter_transform(f, to_world, to_object, n.instance_id);
+                traverse_node(f, params.children[n.first], transform_point(to_object, origin),
+                              transform_vector(to_object, direction));
+                runtime::leave_transform(f, saved);
+                return;
+            }
+#endif
             const runtime::SavedTransform saved =
                 runtime::enter_transform(f, n.to_world, n.to_object, n.instance_id);
             traverse_node(f, params.children[n.first], transform_point(n.to_object, origin),
