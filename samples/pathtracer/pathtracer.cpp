@@ -13,6 +13,7 @@
 #include "samples/aov_passes.h"
 #include "samples/camera_session.h"
 #include "samples/pathtracer/pathtracer_programs.h"
+#include "samples/progressive_frames.h"
 #include "samples/scene_setup.h"
 #include "samples/stages.h"
 #include "samples/view_denoiser.h"
@@ -153,39 +154,11 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
 }
 
 /// Launches settings.spp frames (default 64) into the accumulation buffer and times them.
+/// Progressive accumulation: the frame number lives in the accumulation buffer (its w), so
+/// launches change nothing on the host and the compiled scene (and on the GPU the
+/// megakernel) is reused; a variable per frame would recompile it every frame.
 void render_frames(Context& ctx, const RenderSettings& settings, RenderResult& out) {
-    const unsigned spp = settings.spp ? settings.spp : 64;
-
-    // Progressive accumulation: the frame number lives in the accumulation buffer (its w),
-    // so launches change nothing on the host and the compiled scene (and on the GPU the
-    // megakernel) is reused; a variable per frame would recompile it every frame.
-    std::vector<double> frame_ms;
-    const Clock::time_point render_start = Clock::now();
-    for (unsigned f = 0; f < spp; ++f) {
-        ctx.launch(0, settings.width, settings.height);
-        const LaunchReport& report = ctx.last_launch();
-        if (f == 0) {
-            out.report = report;
-            add_compile_stages(report, out.stages);
-        } else if (report.exception_count() > 0 && out.report.exception_count() == 0) {
-            out.report = report;
-        }
-        frame_ms.push_back(report.launch_ms);
-        if (settings.progress) settings.progress(f + 1, spp);
-    }
-    const double render_ms = ms_since(render_start);
-    // The first frame also compiled the scene (and JIT-compiled it): time the others.
-    std::vector<double> steady(frame_ms.begin() + (spp > 1 ? 1 : 0), frame_ms.end());
-    std::sort(steady.begin(), steady.end());
-    const double median = steady[steady.size() / 2];
-    char note[200];
-    std::snprintf(note, sizeof note, "median of %zu frames (min %.3f, max %.3f)", steady.size(),
-                  steady.front(), steady.back());
-    out.stages.push_back({"launch (frame)", median, note});
-    std::snprintf(note, sizeof note, "%u spp; steady state %.1f samples/pixel/s, %.2f Msamples/s",
-                  spp, 1000.0 / median,
-                  double(settings.width) * settings.height / (median * 1000.0));
-    out.stages.push_back({"render", render_ms, note});
+    render_progressive(ctx, settings, 64, out);
 }
 
 /// `lucent view`: progressive. Each frame adds one sample per pixel to the accumulation
