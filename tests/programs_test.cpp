@@ -85,6 +85,33 @@ TEST_F(RayGenerationTest, SecondLaunchWithAnotherSizeRunsTheNewGrid) {
     for (unsigned x = 0; x < 5; ++x) EXPECT_EQ(values[x].size, make_uint3(5, 1, 1));
 }
 
+TEST_F(RayGenerationTest, LaunchShapeTrialsEndAndEveryLaunchIsComplete) {
+    // The CUDA backend times a few launch shapes on an entry's first launches and says so in
+    // the report (benchmarks skip those); the CPU has no shapes. Either way, every launch,
+    // trial or not, runs every index.
+    constexpr unsigned kWidth = 4099;
+    ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(pk_write_index_1d)));
+    auto output = ctx.create_buffer<IndexAndSize>(BufferType::kOutput, kWidth);
+    ctx["output"] = output;
+    std::vector<bool> trials;
+    for (int launch = 0; launch < 20; ++launch) {
+        ctx.launch(0, kWidth);
+        trials.push_back(ctx.last_launch().launch_shape_trial);
+        const auto values = read_buffer<IndexAndSize>(*output);
+        for (unsigned x = 0; x < kWidth; ++x)
+            ASSERT_EQ(values[x].index, make_uint3(x, 0, 0)) << "launch " << launch;
+    }
+    if (test_backend() == BackendKind::kCpu) {
+        for (bool trial : trials) EXPECT_FALSE(trial);
+        return;
+    }
+    EXPECT_TRUE(trials.front());  // the first launch warms up shape 0
+    // Trials come first and end: once a launch runs the chosen shape, all later ones do.
+    const auto first_chosen = std::find(trials.begin(), trials.end(), false);
+    ASSERT_NE(first_chosen, trials.end()) << "still trying shapes after 20 launches";
+    for (auto it = first_chosen; it != trials.end(); ++it) EXPECT_FALSE(*it);
+}
+
 // ---- miss, intersection and closest hit ---------------------------------------
 
 using ClosestHitTest = CasterFixture;

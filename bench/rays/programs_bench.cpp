@@ -23,10 +23,19 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
     return program;
 }
 
-/// Mrays/s of `repeat` launches of `entry` over `count` rays, after one untimed launch.
+/// Untimed launches before the timed ones: at most this many while the GPU backend still
+/// tries launch shapes (a handful per entry; a trial shape can take 3x the chosen one's time).
+constexpr int kMostWarmUpLaunches = 16;
+
+/// Mrays/s of `repeat` launches of `entry` over `count` rays, after untimed launches: the
+/// first compiles the scene and, on the GPU, the kernel; then until the backend has chosen
+/// its launch shape (before, a median of 5 could be a trial shape's time).
 Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing) {
     std::vector<double> mrays;
-    ctx.launch(entry, unsigned(count));  // compiles the scene and, on the GPU, the megakernel
+    for (int warm_up = 0; warm_up < kMostWarmUpLaunches; ++warm_up) {
+        ctx.launch(entry, unsigned(count));
+        if (!ctx.last_launch().launch_shape_trial) break;
+    }
     for (int run = 0; run < repeat; ++run) {
         ctx.launch(entry, unsigned(count));
         const LaunchReport& report = ctx.last_launch();

@@ -96,6 +96,10 @@ struct LaunchReport {
     double jit_ms = 0;  // CUDA: megakernel generation + NVRTC compile or cache load (0: reused)
     bool jit_cached = false;  // CUDA: the megakernel came from the disk cache
     double kernel_ms = 0;     // CUDA: the megakernel alone (CUDA events), within launch_ms
+    /// CUDA: this launch ran while the backend was still timing launch shapes for its entry
+    /// and size (the first few launches, docs/performance.md "Launch shapes"); a benchmark
+    /// times the launches after the tuning.
+    bool launch_shape_trial = false;
     /// Multi-device launches: what each device ran, in ContextOptions::devices order.
     struct DeviceShare {
         std::string device;      // "cuda:0"

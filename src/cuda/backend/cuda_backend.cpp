@@ -123,11 +123,13 @@ class CudaBackend final : public core::Backend {
         // tuned per entry and size.
         m_kernel = &m_kernels.at(size_t(p.ray_generation.id));
         m_tuning_key = {spec.entry, p.launch_count};
+        m_shape_trial = false;
         if (m_fixed_shape) {
             m_shape = kOccupancyFirst;
         } else {
             auto tuning = m_tuning.try_emplace(m_tuning_key, m_kernel->shapes.size()).first;
             m_shape = tuning->second.next_shape();
+            m_shape_trial = tuning->second.choice() < 0;
         }
         apply_shape(*m_kernel, m_kernel->shapes[size_t(m_shape)]);
         // Scratch for the largest grid of any kernel, so launches that alternate between
@@ -235,6 +237,7 @@ class CudaBackend final : public core::Backend {
         float kernel_ms = 0;
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
+        report.launch_shape_trial = m_shape_trial;
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
@@ -435,6 +438,7 @@ class CudaBackend final : public core::Backend {
     uint64_t m_indices = 0;  // launch indices in them
     uint3 m_size{1, 1, 1};
     int m_shape = kOccupancyFirst;
+    bool m_shape_trial = false;  // this launch times a shape for the tuning
     std::pair<unsigned, uint64_t> m_tuning_key{0, 0};
     CUcontext m_context = nullptr;
     std::vector<RayGenerationKernel> m_kernels;  // by ray-generation program (ProgramTable id)
