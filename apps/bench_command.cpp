@@ -123,8 +123,9 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     b->add_flag("--no-peer", build.no_peer, "Do not run the peer engine (Embree)");
     b->add_flag("--json", build.json, "Machine-readable output");
     b->add_option("--backend", build.backend,
-                  "cpu, auto or cuda (cuda: the GPU builder, H-PLOC, against the host SAH "
-                  "build, and the Mrays/s of both trees)")
+                  "cpu, auto or cuda (cuda: the GPU builder, binned SAH or with "
+                  "LUCENT_GPU_BUILDER=hploc H-PLOC, against the host SAH build, and the "
+                  "Mrays/s of both trees)")
         ->type_name("KIND")
         ->capture_default_str();
     b->add_option("--subdivide", build.subdivide,

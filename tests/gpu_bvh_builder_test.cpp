@@ -17,6 +17,7 @@
 #include "cuda/backend/driver_api.h"
 #include "cuda/accel/gpu_bvh_builder.h"
 #include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/device/lucent_gpu/bvh_sah_build.cuh"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"
@@ -144,12 +145,194 @@ void expect_brute_force_hits(const GpuTriangleBvh& bvh, const Mesh& mesh, unsign
     }
 }
 
-TEST_F(GpuBvhBuilderTest, LayoutFindsWhatBruteForceFinds) {
+constexpr cuda::GpuBuildAlgorithm kAlgorithms[] = {cuda::GpuBuildAlgorithm::kBinnedSah,
+                                                   cuda::GpuBuildAlgorithm::kHploc};
+const char* name_of(cuda::GpuBuildAlgorithm a) {
+    return a == cuda::GpuBuildAlgorithm::kHploc ? "H-PLOC" : "binned SAH";
+}
+
+/// The GPU binned-SAH build (bvh_sah_build.cuh) run on the CPU, a thread at a time, in the
+/// order the GPU launches its passes: the layout it leaves, its SAH cost and depth.
+struct EmulatedSahBuild {
+    GpuTriangleBvh bvh;
+    double sah_cost = 0;
+    unsigned depth = 0;
+    unsigned fault = 0;
+};
+
+Mesh chain_mesh(int count);
+
+EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
+                                       std::span<const uint3> indices,
+                                       const cuda::GpuBvhBuildOptions& options = {}) {
+    const unsigned n = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
+    const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
+    std::vector<float4> prim_lo(n), prim_hi(n), node_lo(nodes), node_hi(nodes);
+    std::vector<unsigned> prim_task(n), order(n), node_parent(nodes), node_inner(nodes),
+        node_arrivals(nodes), counters(gpu::kSahCounterCount);
+    std::vector<uint2> node_range(nodes);
+    std::vector<gpu::GpuSahTask> tasks[2] = {std::vector<gpu::GpuSahTask>(n / 2 + 1),
+                                             std::vector<gpu::GpuSahTask>(n / 2 + 1)};
+    const size_t pool_words = gpu::gpu_sah_pool_words(n);
+    std::vector<unsigned> pool[2] = {std::vector<unsigned>(pool_words),
+                                     std::vector<unsigned>(pool_words)};
+    EmulatedSahBuild out;
+    out.bvh.nodes.resize(gpu::kGpuNodeFloat4s * out_nodes);
+    out.bvh.triangles.resize(gpu::kGpuTriangleFloat4s * size_t(n));
+    out.bvh.triangle_ids.resize(n);
+    out.bvh.parents.resize(out_nodes);
+
+    gpu::GpuSahBuildParams p{};
+    p.positions = positions.data();
+    p.indices = indices.empty() ? nullptr : indices.data();
+    p.vertex_count = unsigned(positions.size());
+    p.triangle_count = n;
+    p.max_leaf_size = unsigned(options.max_leaf_size);
+    p.traversal_cost = options.traversal_cost;
+    p.intersection_cost = options.intersection_cost;
+    p.pool_words = unsigned(pool_words);
+    p.prim_lo = prim_lo.data(), p.prim_hi = prim_hi.data();
+    p.prim_task = prim_task.data(), p.order = order.data();
+    for (int k = 0; k < 2; ++k) p.tasks[k] = tasks[k].data(), p.pool[k] = pool[k].data();
+    p.node_lo = node_lo.data(), p.node_hi = node_hi.data(), p.node_range = node_range.data();
+    p.node_parent = node_parent.data(), p.node_inner = node_inner.data();
+    p.node_arrivals = node_arrivals.data(), p.counters = counters.data();
+    p.out_nodes = out.bvh.nodes.data(), p.out_triangles = out.bvh.triangles.data();
+    p.out_triangle_ids = out.bvh.triangle_ids.data(), p.out_parents = out.bvh.parents.data();
+    gpu::gpu_sah_build_passes(
+        n,
+        [&](gpu::GpuSahPass pass, unsigned threads, unsigned level) {
+            gpu::gpu_sah_run_on_cpu(p, pass, threads, level);
+        },
+        [&](unsigned parity) { return counters[gpu::kSahTaskCount + parity]; });
+    out.bvh.nodes.resize(gpu::kGpuNodeFloat4s * counters[gpu::kSahInner]);
+    out.bvh.parents.resize(counters[gpu::kSahInner]);
+    out.sah_cost = std::bit_cast<float>(counters[gpu::kSahCost]);
+    out.depth = counters[gpu::kSahDepth];
+    out.fault = counters[gpu::kSahFault];
+    return out;
+}
+
+/// Every inner node's boxes hold its children's boxes, and leaf boxes their triangles.
+::testing::AssertionResult boxes_bound_children(const GpuTriangleBvh& bvh) {
+    const size_t nodes = bvh.nodes.size() / gpu::kGpuNodeFloat4s;
+    for (size_t n = 0; n < nodes; ++n) {
+        const float4* node = &bvh.nodes[gpu::kGpuNodeFloat4s * n];
+        const int children[2] = {std::bit_cast<int>(node[3].x), std::bit_cast<int>(node[3].y)};
+        for (int slot = 0; slot < 2; ++slot) {
+            const float4 xy = node[slot];
+            const float zlo = slot == 0 ? node[2].x : node[2].z, zhi = slot == 0 ? node[2].y : node[2].w;
+            auto inside = [&](float3 lo, float3 hi) {
+                return lo.x >= xy.x && hi.x <= xy.y && lo.y >= xy.z && hi.y <= xy.w &&
+                       lo.z >= zlo && hi.z <= zhi;
+            };
+            const int ref = children[slot];
+            if (ref < 0) {
+                if (slot == 1 && children[0] == children[1]) continue;
+                for (unsigned k = 0; k < gpu::gpu_leaf_count(ref); ++k) {
+                    const float4* t = &bvh.triangles[3 * (gpu::gpu_leaf_first(ref) + k)];
+                    for (int v = 0; v < 3; ++v) {
+                        const float3 q = make_float3(t[v].x, t[v].y, t[v].z);
+                        if (!inside(q, q))
+                            return ::testing::AssertionFailure()
+                                   << "node " << n << " slot " << slot << " misses a vertex";
+                    }
+                }
+                continue;
+            }
+            const float4* c = &bvh.nodes[size_t(ref)];
+            for (int cs = 0; cs < 2; ++cs) {
+                const int cref = std::bit_cast<int>(cs == 0 ? c[3].x : c[3].y);
+                if (cs == 1 && cref < 0 && cref == std::bit_cast<int>(c[3].x)) continue;
+                const float3 lo = make_float3(c[cs].x, c[cs].z, cs == 0 ? c[2].x : c[2].z);
+                const float3 hi = make_float3(c[cs].y, c[cs].w, cs == 0 ? c[2].y : c[2].w);
+                if (!inside(lo, hi))
+                    return ::testing::AssertionFailure()
+                           << "node " << n << " slot " << slot << " misses a child box";
+            }
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// The emulation runs without a GPU: these hold in every build with the CUDA backend.
+TEST(GpuSahBuildEmulation, MakesTheHostTree) {
     const Mesh mesh = test_mesh(7, 1500);
     for (int leaf : {1, 4, 8}) {
         SCOPED_TRACE("leaf size " + std::to_string(leaf));
         cuda::GpuBvhBuildOptions options;
         options.max_leaf_size = leaf;
+        const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices, options);
+        const GpuTriangleBvh host =
+            cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
+        EXPECT_EQ(gpu.fault, 0u);
+        // The same splits: the same nodes, depth and cost (summed in another order).
+        EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
+        EXPECT_EQ(gpu.depth, host.stats.depth);
+        EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+        expect_complete(gpu.bvh, mesh);
+        if (HasFatalFailure()) return;
+        EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+        expect_brute_force_hits(gpu.bvh, mesh, 11, 3000);
+    }
+}
+
+TEST(GpuSahBuildEmulation, SmallUnindexedAndDegenerateMeshes) {
+    for (int count : {1, 2, 3, 4, 5, 17, 31, 32, 33, 100}) {
+        SCOPED_TRACE(std::to_string(count) + " triangles");
+        Mesh mesh = test_mesh(count, count);
+        mesh.indices.resize(count);
+        const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices);
+        EXPECT_EQ(gpu.fault, 0u);
+        expect_complete(gpu.bvh, mesh);
+        if (HasFatalFailure()) return;
+        EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+        expect_brute_force_hits(gpu.bvh, mesh, 5, 400);
+        std::vector<float3> soup;
+        for (const uint3 t : mesh.indices)
+            for (unsigned v : {t.x, t.y, t.z}) soup.push_back(mesh.positions[v]);
+        const EmulatedSahBuild u = emulate_gpu_sah_build(soup, {});
+        EXPECT_EQ(u.bvh.triangle_ids.size(), mesh.indices.size());
+        EXPECT_TRUE(is_tree(u.bvh));
+    }
+    // 200 copies of one triangle: every centroid the same, so every split is the median.
+    Mesh same = test_mesh(1, 1);
+    same.indices.assign(200, same.indices[0]);
+    const EmulatedSahBuild gpu = emulate_gpu_sah_build(same.positions, same.indices);
+    EXPECT_EQ(gpu.fault, 0u);
+    expect_complete(gpu.bvh, same);
+    EXPECT_LT(gpu.depth, 12u);
+}
+
+TEST(GpuSahBuildEmulation, ChainStaysWithinTheStack) {
+    const Mesh mesh = chain_mesh(150);
+    const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices);
+    EXPECT_EQ(gpu.fault, 0u);
+    EXPECT_LT(gpu.depth + 2, (unsigned)gpu::kGpuStackSize);
+    expect_complete(gpu.bvh, mesh);
+}
+
+TEST(GpuSahBuildEmulation, SponzaIsTheHostTree) {
+    const std::string file = std::string(LUCENT_SCENES_DIR) + "/sponza.obj";
+    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
+    const scene::ObjMesh mesh = scene::load_obj_mesh(file);
+    const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices);
+    const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+    EXPECT_EQ(gpu.fault, 0u);
+    EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
+    EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+    ASSERT_TRUE(is_tree(gpu.bvh));
+    EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+}
+
+TEST_F(GpuBvhBuilderTest, LayoutFindsWhatBruteForceFinds) {
+    const Mesh mesh = test_mesh(7, 1500);
+    for (auto algorithm : kAlgorithms)
+    for (int leaf : {1, 4, 8}) {
+        SCOPED_TRACE("leaf size " + std::to_string(leaf) + ", " + name_of(algorithm));
+        cuda::GpuBvhBuildOptions options;
+        options.max_leaf_size = leaf;
+        options.gpu_algorithm = algorithm;
         GpuTriangleBvhDevice d;
         const cuda::GpuBvhStats stats = builder->build(mesh.positions, mesh.indices, d, options);
         EXPECT_GT(stats.sah_cost, 0.0);
@@ -163,12 +346,15 @@ TEST_F(GpuBvhBuilderTest, LayoutFindsWhatBruteForceFinds) {
 }
 
 TEST_F(GpuBvhBuilderTest, SmallAndUnindexedMeshes) {
+    for (auto algorithm : kAlgorithms)
     for (int count : {1, 2, 3, 5, 17, 31, 32, 33, 100}) {
-        SCOPED_TRACE(std::to_string(count) + " triangles");
+        SCOPED_TRACE(std::to_string(count) + " triangles, " + name_of(algorithm));
         Mesh mesh = test_mesh(count, count);
         mesh.indices.resize(count);  // only the random triangles
+        cuda::GpuBvhBuildOptions options;
+        options.gpu_algorithm = algorithm;
         GpuTriangleBvhDevice d;
-        builder->build(mesh.positions, mesh.indices, d);
+        builder->build(mesh.positions, mesh.indices, d, options);
         const GpuTriangleBvh bvh = download(d);
         expect_complete(bvh, mesh);
         if (HasFatalFailure()) return;
@@ -178,7 +364,7 @@ TEST_F(GpuBvhBuilderTest, SmallAndUnindexedMeshes) {
         for (const uint3 t : mesh.indices)
             for (unsigned v : {t.x, t.y, t.z}) soup.push_back(mesh.positions[v]);
         GpuTriangleBvhDevice u;
-        builder->build(soup, {}, u);
+        builder->build(soup, {}, u, options);
         EXPECT_EQ(download(u).triangle_ids.size(), mesh.indices.size());
     }
     // No triangles: nothing is hit.
@@ -252,8 +438,10 @@ Mesh chain_mesh(int count) {
 TEST_F(GpuBvhBuilderTest, ChainedTrianglesGiveAValidTreeOrTheTypedError) {
     const Mesh mesh = chain_mesh(150);
     GpuTriangleBvhDevice d;
+    cuda::GpuBvhBuildOptions hploc;
+    hploc.gpu_algorithm = cuda::GpuBuildAlgorithm::kHploc;
     try {
-        const cuda::GpuBvhStats stats = builder->build(mesh.positions, mesh.indices, d);
+        const cuda::GpuBvhStats stats = builder->build(mesh.positions, mesh.indices, d, hploc);
         std::printf("the chain built %u levels deep\n", stats.depth);
         EXPECT_LT(stats.depth + 2, (unsigned)gpu::kGpuStackSize);
         expect_complete(download(d), mesh);
@@ -267,15 +455,25 @@ TEST_F(GpuBvhBuilderTest, SponzaHitsEqualTriangleAccelAndSahIsClose) {
     const std::string file = std::string(LUCENT_SCENES_DIR) + "/sponza.obj";
     if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
     const scene::ObjMesh mesh = scene::load_obj_mesh(file);
-    GpuTriangleBvhDevice d;
-    const cuda::GpuBvhStats stats = builder->build(mesh.positions, mesh.indices, d);
     const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+    for (auto algorithm : kAlgorithms) {
+    SCOPED_TRACE(name_of(algorithm));
+    cuda::GpuBvhBuildOptions options;
+    options.gpu_algorithm = algorithm;
+    GpuTriangleBvhDevice d;
+    const cuda::GpuBvhStats stats = builder->build(mesh.positions, mesh.indices, d, options);
+    if (algorithm == cuda::GpuBuildAlgorithm::kBinnedSah) {
+        // The host's algorithm: the host's tree.
+        EXPECT_NEAR(stats.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+        EXPECT_EQ(stats.node_count, host.stats.node_count);
+    }
     // H-PLOC's trees are within a few percent of a binned-SAH build's cost (HPG 2024,
     // Table 2); 25 % is the bound this test holds it to.
     EXPECT_LT(stats.sah_cost, 1.25 * host.stats.sah_cost)
         << stats.sah_cost << " against " << host.stats.sah_cost;
     const GpuTriangleBvh bvh = download(d);
     ASSERT_TRUE(is_tree(bvh));
+    EXPECT_TRUE(boxes_bound_children(bvh));
     accel::TriangleAccel accel;
     accel.build(mesh.positions, mesh.indices);
     const Aabb box = accel.bounds();
@@ -297,6 +495,7 @@ TEST_F(GpuBvhBuilderTest, SponzaHitsEqualTriangleAccelAndSahIsClose) {
         }
     }
     EXPECT_GT(hits, 10000);
+    }
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "bench/common/rate.h"
@@ -170,7 +172,11 @@ int run_bench_build_cuda(const CudaBuildInput& in) {
     result.in = &in;
     result.device = ctx.name();
     result.triangles = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
-    const GpuBvhBuildOptions options = gpu_build_options();
+    GpuBvhBuildOptions options = gpu_build_options();
+    // The GPU builder to compare with the host's: binned SAH (the default) or, with
+    // LUCENT_GPU_BUILDER=hploc, H-PLOC.
+    if (const char* b = std::getenv("LUCENT_GPU_BUILDER"); b && std::string(b) == "hploc")
+        options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
 
     // The GPU builder, on triangles already in device memory (as for geometry that moves
     // every frame): the GPU time of its kernels.

@@ -8,6 +8,7 @@
 
 #include "cuda/device/lucent_gpu/bvh_build.cuh"
 #include "cuda/device/lucent_gpu/bvh_refit.cuh"
+#include "cuda/device/lucent_gpu/bvh_sah_build.cuh"
 #include "cuda/backend/driver_api.h"
 #include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/error.h"
@@ -41,11 +42,14 @@ struct GpuBvhBuilder::Impl {
     CUfunction reset = nullptr, bounds = nullptr, morton = nullptr, leaves = nullptr,
                hploc = nullptr, emit = nullptr, histogram = nullptr, scan = nullptr,
                scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr;
+    CUfunction sah[8] = {};  // by GpuSahPass
     CUevent start = nullptr, stop = nullptr;
     // Scratch, grown to the largest mesh seen.
     DeviceBuffer keys, keys_alt, order, order_alt, split_slots, clusters, node_lo, node_hi,
         node_children, node_inner, node_parent, histogram_buffer, counters, arrivals;
     DeviceBuffer host_positions, host_indices;  // uploads of the span overloads
+    // Scratch of the binned-SAH build.
+    DeviceBuffer prim_lo, prim_hi, prim_task, tasks[2], pool[2], node_range, sah_counters;
 
     void launch(CUfunction f, unsigned grid, unsigned block, void** args, const char* what) {
         if (grid == 0) return;
@@ -65,6 +69,8 @@ struct GpuBvhBuilder::Impl {
         return ms;
     }
     void sort(unsigned n);
+    GpuBvhStats build_sah(const DeviceTriangles& tris, GpuTriangleBvhDevice& out,
+                          const GpuBvhBuildOptions& options);
     /// Copies host triangles to the device (host_positions, host_indices).
     DeviceTriangles upload(std::span<const float3> positions, std::span<const uint3> indices) {
         return upload_triangles(positions, indices, host_positions, host_indices);
@@ -86,7 +92,8 @@ DeviceTriangles upload_triangles(std::span<const float3> positions, std::span<co
 GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     CompileRequest req = embedded_request(
         "lucent_bvh_build.cu",
-        "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n",
+        "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n"
+        "#include \"lucent_gpu/bvh_sah_build.cuh\"\n",
         {"--std=c++17"}, sm);
     if (const char* debug = std::getenv("LUCENT_GPU_BUILD_DEBUG"); debug && *debug)
         req.options.push_back("-DLUCENT_BUILD_DEBUG=1");  // the kernels print what they do
@@ -111,6 +118,10 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     m->scatter = fn("lucent_radix_scatter");
     m->refit_triangles = fn("lucent_refit_triangles");
     m->refit_nodes = fn("lucent_refit_nodes");
+    const char* sah_names[8] = {"lucent_sah_reset",     "lucent_sah_init",  "lucent_sah_bin",
+                                "lucent_sah_split",     "lucent_sah_partition",
+                                "lucent_sah_count",     "lucent_sah_emit",  "lucent_sah_triangles"};
+    for (int k = 0; k < 8; ++k) m->sah[k] = fn(sah_names[k]);
     check(d.cuEventCreate(&m->start, CU_EVENT_DEFAULT), "cuEventCreate");
     check(d.cuEventCreate(&m->stop, CU_EVENT_DEFAULT), "cuEventCreate");
 }
@@ -158,8 +169,11 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
         GpuTriangleBvh empty = build_gpu_triangle_bvh({}, {});
         upload_gpu_triangle_bvh(empty, out);
         stats.node_count = 1;
+        stats.builder = "GPU";
         return stats;
     }
+    if (options.gpu_algorithm == GpuBuildAlgorithm::kBinnedSah)
+        return m->build_sah(tris, out, options);
     Impl& s = *m;
     const size_t nodes = 2 * size_t(n) - 1;
     const size_t out_nodes = n > 1 ? n - 1 : 1;  // inner nodes at most
@@ -247,6 +261,117 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
     stats.leaf_count = stats.node_count + 1;
     float sah;
     std::memcpy(&sah, &counters[gpu::kCounterSah], sizeof sah);
+    stats.sah_cost = sah;
+    out.node_count = stats.node_count;
+    out.triangle_count = n;
+    return stats;
+}
+
+GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTriangleBvhDevice& out,
+                                           const GpuBvhBuildOptions& options) {
+    const unsigned n = tris.triangle_count;
+    const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
+    const size_t pool_words = gpu::gpu_sah_pool_words(n);
+    if (pool_words > 0xffffffffu)
+        throw Error("GPU BVH builder: " + std::to_string(n) +
+                    " triangles are too many for the binned-SAH build; use H-PLOC");
+    reserve(prim_lo, sizeof(float4) * n);
+    reserve(prim_hi, sizeof(float4) * n);
+    reserve(prim_task, 4 * size_t(n));
+    reserve(order, 4 * size_t(n));
+    for (int k = 0; k < 2; ++k) {
+        reserve(tasks[k], sizeof(gpu::GpuSahTask) * (n / 2 + 1));
+        reserve(pool[k], 4 * pool_words);
+    }
+    reserve(node_lo, sizeof(float4) * nodes);
+    reserve(node_hi, sizeof(float4) * nodes);
+    reserve(node_range, sizeof(uint2) * nodes);
+    reserve(node_parent, 4 * nodes);
+    reserve(node_inner, 4 * nodes);
+    reserve(arrivals, 4 * nodes);
+    reserve(sah_counters, 4 * gpu::kSahCounterCount);
+    reserve(out.nodes, sizeof(float4) * gpu::kGpuNodeFloat4s * out_nodes);
+    reserve(out.triangles, sizeof(float4) * gpu::kGpuTriangleFloat4s * n);
+    reserve(out.triangle_ids, 4 * size_t(n));
+    reserve(out.parents, 4 * out_nodes);
+
+    gpu::GpuSahBuildParams p{};
+    p.positions = reinterpret_cast<const float3*>(static_cast<uintptr_t>(tris.positions));
+    p.indices = reinterpret_cast<const uint3*>(static_cast<uintptr_t>(tris.indices));
+    p.vertex_count = tris.vertex_count;
+    p.triangle_count = n;
+    p.max_leaf_size = unsigned(options.max_leaf_size);
+    p.traversal_cost = options.traversal_cost;
+    p.intersection_cost = options.intersection_cost;
+    p.pool_words = unsigned(pool_words);
+    p.prim_lo = device_ptr<float4>(prim_lo);
+    p.prim_hi = device_ptr<float4>(prim_hi);
+    p.prim_task = device_ptr<unsigned>(prim_task);
+    p.order = device_ptr<unsigned>(order);
+    for (int k = 0; k < 2; ++k) {
+        p.tasks[k] = device_ptr<gpu::GpuSahTask>(tasks[k]);
+        p.pool[k] = device_ptr<unsigned>(pool[k]);
+    }
+    p.node_lo = device_ptr<float4>(node_lo);
+    p.node_hi = device_ptr<float4>(node_hi);
+    p.node_range = device_ptr<uint2>(node_range);
+    p.node_parent = device_ptr<unsigned>(node_parent);
+    p.node_inner = device_ptr<unsigned>(node_inner);
+    p.node_arrivals = device_ptr<unsigned>(arrivals);
+    p.counters = device_ptr<unsigned>(sah_counters);
+    p.out_nodes = device_ptr<float4>(out.nodes);
+    p.out_triangles = device_ptr<float4>(out.triangles);
+    p.out_triangle_ids = device_ptr<unsigned>(out.triangle_ids);
+    p.out_parents = device_ptr<unsigned>(out.parents);
+
+    static const char* const kPassNames[8] = {
+        "BVH build (SAH): reset",     "BVH build (SAH): boxes",  "BVH build (SAH): bins",
+        "BVH build (SAH): split",     "BVH build (SAH): partition",
+        "BVH build (SAH): counts",    "BVH build (SAH): layout", "BVH build (SAH): triangles"};
+    check(api().cuEventRecord(start, nullptr), "cuEventRecord");
+    gpu::gpu_sah_build_passes(
+        n,
+        [&](gpu::GpuSahPass pass, unsigned threads, unsigned level) {
+            p.level = level;
+            void* args[] = {&p};
+            const unsigned block = pass == gpu::GpuSahPass::kReset ? 32u : 128u;
+            launch(sah[int(pass)], blocks_for(threads, block), block, args,
+                   kPassNames[int(pass)]);
+        },
+        [&](unsigned parity) {
+            unsigned count = 0;
+            check(api().cuMemcpyDtoH(&count, sah_counters.ptr() + 4 * (gpu::kSahTaskCount + parity),
+                                     4),
+                  "GPU BVH build: task count");
+            return count;
+        });
+    GpuBvhStats stats;
+    stats.builder = "binned SAH (GPU)";
+    stats.build_ms = elapsed_ms();
+
+    unsigned counters[gpu::kSahCounterCount];
+    sah_counters.download(counters, sizeof counters);
+    if (counters[gpu::kSahBadIndex] != gpu::kSahInvalid)
+        throw Error("GPU BVH builder: triangle " + std::to_string(counters[gpu::kSahBadIndex]) +
+                    " has a vertex index out of range (" + std::to_string(tris.vertex_count) +
+                    " vertices)");
+    if (counters[gpu::kSahFault] == gpu::kSahFaultDeepTree)
+        throw GpuBvhTooDeep("GPU BVH builder: a tree deeper than the traversal stack (" +
+                            std::to_string(gpu::kGpuStackSize) + ") for " + std::to_string(n) +
+                            " triangles; build this mesh with the host SAH builder");
+    if (counters[gpu::kSahFault] != gpu::kSahFaultNone)
+        throw Error("GPU BVH builder: internal error " +
+                    std::to_string(counters[gpu::kSahFault]) + " (GpuSahFault) for " +
+                    std::to_string(n) + " triangles");
+    stats.depth = counters[gpu::kSahDepth];
+    stats.node_count = counters[gpu::kSahInner];
+    if (stats.node_count > out_nodes || stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)
+        throw Error("GPU BVH builder: internal error, " + std::to_string(stats.node_count) +
+                    " inner nodes, depth " + std::to_string(stats.depth) + " for " +
+                    std::to_string(n) + " triangles");
+    stats.leaf_count = stats.node_count + 1;
+    float sah;
+    std::memcpy(&sah, &counters[gpu::kSahCost], sizeof sah);
     stats.sah_cost = sah;
     out.node_count = stats.node_count;
     out.triangle_count = n;

@@ -12,7 +12,13 @@
 
 namespace lucent::cuda {
 
+/// What GpuBvhBuilder runs on the GPU: the host's binned-SAH algorithm (the same tree as
+/// build_gpu_triangle_bvh, bvh_sah_build.cuh), or H-PLOC (faster, trees that trace at
+/// 0.85-0.99x of it, bvh_build.cuh).
+enum class GpuBuildAlgorithm { kBinnedSah, kHploc };
+
 struct GpuBvhBuildOptions {
+    GpuBuildAlgorithm gpu_algorithm = GpuBuildAlgorithm::kBinnedSah;  // GpuBvhBuilder only
     // Aila and Laine build with leaves of at most 8 triangles and equal node and triangle
     // costs; 4 keeps the divergent leaf loop short on wide warps.
     int max_leaf_size = 4;

@@ -426,7 +426,9 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
             m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
         } else {
             try {
-                m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh);
+                GpuBvhBuildOptions options;
+                options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
+                m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh, options);
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
                 // bounds its depth (refits keep that tree's topology).
