@@ -536,6 +536,12 @@ TEST_F(RefitTest, RefitAfterMovingVerticesGivesTheSameHitsAsARebuild) {
     refit_and_rebuild(Builder::kBinnedSah);
 }
 
+TEST_F(RefitTest, DefaultBuilderRefitsAndRebuildsAlike) {
+    // Builder::kAuto: on the CUDA backend the GPU's binned-SAH build and the GPU refit.
+    EXPECT_EQ(ctx.create_acceleration()->builder(), Builder::kAuto);
+    refit_and_rebuild(Builder::kAuto);
+}
+
 TEST_F(RefitTest, GpuBuilderAndItsRefitGiveTheSameHits) {
     // On the CUDA backend the grid's BVH is built (H-PLOC) and refitted on the GPU; on the
     // CPU, Builder::kGpuHploc builds binned SAH.

@@ -215,7 +215,7 @@ class Context : public VariableScope {
     std::shared_ptr<Buffer> create_buffer(BufferType type, const TypeInfo& element, unsigned width,
                                           unsigned height = 0, unsigned depth = 0);
     std::shared_ptr<TextureSampler> create_texture_sampler();
-    std::shared_ptr<Acceleration> create_acceleration(Builder builder = Builder::kBinnedSah);
+    std::shared_ptr<Acceleration> create_acceleration(Builder builder = Builder::kAuto);
     std::shared_ptr<Group> create_group();
     std::shared_ptr<GeometryGroup> create_geometry_group();
     std::shared_ptr<Transform> create_transform();

@@ -21,7 +21,11 @@ const char* node_kind_name(NodeKind kind);
 
 /// How an Acceleration builds its BVH.
 enum class Builder {
-    kBinnedSah,  // binned SAH (Wald 2007): best traversal, rebuilt when marked dirty
+    // The default: binned SAH (Wald 2007), built where the backend traces: on the CUDA
+    // backend on the GPU (bvh_sah_build.cuh: the host's algorithm, the same tree, in about a
+    // millisecond), on the CPU backend (and wherever a CPU device traces too) on the host.
+    kAuto,
+    kBinnedSah,  // binned SAH (Wald 2007) built on the host: best traversal, rebuilt when marked dirty
     kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)
     // Triangles that change every frame: on the CUDA backend the BVH is built on the GPU
     // (H-PLOC, Benthin et al. 2024; build and trace figures in docs/performance.md) and,
@@ -47,7 +51,7 @@ class Acceleration : public ContextObject {
     void clear_dirty() { m_dirty = false; }
 
   private:
-    Builder m_builder = Builder::kBinnedSah;
+    Builder m_builder = Builder::kAuto;
     bool m_refit = false;
     bool m_dirty = true;
 };

@@ -207,7 +207,7 @@ void bind_context(py::module_& m) {
             [](Context& c, const std::string& builder) {
                 return c.create_acceleration(builder_from_name(builder));
             },
-            py::arg("builder") = "sah")
+            py::arg("builder") = "auto")
         .def("create_group", &Context::create_group)
         .def("create_geometry_group", &Context::create_geometry_group)
         .def("create_transform", &Context::create_transform)

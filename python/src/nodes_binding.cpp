@@ -15,14 +15,17 @@ namespace lucent::python {
 namespace {
 
 Builder builder_from(const std::string& name) {
+    if (name == "auto") return Builder::kAuto;
     if (name == "sah") return Builder::kBinnedSah;
     if (name == "none") return Builder::kNone;
     if (name == "gpu_hploc") return Builder::kGpuHploc;
-    throw py::value_error("builder: expected 'sah', 'none' or 'gpu_hploc'; got '" + name + "'");
+    throw py::value_error("builder: expected 'auto', 'sah', 'none' or 'gpu_hploc'; got '" + name +
+                          "'");
 }
 
 const char* builder_name(Builder b) {
     switch (b) {
+        case Builder::kAuto: return "auto";
         case Builder::kBinnedSah: return "sah";
         case Builder::kNone: return "none";
         case Builder::kGpuHploc: return "gpu_hploc";
@@ -53,8 +56,9 @@ void bind_nodes(py::module_& m) {
                                                             "The BVH of a Group or GeometryGroup.")
         .def_property("builder", [](const Acceleration& a) { return builder_name(a.builder()); },
                       [](Acceleration& a, const std::string& b) { a.set_builder(builder_from(b)); },
-                      "'sah' (binned SAH), 'none' (every child tested) or 'gpu_hploc' (built "
-                      "on the GPU by the CUDA backend)")
+                      "'auto' (the default: binned SAH, built on the GPU by the CUDA backend), "
+                      "'sah' (binned SAH built on the host), 'none' (every child tested) or "
+                      "'gpu_hploc' (H-PLOC, built on the GPU by the CUDA backend)")
         .def_property("refit", &Acceleration::refit, &Acceleration::set_refit,
                       "Refit instead of rebuilding when only vertices moved")
         .def("mark_dirty", &Acceleration::mark_dirty)

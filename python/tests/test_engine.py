@@ -260,11 +260,13 @@ def test_node_graph_objects():
     assert group.add_child(transform) == 0 and group.child_count == 1
     assert group.children[0] is transform and transform.child is gg
     assert (group.kind, transform.kind, gg.kind) == ("Group", "Transform", "GeometryGroup")
+    assert ctx.create_acceleration().builder == "auto"
+    assert ctx.create_acceleration("sah").builder == "sah"
     group.acceleration = ctx.create_acceleration("none")
     assert group.acceleration.builder == "none"
     gg.acceleration.refit = True
     assert gg.acceleration.refit
-    with pytest.raises(ValueError, match="builder: expected 'sah', 'none' or 'gpu_hploc'"):
+    with pytest.raises(ValueError, match="builder: expected 'auto', 'sah', 'none' or 'gpu_hploc'"):
         ctx.create_acceleration("lbvh")
     geometry = ctx.create_geometry()
     geometry.primitive_count = 3

@@ -249,7 +249,8 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
     const bool same_content = ga.content_signature == content.h;
     node.geometry = cached;
     // A BVH built on the GPU needs no host copy unless the host traverses too.
-    const bool host_triangles = m_host_traversal || accel.builder() != Builder::kGpuHploc;
+    const bool host_triangles = m_host_traversal || (accel.builder() != Builder::kGpuHploc &&
+                                                     accel.builder() != Builder::kAuto);
     const bool host_current = ga.host_triangles || !host_triangles || !ga.triangles_only;
     if (same_structure && same_content && !accel.dirty() && host_current) return;
     const bool refit = same_structure && accel.refit() && !node.brute_force && host_current;

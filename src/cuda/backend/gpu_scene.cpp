@@ -411,14 +411,14 @@ void GpuScene::fetch(const Buffer& buffer) {
 }
 
 /// Rebuilds (or refits) the GPU layout of a GeometryGroup's triangles when they changed:
-/// on the host with binned SAH, or on the GPU for Builder::kGpuHploc.
+/// on the GPU for Builder::kAuto (binned SAH) and kGpuHploc, on the host for kBinnedSah.
 void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror) {
     const core::GeometryAccel& ga = *node.geometry;
     if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
         return;
     const auto start = std::chrono::steady_clock::now();
     const Acceleration& accel = acceleration_of(node);
-    if (accel.builder() == Builder::kGpuHploc) {
+    if (accel.builder() == Builder::kGpuHploc || accel.builder() == Builder::kAuto) {
         if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
                            mirror.bvh.triangle_count == ga.indices.size();
@@ -427,7 +427,8 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
         } else {
             try {
                 GpuBvhBuildOptions options;
-                options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
+                if (accel.builder() == Builder::kGpuHploc)
+                    options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
                 m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh, options);
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build

@@ -81,7 +81,7 @@ class GpuScene {
 
     int m_sm;
     double m_accel_ms = 0;
-    std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a Builder::kGpuHploc needs it
+    std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a GPU build (Builder::kAuto, kGpuHploc) needs it
     ProgramTable m_programs;
     std::vector<unsigned char> m_records;
     std::unordered_map<const void*, gpu::ProgramRef> m_callable_slots;  // by host record
