@@ -80,6 +80,25 @@ TEST(LaunchShapes, TuningTriesEachShapeOnceAfterTwoLaunchesOfTheFirstThenKeepsTh
     EXPECT_EQ(tuning.choice(), 1);
 }
 
+TEST(LaunchShapes, AddedShapesReopenTheChoiceAfterOneUntimedLaunch) {
+    ShapeTuning tuning(2);
+    for (const auto& [shape, ms] : std::vector<std::pair<int, double>>{{0, 9.0}, {0, 2.0}, {1, 3.0}})
+        tuning.record(shape, ms);
+    ASSERT_EQ(tuning.choice(), 0);
+    tuning.add_shapes(2);  // shapes 2 and 3: shape 3 is the fastest of all
+    const double ms[] = {2.0, 3.0, 2.5, 1.0};
+    std::vector<int> tried;
+    for (int launch = 0; launch < 3; ++launch) {
+        EXPECT_EQ(tuning.choice(), -1) << "still trying at launch " << launch;
+        const int shape = tuning.next_shape();
+        tried.push_back(shape);
+        tuning.record(shape, launch == 0 ? 100.0 : ms[shape]);  // the new code warms up first
+    }
+    EXPECT_EQ(tried, (std::vector<int>{2, 2, 3}));
+    EXPECT_EQ(tuning.choice(), 3);
+    EXPECT_EQ(tuning.next_shape(), 3);
+}
+
 TEST(LaunchShapes, OneShapeNeedsNoTrials) {
     ShapeTuning tuning(1);
     EXPECT_EQ(tuning.next_shape(), 0);

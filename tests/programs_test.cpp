@@ -19,6 +19,17 @@ namespace {
 using testing::HasSubstr;
 using testing::Not;
 
+/// Sets an environment variable for one test's scope (the CUDA backend reads its tuning
+/// switches when it compiles a scene's kernels, at the first launch).
+class ScopedEnv {
+  public:
+    ScopedEnv(const char* name, const char* value) : m_name(name) { setenv(name, value, 1); }
+    ~ScopedEnv() { unsetenv(m_name); }
+
+  private:
+    const char* m_name;
+};
+
 // ---- ray generation ------------------------------------------------------------
 
 class RayGenerationTest : public testing::Test {
@@ -90,6 +101,8 @@ TEST_F(RayGenerationTest, LaunchShapeTrialsEndAndEveryLaunchIsComplete) {
     // the report (benchmarks skip those); the CPU has no shapes. Either way, every launch,
     // trial or not, runs every index.
     constexpr unsigned kWidth = 4099;
+    // Without the register-capped variants, which would reopen the tuning when they arrive.
+    const ScopedEnv variants("LUCENT_GPU_REGISTER_VARIANTS", "off");
     ctx.set_ray_generation_program(0, program(ctx, LUCENT_PROGRAM(pk_write_index_1d)));
     auto output = ctx.create_buffer<IndexAndSize>(BufferType::kOutput, kWidth);
     ctx["output"] = output;
@@ -131,6 +144,45 @@ TEST_F(ClosestHitTest, MissProgramRunsWhenNothingIsHitAndReadsItsRecord) {
     // The miss program sees the ray's full interval: nothing shortened it.
     EXPECT_GE(hits[0].ray_tmax, kInfinity);
     EXPECT_EQ(hits[1].hit, 1) << "the ray along +z hits the sphere: the miss must not run";
+}
+
+TEST_F(ClosestHitTest, RegisterCappedVariantGivesTheSameHitsAsTheKernelAsCompiled) {
+    // "sync": the CUDA backend compiles the capped variant (64 registers a thread) of this
+    // tracing kernel with it, so the tuning's trials run both within the launches below.
+    const ScopedEnv variants("LUCENT_GPU_REGISTER_VARIANTS", "sync");
+    std::vector<float4> centres;
+    for (int i = 0; i < 64; ++i)
+        centres.push_back(make_float4(float(i % 8) - 3.5f, float(i / 8) - 3.5f, 10.0f + i % 3, 0.45f));
+    auto top = make_geometry_group(
+        ctx, {make_instance(ctx, make_spheres(ctx, centres),
+                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+    std::vector<CastRay> rays;
+    for (int i = 0; i < 4096; ++i) {
+        const float x = float(i % 64) / 8.0f - 4.0f, y = float(i / 64) / 8.0f - 4.0f;
+        rays.push_back(cast_ray(make_float3(0, 0, 0), normalize(make_float3(x, y, 10.0f))));
+    }
+    (*caster)["top"] = top;
+    (*caster)["rays"] = input_buffer(ctx, rays);
+    auto results = ctx.create_buffer<TestPayload>(BufferType::kOutput, unsigned(rays.size()));
+    (*caster)["results"] = results;
+    ctx.launch(0, unsigned(rays.size()));
+    const std::vector<TestPayload> first = read_buffer<TestPayload>(*results);
+    size_t hits = 0;
+    for (const TestPayload& h : first) hits += h.hit == 1;
+    ASSERT_GT(hits, 1000u);
+    bool capped = false;
+    for (int launch = 1; launch < 24; ++launch) {
+        ctx.launch(0, unsigned(rays.size()));
+        capped = capped || ctx.last_launch().registers_capped;
+        const std::vector<TestPayload> again = read_buffer<TestPayload>(*results);
+        for (size_t i = 0; i < rays.size(); ++i) {
+            ASSERT_EQ(again[i].hit, first[i].hit) << "ray " << i << ", launch " << launch;
+            ASSERT_EQ(again[i].prim, first[i].prim) << "ray " << i << ", launch " << launch;
+            ASSERT_EQ(again[i].t, first[i].t) << "ray " << i << ", launch " << launch;
+        }
+    }
+    // The CPU has no variants; the GPU's tracing kernel uses more than 64 registers.
+    EXPECT_EQ(capped, test_backend() == BackendKind::kCuda);
 }
 
 TEST_F(ClosestHitTest, CustomSphereIntersectionFeedsAttributesToClosestHit) {

@@ -1,5 +1,6 @@
 #include "bench/rays/programs_bench.h"
 
+#include <cstdlib>
 #include <vector>
 
 #include "bench/common/input_buffer.h"
@@ -23,22 +24,25 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
     return program;
 }
 
-/// Untimed launches before the timed ones: at most this many while the GPU backend still
-/// tries launch shapes (a handful per entry; a trial shape can take 3x the chosen one's time).
-constexpr int kMostWarmUpLaunches = 16;
+/// The most launches one measurement makes: the timed ones, and those the GPU backend's
+/// launch-shape tuning spends (a handful per entry, a few more when a register-capped
+/// variant of the kernel arrives from its background compile).
+constexpr int kMostLaunches = 96;
 
-/// Mrays/s of `repeat` launches of `entry` over `count` rays, after untimed launches: the
-/// first compiles the scene and, on the GPU, the kernel; then until the backend has chosen
-/// its launch shape (before, a median of 5 could be a trial shape's time).
+/// Mrays/s of `repeat` launches of `entry` over `count` rays, all after the tuning: the
+/// first launch compiles the scene and, on the GPU, the kernel; trial launches are not
+/// timed, and a trial after timing began (new shapes to try) restarts the timing, since the
+/// choice may change (before, a median of 5 could be a trial shape's time).
 Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing) {
     std::vector<double> mrays;
-    for (int warm_up = 0; warm_up < kMostWarmUpLaunches; ++warm_up) {
-        ctx.launch(entry, unsigned(count));
-        if (!ctx.last_launch().launch_shape_trial) break;
-    }
-    for (int run = 0; run < repeat; ++run) {
+    ctx.launch(entry, unsigned(count));
+    for (int launch = 1; launch < kMostLaunches && int(mrays.size()) < repeat; ++launch) {
         ctx.launch(entry, unsigned(count));
         const LaunchReport& report = ctx.last_launch();
+        if (report.launch_shape_trial) {
+            mrays.clear();
+            continue;
+        }
         const bool kernel = report.kernel_ms > 0;
         timing = kernel ? "kernel" : "launch";
         const double ms = kernel ? report.kernel_ms : report.launch_ms;
@@ -52,6 +56,10 @@ Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std:
 ProgramsResult run_programs(const ProgramsInput& in) {
     const scene::ObjMesh& mesh = *in.mesh;
     const RaySet& primary = *in.primary;
+    // The register-capped variants of the GPU kernels compiled with them, not in the
+    // background, so that every ray set is timed with all of its shapes tried (unless the
+    // caller chose otherwise).
+    setenv("LUCENT_GPU_REGISTER_VARIANTS", "sync", 0);
     ContextOptions options;
     options.backend = in.backend;
     options.threads = in.threads;

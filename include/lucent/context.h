@@ -100,6 +100,9 @@ struct LaunchReport {
     /// and size (the first few launches, docs/performance.md "Launch shapes"); a benchmark
     /// times the launches after the tuning.
     bool launch_shape_trial = false;
+    /// CUDA: this launch ran the kernel's variant compiled for at most 64 registers a thread
+    /// (compiled in the background after the first launch; one more shape the tuning times).
+    bool registers_capped = false;
     /// Multi-device launches: what each device ran, in ContextOptions::devices order.
     struct DeviceShare {
         std::string device;      // "cuda:0"

@@ -22,8 +22,9 @@ const char* node_kind_name(NodeKind kind);
 /// How an Acceleration builds its BVH.
 enum class Builder {
     // The default: binned SAH (Wald 2007), built where the backend traces: on the CUDA
-    // backend on the GPU (bvh_sah_build.cuh: the host's algorithm, the same tree, in about a
-    // millisecond), on the CPU backend (and wherever a CPU device traces too) on the host.
+    // backend on the GPU (bvh_sah_build.cuh: the host's algorithm and tree, 5.5 ms for Sponza
+    // on an H200 against 19 ms on the host), on the CPU backend (and wherever a CPU device
+    // traces too) on the host.
     kAuto,
     kBinnedSah,  // binned SAH (Wald 2007) built on the host: best traversal, rebuilt when marked dirty
     kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)

@@ -67,6 +67,7 @@ void bind_context(py::module_& m) {
         .def_readonly("jit_cached", &LaunchReport::jit_cached)
         .def_readonly("kernel_ms", &LaunchReport::kernel_ms)
         .def_readonly("launch_shape_trial", &LaunchReport::launch_shape_trial)
+        .def_readonly("registers_capped", &LaunchReport::registers_capped)
         .def_readonly("exchange_ms", &LaunchReport::exchange_ms)
         .def_property_readonly("exception_count", &LaunchReport::exception_count)
         .def_property_readonly("exceptions",

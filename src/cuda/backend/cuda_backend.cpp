@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <future>
 #include <map>
 #include <memory>
 #include <utility>
@@ -31,10 +33,31 @@ constexpr unsigned kBlock = 128;  // LUCENT_GPU_BLOCK in the runtime
 constexpr unsigned kPiecesInFlight = 4, kMaxPiecesInFlight = 8;
 
 constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
+// The register-capped variant of a kernel: __launch_bounds__ for 8 blocks of 128 threads per
+// SM, so at most 64 registers a thread. Measured (docs/performance.md, "The engine path
+// against OptiX"): 13-17 % faster for bench rays --programs and 4-7 % for IGI, 20 % slower
+// for the path tracer on Sponza; so it is one more shape for the tuning to time, not a rule.
+constexpr int kCappedBlocksPerSm = 8;
+constexpr int kCappedRegisters = 65536 / (kCappedBlocksPerSm * 128);
 
 constexpr size_t kExceptionBytes = sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots;
 
 class CudaBackend final : public core::Backend {
+  private:
+    /// One compiled variant of a ray-generation program's kernel, in its own module.
+    struct KernelCode {
+        CUmodule module = nullptr;
+        CUfunction function = nullptr;
+        CUdeviceptr params = 0;  // the module's launch parameters
+        int carveout = -1;       // the carveout last set on the function
+    };
+    /// A ray-generation program's kernel: its variants (0: as compiled; 1: registers capped,
+    /// once compiled) and the launch shapes of all of them (launch_shapes.h).
+    struct RayGenerationKernel {
+        std::vector<KernelCode> codes;
+        std::vector<LaunchShape> shapes{LaunchShape{}};  // shape 0: occupancy first
+    };
+
   public:
     CudaBackend(const DriverApi& d, int ordinal) : m_driver(d), m_ordinal(ordinal) {
         check(d.cuDeviceGet(&m_device, ordinal), "cuDeviceGet");
@@ -121,6 +144,7 @@ class CudaBackend final : public core::Backend {
         // The kernel of the entry's ray-generation program (the context refuses a launch of
         // an entry without one), and its launch shape: fixed by LUCENT_GPU_CARVEOUT, else
         // tuned per entry and size.
+        adopt_capped_variants();
         m_kernel = &m_kernels.at(size_t(p.ray_generation.id));
         m_tuning_key = {spec.entry, p.launch_count};
         m_shape_trial = false;
@@ -143,7 +167,7 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuMemsetD32Async(m_exceptions.ptr(), 0, kExceptionBytes / 4, m_streams[0]),
               "clear the exception slots");
         *m_params_host = p;
-        check(m_driver.cuMemcpyHtoDAsync(m_kernel->params, m_params_host, sizeof p, m_streams[0]),
+        check(m_driver.cuMemcpyHtoDAsync(m_code->params, m_params_host, sizeof p, m_streams[0]),
               "upload launch parameters");
         m_size = spec.size;
         m_pieces = 0;
@@ -169,7 +193,7 @@ class CudaBackend final : public core::Backend {
         void* no_owners = nullptr;
         unsigned device = 0;
         void* args[] = {&first, &last, &counter_arg, &no_owners, &device};
-        check(m_driver.cuLaunchKernel(m_kernel->function, unsigned(m_kernel->applied.grid), 1, 1,
+        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1,
                                       kBlock, 1, 1, 0,
                                       stream, args, nullptr),
               "launch the megakernel");
@@ -190,7 +214,7 @@ class CudaBackend final : public core::Backend {
         void* counter_arg = reinterpret_cast<void*>(counter);
         void* owners_arg = reinterpret_cast<void*>(owners);
         void* args[] = {&first, &last, &counter_arg, &owners_arg, &device};
-        check(m_driver.cuLaunchKernel(m_kernel->function, unsigned(m_kernel->applied.grid), 1, 1,
+        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1,
                                       kBlock, 1, 1, 0,
                                       m_streams[0], args, nullptr),
               "launch the megakernel");
@@ -238,6 +262,7 @@ class CudaBackend final : public core::Backend {
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
         report.launch_shape_trial = m_shape_trial;
+        report.registers_capped = m_kernel->shapes[size_t(m_shape)].variant > 0;
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
@@ -331,20 +356,12 @@ class CudaBackend final : public core::Backend {
         m_largest_grid = 1;
         for (size_t i = 0; i < m_kernels.size(); ++i) {
             RayGenerationKernel& k = m_kernels[i];
-            check(m_driver.cuModuleLoadData(&k.module, kernel.binaries[i].cubin.data()),
-                  "load the megakernel");
-            const std::string name = ray_generation_kernel(int(i));
-            check(m_driver.cuModuleGetFunction(&k.function, k.module, name.c_str()),
-                  ("find " + name).c_str());
-            size_t bytes = 0;
-            check(m_driver.cuModuleGetGlobal(&k.params, &bytes, k.module,
-                                             "_ZN6lucent3gpu6paramsE"),
-                  "find the launch parameters");
-            k.shapes = launch_shapes(k.function, fixed);
+            k.codes.push_back(load_code(kernel.binaries[i].cubin, i));
+            k.shapes = launch_shapes(k.codes[0].function, fixed);
             for (const LaunchShape& s : k.shapes) m_largest_grid = std::max(m_largest_grid, s.grid);
         }
         if (!m_kernels.empty())  // every module has it: the first's serves
-            check(m_driver.cuModuleGetFunction(&m_gather, m_kernels[0].module,
+            check(m_driver.cuModuleGetFunction(&m_gather, m_kernels[0].codes[0].module,
                                                "lucent_gather_tiles"),
                   "find lucent_gather_tiles");
         m_tuning.clear();
@@ -352,13 +369,100 @@ class CudaBackend final : public core::Backend {
         size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
         check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
         m_source = std::move(text);
+        start_capped_variants(kernel);
+    }
+
+    /// A compiled kernel loaded as its own module.
+    KernelCode load_code(const std::string& cubin, size_t kernel) {
+        KernelCode code;
+        check(m_driver.cuModuleLoadData(&code.module, cubin.data()), "load the megakernel");
+        const std::string name = ray_generation_kernel(int(kernel));
+        check(m_driver.cuModuleGetFunction(&code.function, code.module, name.c_str()),
+              ("find " + name).c_str());
+        size_t bytes = 0;
+        check(m_driver.cuModuleGetGlobal(&code.params, &bytes, code.module,
+                                         "_ZN6lucent3gpu6paramsE"),
+              "find the launch parameters");
+        return code;
+    }
+
+    /// Compiles the register-capped variant of every kernel that uses more registers than
+    /// the cap allows, on other threads while launches run (LUCENT_GPU_REGISTER_VARIANTS:
+    /// "sync" compiles them here, "off" not at all); adopt_capped_variants adds them to the
+    /// kernels' shapes. Not with a fixed carveout or a block count in LUCENT_NVRTC_OPTIONS
+    /// (experiments that choose the shape themselves).
+    void start_capped_variants(const Megakernel& kernel) {
+        const char* mode_env = std::getenv("LUCENT_GPU_REGISTER_VARIANTS");
+        const std::string mode = mode_env ? mode_env : "background";
+        const char* options = std::getenv("LUCENT_NVRTC_OPTIONS");
+        if (mode == "off" || m_fixed_shape ||
+            (options && std::strstr(options, "LUCENT_GPU_MIN_BLOCKS")))
+            return;
+        m_capped_kernels.clear();
+        for (size_t i = 0; i < m_kernels.size(); ++i) {
+            int registers = 0;
+            m_driver.cuFuncGetAttribute(&registers, CU_FUNC_ATTRIBUTE_NUM_REGS,
+                                        m_kernels[i].codes[0].function);
+            if (registers > kCappedRegisters) m_capped_kernels.push_back(i);
+        }
+        if (m_capped_kernels.empty()) return;
+        std::vector<CompileRequest> requests =
+            unit_requests(kernel, m_sm, m_capped_kernels,
+                          {"-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(kCappedBlocksPerSm)});
+        if (mode == "sync") {
+            adopt_capped(compile_units(requests));
+            return;
+        }
+        m_capped = std::async(std::launch::async, [requests = std::move(requests)] {
+            return compile_units(requests);
+        });
+    }
+
+    /// At a launch's start: the capped variants, once compiled, become shapes of their
+    /// kernels. A variant that failed to compile is left out (the kernels as compiled run).
+    void adopt_capped_variants() {
+        if (!m_capped.valid() ||
+            m_capped.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+            return;
+        std::vector<CompileResult> binaries;
+        try {
+            binaries = m_capped.get();
+        } catch (const std::exception&) {
+            return;
+        }
+        adopt_capped(binaries);
+    }
+
+    void adopt_capped(const std::vector<CompileResult>& binaries) {
+        for (size_t j = 0; j < binaries.size() && j < m_capped_kernels.size(); ++j) {
+            const size_t i = m_capped_kernels[j];
+            RayGenerationKernel& k = m_kernels[i];
+            KernelCode code = load_code(binaries[j].cubin, i);
+            std::vector<LaunchShape> shapes = launch_shapes(code.function, nullptr);
+            for (LaunchShape& shape : shapes) {
+                shape.variant = int(k.codes.size());
+                m_largest_grid = std::max(m_largest_grid, shape.grid);
+            }
+            k.codes.push_back(code);
+            k.shapes.insert(k.shapes.end(), shapes.begin(), shapes.end());
+            // Entries already tuned time the new shapes too.
+            for (auto& [key, tuning] : m_tuning)
+                if (size_t(m_scene->ray_generation(key.first).id) == i)
+                    tuning.add_shapes(shapes.size());
+        }
+        m_capped_kernels.clear();
     }
 
     void unload_kernels() {
+        if (m_capped.valid()) m_capped.wait();  // its results are of these kernels
+        m_capped = {};
+        m_capped_kernels.clear();
         for (RayGenerationKernel& k : m_kernels)
-            if (k.module) m_driver.cuModuleUnload(k.module);
+            for (KernelCode& code : k.codes)
+                if (code.module) m_driver.cuModuleUnload(code.module);
         m_kernels.clear();
         m_kernel = nullptr;
+        m_code = nullptr;
         m_gather = nullptr;
         m_source.clear();
     }
@@ -371,14 +475,6 @@ class CudaBackend final : public core::Backend {
         return ptr;
     }
 
-    /// A ray-generation program's kernel and its launch shapes (launch_shapes.h).
-    struct RayGenerationKernel {
-        CUmodule module = nullptr;  // its own (compile_megakernel's units)
-        CUfunction function = nullptr;
-        CUdeviceptr params = 0;     // the module's launch parameters
-        std::vector<LaunchShape> shapes{LaunchShape{}};  // shape 0: occupancy first
-        LaunchShape applied{-1, 0};
-    };
 
     /// The launch shapes of `kernel` (launch_shapes.h): for each count of blocks per SM up to
     /// what its registers allow, just the shared memory those blocks need (the runtime's
@@ -419,13 +515,16 @@ class CudaBackend final : public core::Backend {
         return std::max(1, blocks);
     }
 
+    /// The variant and grid of `shape` for this launch, with its carveout set.
     void apply_shape(RayGenerationKernel& kernel, const LaunchShape& shape) {
-        if (shape.carveout == kernel.applied.carveout) return;
-        check(m_driver.cuFuncSetAttribute(kernel.function,
+        m_code = &kernel.codes.at(size_t(shape.variant));
+        m_grid = shape.grid;
+        if (shape.carveout == m_code->carveout) return;
+        check(m_driver.cuFuncSetAttribute(m_code->function,
                                           CU_FUNC_ATTRIBUTE_PREFERRED_SHARED_MEMORY_CARVEOUT,
                                           shape.carveout),
               "set the shared memory carveout");
-        kernel.applied = shape;
+        m_code->carveout = shape.carveout;
     }
 
     const DriverApi& m_driver;
@@ -443,6 +542,10 @@ class CudaBackend final : public core::Backend {
     CUcontext m_context = nullptr;
     std::vector<RayGenerationKernel> m_kernels;  // by ray-generation program (ProgramTable id)
     RayGenerationKernel* m_kernel = nullptr;      // the current launch's
+    KernelCode* m_code = nullptr;                 // its variant in this launch's shape
+    int m_grid = 1;                               // and that shape's grid
+    std::future<std::vector<CompileResult>> m_capped;  // capped variants being compiled
+    std::vector<size_t> m_capped_kernels;              // the kernels they are of
     int m_largest_grid = 1;                       // of every kernel's shapes
     CUfunction m_gather = nullptr;
     std::string m_device_name, m_source;

@@ -27,15 +27,30 @@ std::vector<int> launch_shape_carveouts(int by_registers, const SharedMemoryNeed
 
 int ShapeTuning::next_shape() const {
     if (m_choice >= 0) return m_choice;
-    return m_launches <= 1 ? 0 : int(m_launches - 1);
+    // During a warm-up the first shape still to time runs (untimed); shape 0 at the start.
+    const auto untimed = std::find(m_timed.begin(), m_timed.end(), false);
+    return untimed == m_timed.end() ? 0 : int(untimed - m_timed.begin());
 }
 
 void ShapeTuning::record(int shape, double ms_per_index) {
     if (m_choice >= 0) return;
-    if (m_launches >= 1 && shape >= 0 && size_t(shape) < m_ms.size())
-        m_ms[size_t(shape)] = ms_per_index;
-    if (++m_launches == m_ms.size() + 1)
+    if (m_warm_ups > 0) {
+        --m_warm_ups;
+        return;
+    }
+    if (shape < 0 || size_t(shape) >= m_ms.size()) return;
+    m_ms[size_t(shape)] = ms_per_index;
+    m_timed[size_t(shape)] = true;
+    if (std::find(m_timed.begin(), m_timed.end(), false) == m_timed.end())
         m_choice = int(std::min_element(m_ms.begin(), m_ms.end()) - m_ms.begin());
+}
+
+void ShapeTuning::add_shapes(size_t count) {
+    if (count == 0) return;
+    m_ms.resize(m_ms.size() + count, 0.0);
+    m_timed.resize(m_ms.size(), false);
+    m_choice = -1;
+    m_warm_ups = 1;  // a new kernel's first launch loads its code: not a fair time
 }
 
 }  // namespace lucent::cuda

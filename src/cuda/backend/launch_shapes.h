@@ -9,10 +9,12 @@
 
 namespace lucent::cuda {
 
-/// A launch shape: the carveout and the persistent grid it lets run at once.
+/// A launch shape: which compiled variant of the kernel, the carveout, and the persistent
+/// grid they let run at once.
 struct LaunchShape {
     int carveout = 0;  // percent of the largest shared-memory configuration
     int grid = 1;      // blocks: resident blocks per SM x SMs
+    int variant = 0;   // 0: the kernel as compiled; 1: its register-capped variant
 };
 
 /// What a block needs of the SM's shared memory, in bytes (driver attributes).
@@ -39,19 +41,25 @@ std::vector<int> launch_shape_carveouts(int by_registers, const SharedMemoryNeed
 /// second is timed), launches 3 to n + 1 shapes 1 to n - 1; from then on, the fastest of
 /// those n, per launch index (a device of several runs a different share of each launch).
 /// Trials start at the third launch so that a job launching an entry twice (a denoiser's
-/// ping-pong passes in one render) never runs a trial shape.
+/// ping-pong passes in one render) never runs a trial shape. Shapes added later (a variant
+/// of the kernel compiled in the background) reopen the choice: one untimed launch, one
+/// timed launch of each new shape, then the fastest of all.
 class ShapeTuning {
   public:
-    explicit ShapeTuning(size_t shapes = 1) : m_ms(shapes == 0 ? 1 : shapes, 0.0) {}
+    explicit ShapeTuning(size_t shapes = 1)
+        : m_ms(shapes == 0 ? 1 : shapes, 0.0), m_timed(m_ms.size(), false) {}
     int next_shape() const;
     /// The time of a launch of `shape`, per launch index.
     void record(int shape, double ms_per_index);
+    /// `count` more shapes to time, numbered after the present ones.
+    void add_shapes(size_t count);
     /// The chosen shape, or -1 while still trying.
     int choice() const { return m_choice; }
 
   private:
-    unsigned m_launches = 0;
     std::vector<double> m_ms;  // per shape
+    std::vector<bool> m_timed;
+    unsigned m_warm_ups = 1;  // launches still to run untimed
     int m_choice = -1;
 };
 

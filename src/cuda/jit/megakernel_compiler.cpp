@@ -54,13 +54,13 @@ Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTa
     return k;
 }
 
-void compile_megakernel(Megakernel& k, int sm) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
+std::vector<CompileRequest> unit_requests(const Megakernel& k, int sm,
+                                          const std::vector<size_t>& kernels,
+                                          const std::vector<std::string>& extra_options) {
     std::vector<CompileRequest> requests;
-    for (const std::string& kernel : k.kernels) {
+    for (size_t i : kernels) {
         CompileRequest request =
-            embedded_request("lucent_megakernel.cu", k.source + kernel,
+            embedded_request("lucent_megakernel.cu", k.source + k.kernels.at(i),
                              {"--std=c++20", "-default-device", "--use_fast_math"}, sm);
         std::set<std::string> names;  // two modules may include one file
         for (const auto& module : k.modules)
@@ -68,18 +68,23 @@ void compile_megakernel(Megakernel& k, int sm) {
                 if (names.insert(name).second) request.headers.emplace_back(name, text);
         // LUCENT_NVRTC_OPTIONS="-DLUCENT_GPU_MIN_BLOCKS=8 ...": tuning experiments.
         add_options_from_env(request, "LUCENT_NVRTC_OPTIONS");
+        for (const std::string& o : extra_options) request.options.push_back(o);
         requests.push_back(std::move(request));
     }
+    return requests;
+}
+
+std::vector<CompileResult> compile_units(const std::vector<CompileRequest>& requests) {
     // The units are independent NVRTC programs: compiled side by side, a scene of several
     // ray-generation programs takes about as long as its largest one on a machine with the
     // cores (ptxas would otherwise compile trace_ray once per kernel, one after another).
-    k.binaries.assign(requests.size(), CompileResult{});
+    std::vector<CompileResult> binaries(requests.size());
     std::vector<std::exception_ptr> errors(requests.size());
     std::atomic<size_t> next{0};
     const auto work = [&] {
         for (size_t i; (i = next++) < requests.size();) {
             try {
-                k.binaries[i] = compile_cubin(requests[i]);
+                binaries[i] = compile_cubin(requests[i]);
             } catch (...) {
                 errors[i] = std::current_exception();
             }
@@ -94,6 +99,15 @@ void compile_megakernel(Megakernel& k, int sm) {
     for (std::thread& t : pool) t.join();
     for (const std::exception_ptr& e : errors)
         if (e) std::rethrow_exception(e);
+    return binaries;
+}
+
+void compile_megakernel(Megakernel& k, int sm) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    std::vector<size_t> all(k.kernels.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+    k.binaries = compile_units(unit_requests(k, sm, all, {}));
     k.from_cache = !k.binaries.empty();
     for (const CompileResult& b : k.binaries) k.from_cache = k.from_cache && b.from_cache;
     k.jit_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

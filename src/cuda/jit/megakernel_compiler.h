@@ -37,4 +37,13 @@ Megakernel generate_megakernel(const core::CompiledScene& scene, const ProgramTa
 /// one thread per unit and processor (8 at most); throws the first unit's error.
 void compile_megakernel(Megakernel& kernel, int sm);
 
+/// The NVRTC requests of the units of `kernels` (indices into kernel.kernels) for `sm`, with
+/// `extra_options` after the usual ones (e.g. a register cap for a variant).
+std::vector<CompileRequest> unit_requests(const Megakernel& kernel, int sm,
+                                          const std::vector<size_t>& kernels,
+                                          const std::vector<std::string>& extra_options);
+/// Compiles `requests` through the disk cache, side by side on up to one thread per request
+/// and processor (8 at most); throws the first one's error.
+std::vector<CompileResult> compile_units(const std::vector<CompileRequest>& requests);
+
 }  // namespace lucent::cuda
