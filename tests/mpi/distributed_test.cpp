@@ -53,14 +53,16 @@ void expect_one_process_image(const std::string& sample, RenderSettings settings
         EXPECT_TRUE(spread.report.ranks.empty());
         return;
     }
-    // The last launch was spread: every rank ran pieces of it (3 ranks, 40 rows).
+    // The last launch was spread: the ranks' pieces cover it exactly once. (Which rank took
+    // how many depends on timing: on CI's two cores a descheduled rank may take none.)
     ASSERT_EQ(spread.report.ranks.size(), size_t(world()->size()));
-    uint64_t indices = 0;
+    uint64_t indices = 0, pieces = 0;
     for (const auto& share : spread.report.ranks) {
-        EXPECT_GT(share.pieces, 0u);
         indices += share.indices;
+        pieces += share.pieces;
     }
     EXPECT_EQ(indices, uint64_t(settings.width) * settings.height);
+    EXPECT_GE(pieces, 2u * uint64_t(world()->size()));
 }
 
 TEST(Distributed, WhittedEqualsOneProcessOnEveryRank) {
