@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <map>
 #include <mutex>
 
 #include "core/backend.h"
@@ -71,6 +72,21 @@ uint64_t get(const unsigned char*& p) {
 }
 
 class DistributedBackend final : public Backend {
+  private:
+    /// A launch's entry point and size.
+    struct Key {
+        unsigned entry, x, y, z;
+        auto operator<=>(const Key&) const = default;
+    };
+    /// An index-local buffer whose elements are where the ranks computed them.
+    struct Partial {
+        std::shared_ptr<const Buffer> buffer;
+        Key key;                          // of the launches that wrote it
+        std::vector<LaunchPiece> pieces;  // this rank's
+        uint64_t version = 0;             // its host contents' then
+    };
+
+
   public:
     DistributedBackend(std::unique_ptr<Backend> local, std::shared_ptr<Ranks> ranks)
         : m_local(std::move(local)), m_ranks(std::move(ranks)), m_group(m_ranks->impl()) {}
@@ -81,9 +97,17 @@ class DistributedBackend final : public Backend {
     }
     bool traces_on_host() const override { return m_local->traces_on_host(); }
     bool uses_host_storage() const override { return m_local->uses_host_storage(); }
-    void fetch(const Buffer& buffer) override { m_local->fetch(buffer); }
+    void fetch(const Buffer& buffer) override {
+        // A host read of an index-local buffer whose elements are spread over the ranks:
+        // collective, as every rank's host code makes the same reads (SPMD).
+        auto found = m_partial.find(&buffer);
+        if (found != m_partial.end()) return gather_partial(found, true);
+        m_local->fetch(buffer);
+    }
     std::vector<std::shared_ptr<const Buffer>> host_copies_behind() const override {
-        return m_local->host_copies_behind();
+        auto behind = m_local->host_copies_behind();
+        for (const auto& [raw, partial] : m_partial) behind.push_back(partial.buffer);
+        return behind;
     }
     std::shared_ptr<DisplayFrame> display_frame(const Buffer& output) override {
         return m_local->display_frame(output);
@@ -109,14 +133,33 @@ class DistributedBackend final : public Backend {
         // A launch that writes elsewhere runs whole on every rank: each computes the same
         // (SPMD, same inputs), so no rank waits for another's copy.
         const bool split = !other && ranks > 1 && cut.pieces >= 2 * uint64_t(ranks);
-        if (split && m_group.rank() == 0) m_group.reset_counter();  // before anyone takes
+        // Index-local outputs only (an accumulation): each rank keeps its rows from the
+        // first such launch on, and nothing is gathered until something else reads them.
+        bool sticky = split && !shaped.empty();
+        for (const auto& b : shaped) sticky = sticky && b->launch_index_local();
+        const Key key{spec.entry, spec.size.x, spec.size.y, spec.size.z};
+        auto kept = m_kept_rows.find(key);
+        const bool take_from_counter = split && !(sticky && kept != m_kept_rows.end());
+        if (take_from_counter && m_group.rank() == 0) m_group.reset_counter();  // before anyone takes
         agree(m_group, nullptr, m_digest.of(scene, spec), "launch");
+        // Elements another launch left on other ranks, which this one reads: gathered now,
+        // in the order of the launch's buffers (the same on every rank).
+        for (const auto& b : launch_buffers(scene, spec.entry, &CompiledProgram::buffers)) {
+            auto found = m_partial.find(b.get());
+            if (found == m_partial.end()) continue;
+            if (found->second.version != b->version()) {  // new host contents since
+                m_partial.erase(found);
+                continue;
+            }
+            if (!(sticky && found->second.key == key)) gather_partial(found, false);
+        }
 
         LaunchSpec local = spec;
         local.on_rows = nullptr;  // a rank's pieces are not bands of the image
         std::mutex mutex;
         std::vector<LaunchPiece> mine;
-        if (split)
+        size_t next_kept = 0;
+        if (take_from_counter)
             local.next_piece = [&]() -> std::optional<LaunchPiece> {
                 const uint64_t k = m_group.fetch_add_counter(1);
                 if (k >= cut.pieces) return std::nullopt;
@@ -124,6 +167,13 @@ class DistributedBackend final : public Backend {
                 std::lock_guard lock(mutex);
                 mine.push_back(piece);
                 return piece;
+            };
+        else if (split)  // the rows this rank ran in the first launch of this entry and size
+            local.next_piece = [&]() -> std::optional<LaunchPiece> {
+                std::lock_guard lock(mutex);
+                if (next_kept == kept->second.size()) return std::nullopt;
+                mine.push_back(kept->second[next_kept]);
+                return kept->second[next_kept++];
             };
         const auto t0 = Clock::now();
         std::string failure;
@@ -139,18 +189,38 @@ class DistributedBackend final : public Backend {
         agree(m_group, failed ? &failure : nullptr, 0, "launch");
         if (!split) return;
         const auto t_gather = Clock::now();
-        gather(shaped, mine, busy_ms, spec, report);
+        if (sticky) {
+            if (take_from_counter) m_kept_rows[key] = mine;
+            exchange(mine, busy_ms, spec, {}, report, false);
+            for (const auto& b : shaped) {
+                b->mark_device_newer();  // a host read gathers it (fetch)
+                m_partial[b.get()] = Partial{b, key, mine, b->version()};
+            }
+        } else {
+            exchange(mine, busy_ms, spec, shaped, report, false);
+        }
         report.gather_ms = ms_between(t_gather, Clock::now());
-        trace(spec, report);
+        trace(spec, sticky, report);
     }
 
   private:
+    /// The elements an index-local buffer's last launches left on each rank reach every
+    /// rank (`in_fetch`: inside a host read, whose flag is already cleared).
+    void gather_partial(std::map<const Buffer*, Partial>::iterator found, bool in_fetch) {
+        const Partial partial = found->second;
+        m_partial.erase(found);
+        LaunchReport ignored;
+        LaunchSpec spec;
+        spec.size = uint3{partial.key.x, partial.key.y, partial.key.z};
+        exchange(partial.pieces, 0, spec, {partial.buffer}, ignored, in_fetch);
+    }
+
     /// Every rank sends the pieces it ran (their ranges, its exceptions, then each written
     /// buffer's bytes of each piece) to every other; each writes the others' pieces into
     /// its host copies, which then are the one-process image on every rank.
-    void gather(const std::vector<std::shared_ptr<const Buffer>>& shaped,
-                const std::vector<LaunchPiece>& mine, double busy_ms, const LaunchSpec& spec,
-                LaunchReport& report) {
+    void exchange(const std::vector<LaunchPiece>& mine, double busy_ms, const LaunchSpec& spec,
+                  const std::vector<std::shared_ptr<const Buffer>>& shaped, LaunchReport& report,
+                  bool in_fetch) {
         const uint3 size = spec.size;
         auto linear = [&](uint3 i) { return (uint64_t(i.z) * size.y + i.y) * size.x + i.x; };
         std::vector<unsigned char>& out = m_send;
@@ -171,7 +241,11 @@ class DistributedBackend final : public Backend {
             put(out, p.last);
         }
         for (const auto& b : shaped) {
-            b->sync_from_device();  // a GPU rank's pieces reach its host copy
+            // A GPU rank's pieces reach its host copy.
+            if (in_fetch)
+                m_local->fetch(*b);
+            else
+                b->sync_from_device();
             const size_t element = b->element().size;
             const auto* bytes = static_cast<const unsigned char*>(b->raw());
             for (const LaunchPiece& p : mine)
@@ -221,10 +295,11 @@ class DistributedBackend final : public Backend {
         for (const auto& b : shaped) const_cast<Buffer&>(*b).unmap();
     }
 
-    void trace(const LaunchSpec& spec, const LaunchReport& report) const {
+    void trace(const LaunchSpec& spec, bool sticky, const LaunchReport& report) const {
         if (!m_trace || m_group.rank() != 0) return;
-        std::fprintf(stderr, "distributed: entry %u, %llu indices, gather %.3f ms:", spec.entry,
-                     (unsigned long long)spec.count(), report.gather_ms);
+        std::fprintf(stderr, "distributed: entry %u, %llu indices, %s, gather %.3f ms:",
+                     spec.entry, (unsigned long long)spec.count(),
+                     sticky ? "rows kept (index-local)" : "pieces", report.gather_ms);
         for (size_t r = 0; r < report.ranks.size(); ++r)
             std::fprintf(stderr, " [rank %zu: %u pieces %llu indices %.3f ms]", r,
                          report.ranks[r].pieces, (unsigned long long)report.ranks[r].indices,
@@ -234,6 +309,8 @@ class DistributedBackend final : public Backend {
 
     std::unique_ptr<Backend> m_local;
     std::shared_ptr<Ranks> m_ranks;
+    std::map<Key, std::vector<LaunchPiece>> m_kept_rows;  // per entry and size: this rank's
+    std::map<const Buffer*, Partial> m_partial;
     Ranks::Impl& m_group;
     LaunchDigest m_digest;
     std::vector<unsigned char> m_send, m_received;  // kept: a 4K image's pieces each launch

@@ -2,10 +2,11 @@
 # `MPIRUN -np 3`; the two .pfm files (32-bit float, no metadata) must be equal byte for byte,
 # and the distributed run must have spread its launches over the ranks (rank 0's trace lines).
 file(MAKE_DIRECTORY ${WORK})
-set(one ${WORK}/${SAMPLE}-one.pfm)
-set(three ${WORK}/${SAMPLE}-three.pfm)
+# EXTRA: more render flags (e.g. --denoise), also naming the files.
+set(one ${WORK}/${SAMPLE}${EXTRA}-one.pfm)
+set(three ${WORK}/${SAMPLE}${EXTRA}-three.pfm)
 file(REMOVE ${one} ${three})
-set(args render --sample ${SAMPLE} --backend cpu --threads 1 --size 64x48 --quiet)
+set(args render --sample ${SAMPLE} --backend cpu --threads 1 --size 64x48 --quiet ${EXTRA})
 execute_process(COMMAND ${LUCENT} ${args} --out ${one} RESULT_VARIABLE rc ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "one process: exit ${rc}: ${err}")
