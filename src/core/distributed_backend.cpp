@@ -84,6 +84,7 @@ class DistributedBackend final : public Backend {
         Key key;                          // of the launches that wrote it
         std::vector<LaunchPiece> pieces;  // this rank's
         uint64_t version = 0;             // its host contents' then
+        bool kept_rows = false;           // written on the rows this rank keeps for `key`
     };
 
 
@@ -139,7 +140,8 @@ class DistributedBackend final : public Backend {
         for (const auto& b : shaped) sticky = sticky && b->launch_index_local();
         const Key key{spec.entry, spec.size.x, spec.size.y, spec.size.z};
         auto kept = m_kept_rows.find(key);
-        const bool take_from_counter = split && !(sticky && kept != m_kept_rows.end());
+        const bool run_kept = sticky && kept != m_kept_rows.end();
+        const bool take_from_counter = split && !run_kept;
         if (take_from_counter && m_group.rank() == 0) m_group.reset_counter();  // before anyone takes
         agree(m_group, nullptr, m_digest.of(scene, spec), "launch");
         // Elements another launch left on other ranks, which this one reads: gathered now,
@@ -151,7 +153,8 @@ class DistributedBackend final : public Backend {
                 m_partial.erase(found);
                 continue;
             }
-            if (!(sticky && found->second.key == key)) gather_partial(found, false);
+            if (!(run_kept && found->second.key == key && found->second.kept_rows))
+                gather_partial(found, false);
         }
 
         LaunchSpec local = spec;
@@ -190,17 +193,20 @@ class DistributedBackend final : public Backend {
         if (!split) return;
         const auto t_gather = Clock::now();
         if (sticky) {
-            if (take_from_counter) m_kept_rows[key] = mine;
+            // The rows of the second launch are kept: the first one's shares include
+            // warming up (a GPU's kernel compile), not the devices' speeds.
+            if (take_from_counter && ++m_sticky_launches[key] == 2) m_kept_rows[key] = mine;
             exchange(mine, busy_ms, spec, {}, report, false);
             for (const auto& b : shaped) {
                 b->mark_device_newer();  // a host read gathers it (fetch)
-                m_partial[b.get()] = Partial{b, key, mine, b->version()};
+                m_partial[b.get()] = Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
             }
         } else {
             exchange(mine, busy_ms, spec, shaped, report, false);
         }
         report.gather_ms = ms_between(t_gather, Clock::now());
-        trace(spec, sticky, report);
+        trace(spec, run_kept ? "index-local, rows kept" : sticky ? "index-local, pieces" : "pieces",
+              report);
     }
 
   private:
@@ -295,11 +301,11 @@ class DistributedBackend final : public Backend {
         for (const auto& b : shaped) const_cast<Buffer&>(*b).unmap();
     }
 
-    void trace(const LaunchSpec& spec, bool sticky, const LaunchReport& report) const {
+    void trace(const LaunchSpec& spec, const char* how, const LaunchReport& report) const {
         if (!m_trace || m_group.rank() != 0) return;
-        std::fprintf(stderr, "distributed: entry %u, %llu indices, %s, gather %.3f ms:",
-                     spec.entry, (unsigned long long)spec.count(),
-                     sticky ? "rows kept (index-local)" : "pieces", report.gather_ms);
+        std::fprintf(stderr, "distributed: entry %u, %llu indices, %s, gather %.3f ms of %zu bytes:",
+                     spec.entry, (unsigned long long)spec.count(), how, report.gather_ms,
+                     m_received.size());
         for (size_t r = 0; r < report.ranks.size(); ++r)
             std::fprintf(stderr, " [rank %zu: %u pieces %llu indices %.3f ms]", r,
                          report.ranks[r].pieces, (unsigned long long)report.ranks[r].indices,
@@ -310,6 +316,7 @@ class DistributedBackend final : public Backend {
     std::unique_ptr<Backend> m_local;
     std::shared_ptr<Ranks> m_ranks;
     std::map<Key, std::vector<LaunchPiece>> m_kept_rows;  // per entry and size: this rank's
+    std::map<Key, unsigned> m_sticky_launches;           // index-local launches taken so far
     std::map<const Buffer*, Partial> m_partial;
     Ranks::Impl& m_group;
     LaunchDigest m_digest;
