@@ -27,7 +27,8 @@ double ping_pong(int rank, int peer, size_t bytes, int repeats) {
         const double t0 = now();
         if (rank == 0) {
             MPI_Send(buffer.data(), int(bytes), MPI_BYTE, peer, 0, MPI_COMM_WORLD);
-            MPI_Recv(buffer.data(), int(bytes), MPI_BYTE, peer, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            MPI_Recv(buffer.data(), int(bytes), MPI_BYTE, peer, 0, MPI_COMM_WORLD,
+                     MPI_STATUS_IGNORE);
         } else if (rank == peer) {
             MPI_Recv(buffer.data(), int(bytes), MPI_BYTE, 0, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
             MPI_Send(buffer.data(), int(bytes), MPI_BYTE, 0, 0, MPI_COMM_WORLD);
@@ -106,15 +107,16 @@ int main(int argc, char** argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     if (ranks < 2) {
-        if (rank == 0) std::fprintf(stderr, "lucent-ranks-bench: run it under mpirun -np 2 or more\n");
+        if (rank == 0)
+            std::fprintf(stderr, "lucent-ranks-bench: run it under mpirun -np 2 or more\n");
         MPI_Finalize();
         return 2;
     }
     const int peer = ranks - 1;
     const bool print = rank == 0;
     if (print) std::printf("lucent-ranks-bench: %d ranks\n", ranks);
-    for (size_t bytes : {size_t(8), size_t(64) << 10, size_t(1) << 20, size_t(16) << 20,
-                         size_t(128) << 20}) {
+    for (size_t bytes :
+         {size_t(8), size_t(64) << 10, size_t(1) << 20, size_t(16) << 20, size_t(128) << 20}) {
         const double s = ping_pong(rank, peer, bytes, bytes > (1u << 20) ? 5 : 200);
         if (print)
             std::printf("  ping-pong %10zu B: %10.2f us one way, %8.2f GB/s\n", bytes, s * 1e6,
@@ -128,9 +130,9 @@ int main(int argc, char** argv) {
         const size_t bytes = size_t(w) * h * 16;
         const double s = gather_image(ranks, bytes, 3);
         if (print)
-            std::printf("  all-gather of a %ux%u float4 image (%.1f MB): %.2f ms, %.2f GB/s per rank\n",
-                        w, h, double(bytes) / 1e6, s * 1e3,
-                        double(bytes) * (ranks - 1) / ranks / s / 1e9);
+            std::printf(
+                "  all-gather of a %ux%u float4 image (%.1f MB): %.2f ms, %.2f GB/s per rank\n", w,
+                h, double(bytes) / 1e6, s * 1e3, double(bytes) * (ranks - 1) / ranks / s / 1e9);
     }
     MPI_Finalize();
     return 0;

@@ -87,7 +87,6 @@ class DistributedBackend final : public Backend {
         bool kept_rows = false;           // written on the rows this rank keeps for `key`
     };
 
-
   public:
     DistributedBackend(std::unique_ptr<Backend> local, std::shared_ptr<Ranks> ranks)
         : m_local(std::move(local)), m_ranks(std::move(ranks)), m_group(m_ranks->impl()) {}
@@ -142,7 +141,8 @@ class DistributedBackend final : public Backend {
         auto kept = m_kept_rows.find(key);
         const bool run_kept = sticky && kept != m_kept_rows.end();
         const bool take_from_counter = split && !run_kept;
-        if (take_from_counter && m_group.rank() == 0) m_group.reset_counter();  // before anyone takes
+        if (take_from_counter && m_group.rank() == 0)
+            m_group.reset_counter();  // before anyone takes
         agree(m_group, nullptr, m_digest.of(scene, spec), "launch");
         // Elements another launch left on other ranks, which this one reads: gathered now,
         // in the order of the launch's buffers (the same on every rank).
@@ -199,13 +199,17 @@ class DistributedBackend final : public Backend {
             exchange(mine, busy_ms, spec, {}, report, false);
             for (const auto& b : shaped) {
                 b->mark_device_newer();  // a host read gathers it (fetch)
-                m_partial[b.get()] = Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
+                m_partial[b.get()] =
+                    Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
             }
         } else {
             exchange(mine, busy_ms, spec, shaped, report, false);
         }
         report.gather_ms = ms_between(t_gather, Clock::now());
-        trace(spec, run_kept ? "index-local, rows kept" : sticky ? "index-local, pieces" : "pieces",
+        trace(spec,
+              run_kept ? "index-local, rows kept"
+              : sticky ? "index-local, pieces"
+                       : "pieces",
               report);
     }
 
@@ -293,8 +297,9 @@ class DistributedBackend final : public Backend {
                     p += n;
                 }
             }
-            if (p != end) throw Error("distributed backend: rank " + std::to_string(r) +
-                                      "'s gathered pieces do not add up (internal error)");
+            if (p != end)
+                throw Error("distributed backend: rank " + std::to_string(r) +
+                            "'s gathered pieces do not add up (internal error)");
         }
         // New host contents on every rank alike: a GPU uploads them before it next reads
         // them, and the versions (which launch digests do not hash) stay equal across ranks.
@@ -303,9 +308,10 @@ class DistributedBackend final : public Backend {
 
     void trace(const LaunchSpec& spec, const char* how, const LaunchReport& report) const {
         if (!m_trace || m_group.rank() != 0) return;
-        std::fprintf(stderr, "distributed: entry %u, %llu indices, %s, gather %.3f ms of %zu bytes:",
-                     spec.entry, (unsigned long long)spec.count(), how, report.gather_ms,
-                     m_received.size());
+        std::fprintf(
+            stderr,
+            "distributed: entry %u, %llu indices, %s, gather %.3f ms of %zu bytes:", spec.entry,
+            (unsigned long long)spec.count(), how, report.gather_ms, m_received.size());
         for (size_t r = 0; r < report.ranks.size(); ++r)
             std::fprintf(stderr, " [rank %zu: %u pieces %llu indices %.3f ms]", r,
                          report.ranks[r].pieces, (unsigned long long)report.ranks[r].indices,
@@ -316,7 +322,7 @@ class DistributedBackend final : public Backend {
     std::unique_ptr<Backend> m_local;
     std::shared_ptr<Ranks> m_ranks;
     std::map<Key, std::vector<LaunchPiece>> m_kept_rows;  // per entry and size: this rank's
-    std::map<Key, unsigned> m_sticky_launches;           // index-local launches taken so far
+    std::map<Key, unsigned> m_sticky_launches;            // index-local launches taken so far
     std::map<const Buffer*, Partial> m_partial;
     Ranks::Impl& m_group;
     LaunchDigest m_digest;

@@ -111,7 +111,8 @@ uint64_t LaunchDigest::of(const CompiledScene& scene, const LaunchSpec& spec) {
                     h.word(contents(b));
                     break;
                 }
-                case FieldKind::kCallable:  // a host address; the program's label is in the callables
+                case FieldKind::kCallable:  // a host address; the program's label is in the
+                                            // callables
                     break;
                 default:  // values, node handles (indices), user structs
                     h.bytes(record + field.offset, field.size);

@@ -103,8 +103,9 @@ class MultiDeviceBackend final : public Backend {
         const auto viewed = launch_buffers(scene, spec.entry, &CompiledProgram::buffers);
         if (spec.next_piece) {  // pieces from the ranks' counter: every device takes them
             if (!other.empty())
-                throw Error("multi-device backend: pieces given for a launch that writes "
-                            "buffers of another shape than the launch");
+                throw Error(
+                    "multi-device backend: pieces given for a launch that writes "
+                    "buffers of another shape than the launch");
             run_in_pieces(scene, spec, shaped, other, viewed, nullptr, whole_on, speeds, report);
             return;
         }

@@ -18,13 +18,15 @@ struct Ranks::Impl {
     virtual int rank() const = 0;
     virtual int size() const = 0;
     /// Collective: every rank's `words`, in rank order.
-    virtual std::vector<std::array<uint64_t, 2>> all_gather_words(std::array<uint64_t, 2> words) = 0;
+    virtual std::vector<std::array<uint64_t, 2>> all_gather_words(
+        std::array<uint64_t, 2> words) = 0;
     /// Collective: `root`'s text, on every rank.
     virtual std::string broadcast_text(int root, const std::string& text) = 0;
     /// Collective: every rank's bytes, concatenated in rank order; `counts` gets each
     /// rank's byte count.
     virtual void all_gather_bytes(const std::vector<unsigned char>& mine,
-                                  std::vector<unsigned char>& all, std::vector<uint64_t>& counts) = 0;
+                                  std::vector<unsigned char>& all,
+                                  std::vector<uint64_t>& counts) = 0;
     /// The launch's shared piece counter on rank 0. reset: rank 0 only, before the
     /// agreement that opens a launch (so no rank takes a piece before it); take: adds `n`
     /// and returns the value before, from any thread of any rank.

@@ -59,7 +59,8 @@ void agree(Ranks::Impl& ranks, const std::string* failure, uint64_t digest, cons
         }
     std::string differ;
     for (int r = 1; r < int(all.size()); ++r)
-        if (all[size_t(r)][1] != all[0][1]) differ += (differ.empty() ? "" : ", ") + std::to_string(r);
+        if (all[size_t(r)][1] != all[0][1])
+            differ += (differ.empty() ? "" : ", ") + std::to_string(r);
     if (!differ.empty())
         throw RankError(-1, std::string("ranks diverged: the ") + what + " of rank" +
                                 (differ.find(',') == std::string::npos ? " " : "s ") + differ +

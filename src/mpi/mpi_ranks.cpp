@@ -97,7 +97,8 @@ class MpiRanks final : public Ranks::Impl {
         const uint64_t my_count = mine.size();
         check(MPI_Allgather(&my_count, 1, MPI_UINT64_T, counts.data(), 1, MPI_UINT64_T, m_comm),
               "MPI_Allgather");
-        std::vector<int> int_counts(static_cast<size_t>(m_size)), displacements(static_cast<size_t>(m_size));
+        std::vector<int> int_counts(static_cast<size_t>(m_size)),
+            displacements(static_cast<size_t>(m_size));
         uint64_t total = 0;
         for (int r = 0; r < m_size; ++r) {
             displacements[size_t(r)] = int(total);
@@ -155,8 +156,15 @@ std::shared_ptr<Ranks> ranks_of(MPI_Comm comm) {
     int initialised = 0;
     MPI_Initialized(&initialised);
     if (!initialised)
-        throw Error("ranks_of: MPI is not initialised; call MPI_Init_thread (with "
-                    "MPI_THREAD_SERIALIZED or more) first, or use Ranks::world()");
+        throw Error(
+            "ranks_of: MPI is not initialised; call MPI_Init_thread (with "
+            "MPI_THREAD_SERIALIZED or more) first, or use Ranks::world()");
+    int level = 0;
+    MPI_Query_thread(&level);
+    if (level < MPI_THREAD_SERIALIZED)
+        throw Error("ranks_of: MPI was initialised with thread level " + std::to_string(level) +
+                    "; a rank's devices take pieces from several threads: initialise it with "
+                    "MPI_Init_thread(..., MPI_THREAD_SERIALIZED, ...) or more");
     return std::make_shared<Ranks>(std::make_unique<core::MpiRanks>(comm));
 }
 

@@ -34,7 +34,8 @@ RenderSettings small(const std::string& sample_spp = "") {
 
 bool same_bytes(const lucent::scene::Image& a, const lucent::scene::Image& b) {
     return a.width == b.width && a.height == b.height && a.pixels.size() == b.pixels.size() &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) ==
+               0;
 }
 
 /// Each rank renders once across all ranks and once alone: both images must be the same
@@ -83,7 +84,8 @@ TEST(Distributed, DivergedVariableIsAnErrorOnEveryRank) {
     RenderSettings s = small("1");
     s.ranks = world();
     // The last rank traces shorter paths: a record's variable differs.
-    if (world()->rank() == world()->size() - 1 && world()->size() > 1) s.sets = {{"max_depth", "3"}};
+    if (world()->rank() == world()->size() - 1 && world()->size() > 1)
+        s.sets = {{"max_depth", "3"}};
     if (world()->size() == 1) GTEST_SKIP() << "one rank: nothing can diverge";
     try {
         find_sample("pathtracer").render(s);
