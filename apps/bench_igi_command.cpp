@@ -3,6 +3,7 @@
 
 #include "bench/igi/igi_bench.h"
 #include "cli_parse.h"
+#include "cli_ranks.h"
 #include "progress_bar.h"
 
 namespace lucent::cli {
@@ -70,7 +71,13 @@ int run_bench_igi_command(const BenchIgiArgs& args) {
     options.interleave = args.interleave;
     options.reflection_layer = args.reflection_layer != 0;
     options.json = args.json;
-    return run_with_progress_bar("bench igi", "configurations", options, bench::run_igi_bench);
+    // Under mpirun: every frame's launches spread over the ranks; rank 0 prints the table.
+    options.ranks = join_ranks();
+    int code = 0;
+    run_agreed(options.ranks, [&] {
+        code = run_with_progress_bar("bench igi", "configurations", options, bench::run_igi_bench);
+    });
+    return code;
 }
 
 }  // namespace lucent::cli

@@ -12,6 +12,7 @@
 #include "bench_spheres_command.h"
 #include "cli_errors.h"
 #include "cli_parse.h"
+#include "cli_ranks.h"
 #include "compare_command.h"
 #include "lucent/error.h"
 #include "lucent/version.h"
@@ -27,8 +28,12 @@ namespace {
 constexpr int kRuntimeExit = 1;
 constexpr int kUsageExit = 2;
 
-int report(const std::string& where, const char* kind, const char* what, int code) {
+int report(const std::string& where, const char* kind, const char* what, int code,
+           bool every_rank_alike = false) {
     std::fflush(stdout);
+    // Under mpirun, what every rank meets alike (a usage error, an agreed rank failure) is
+    // printed once, by rank 0.
+    if (every_rank_alike && lucent::cli::launcher_rank() != 0) return code;
     std::fprintf(stderr, "%s: %s%s\n", where.c_str(), kind, what);
     return code;
 }
@@ -90,7 +95,7 @@ int main(int argc, char** argv) {
             // error, worded as Lucent's own.
             if (e.get_exit_code() == 0) return app.exit(e);
             const UsageMessage message = usage_message(app, e, argc, argv);
-            return report(message.where, "", message.text.c_str(), kUsageExit);
+            return report(message.where, "", message.text.c_str(), kUsageExit, true);
         }
         if (render->parsed()) {
             where = "lucent render";
@@ -146,9 +151,11 @@ int main(int argc, char** argv) {
         }
         return report(where, "", "no command given; run `lucent --help`", kUsageExit);
     } catch (const UsageError& e) {
-        return report(where, "", e.what(), kUsageExit);
+        return report(where, "", e.what(), kUsageExit, true);
     } catch (const lucent::samples::SettingsError& e) {
-        return report(where, "", e.what(), kUsageExit);
+        return report(where, "", e.what(), kUsageExit, true);
+    } catch (const lucent::RankError& e) {
+        return report(where, "error: ", e.what(), kRuntimeExit, true);
     } catch (const lucent::Error& e) {
         return report(where, "error: ", e.what(), kRuntimeExit);
     } catch (const std::exception& e) {

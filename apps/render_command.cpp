@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "camera_flags.h"
+#include "cli_ranks.h"
 #include "cli_parse.h"
 #include "progress_bar.h"
 #include "samples/sample.h"
@@ -279,6 +280,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
 
 int run_render(const RenderArgs& args) {
     samples::RenderSettings settings = settings_from(args);
+    // Under mpirun: every rank renders its pieces of each launch; rank 0 writes and prints.
+    settings.ranks = join_ranks();
+    const bool writes = !settings.ranks || settings.ranks->rank() == 0;
     check_image_path("--out", args.out);
     std::string extension = std::filesystem::path(args.out).extension().string();
     for (char& c : extension) c = char(std::tolower((unsigned char)c));
@@ -316,7 +320,8 @@ int run_render(const RenderArgs& args) {
                                            uint64_t total) { progress.load(stage, done, total); };
     }
     const Clock::time_point start = Clock::now();
-    samples::RenderResult result = sample.render(run);
+    samples::RenderResult result;
+    run_agreed(settings.ranks, [&] { result = sample.render(run); });
     progress.finish();
     const Clock::time_point written = Clock::now();
     scene::ExrExtras extras;
@@ -328,7 +333,10 @@ int run_render(const RenderArgs& args) {
         result.aovs.clear();
         for (const scene::ExrChannel& c : extras.channels) result.aovs.push_back({c.name, {}});
     }
-    scene::write_image(args.out, result.image, extras);
+    // Every rank learns whether rank 0's write failed, and all exit alike.
+    run_agreed(settings.ranks, [&] {
+        if (writes) scene::write_image(args.out, result.image, extras);
+    });
     const double write_ms = ms_since(written);
     const double total_ms = ms_since(start);
 

@@ -53,6 +53,9 @@ struct RenderSettings {
     /// Called as bands of rows of a launch finish on the CPU (ContextOptions::on_progress),
     /// e.g. for a viewer showing partial results; may be empty.
     std::function<void(const LaunchProgress&)> on_launch_progress;
+    /// The processes each launch is spread over (`mpirun`; docs/distributed.md); null: this
+    /// process alone.
+    std::shared_ptr<Ranks> ranks;
     /// Called as a large scene file is read (scene::LoadProgress), e.g. for a progress bar;
     /// may be empty.
     scene::LoadProgress on_load_progress;
@@ -64,6 +67,7 @@ struct RenderSettings {
     ContextOptions context_options() const {
         ContextOptions options{backend, threads, jit_check_sm};
         options.devices = devices;
+        options.ranks = ranks;
         options.on_progress = on_launch_progress;
         return options;
     }

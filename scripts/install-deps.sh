@@ -10,6 +10,7 @@ packages=(
   libglfw3-dev libimgui-dev libgl-dev libopengl-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   xvfb xauth
   pybind11-dev python3-dev python3-numpy python3-pytest
+  openmpi-bin libopenmpi-dev
 )
 
 missing=()

@@ -53,6 +53,7 @@ Row run_one(const IgiBenchOptions& options, const Configuration& c, unsigned vpl
     settings.backend = options.backend;
     settings.devices = options.devices;
     settings.threads = options.threads;
+    settings.ranks = options.ranks;
     settings.scene = options.scene;
     settings.repeat = options.frames + 1;  // the first frame compiles: not timed
     settings.sets = {

@@ -16,6 +16,7 @@ struct IgiBenchOptions {
     BackendKind backend = BackendKind::kCpu;
     std::vector<DeviceSpec> devices;  // non-empty: launches spread over these
     unsigned threads = 0;
+    std::shared_ptr<Ranks> ranks;  // non-null: launches spread over these processes (mpirun)
     unsigned width = 800, height = 600;  // the paper's resolution
     unsigned frames = 10;                // timed after one warm-up frame
     std::vector<unsigned> vpls{30, 90, 180};

@@ -60,6 +60,16 @@ class Buffer : public ContextObject {
         unmap();
     }
 
+    /// Declares that launches read and write element i of this launch-shaped buffer only
+    /// at launch index i (an accumulation buffer; OptiX's RT_BUFFER_GPU_LOCAL serves the
+    /// same purpose across GPUs). A Context spanning ranks then keeps each rank's elements
+    /// where they were computed, launch after launch of one entry point and size, and
+    /// gathers them only when something else reads the buffer: another launch, or a host
+    /// read, which is then collective (every rank must make it; docs/distributed.md,
+    /// "Index-local buffers"). No effect in one process.
+    void set_launch_index_local(bool local) { m_launch_index_local = local; }
+    bool launch_index_local() const { return m_launch_index_local; }
+
     /// The host copy, as it is (backends use these; applications use map/data).
     void* raw() { return bytes(); }
     const void* raw() const { return bytes(); }
@@ -83,6 +93,7 @@ class Buffer : public ContextObject {
     std::vector<Block> m_blocks;  // 16-byte aligned backing store
     bool m_mapped = false;
     mutable bool m_device_newer = false;
+    bool m_launch_index_local = false;
     uint64_t m_version = 1;
 };
 

@@ -11,6 +11,7 @@
 #include "lucent/display.h"
 #include "lucent/nodes.h"
 #include "lucent/program.h"
+#include "lucent/ranks.h"
 #include "lucent/variables.h"
 
 namespace lucent {
@@ -62,6 +63,11 @@ struct ContextOptions {
     /// device's copy of the buffers is host memory (the CPU backend, one device); an
     /// interactive viewer shows them while a slow frame renders. Empty: launches run whole.
     std::function<void(const LaunchProgress&)> on_progress;
+    /// The processes every launch is spread over (lucent/ranks.h, docs/distributed.md):
+    /// each rank runs pieces on its own devices (`devices`, `backend`), and every rank's
+    /// outputs hold the whole image after a launch. Every rank must run the same host code
+    /// (each launch checks it). Null: this process alone.
+    std::shared_ptr<Ranks> ranks;
 };
 
 constexpr unsigned kMaxDevices = 16;
@@ -114,6 +120,16 @@ struct LaunchReport {
     /// Multi-device launches: bringing every device's copy of the written buffers up to
     /// date with the pieces the other devices ran (within launch_ms).
     double exchange_ms = 0;
+    /// Launches spread over ranks (ContextOptions::ranks): what each rank ran, in rank
+    /// order (empty when the launch ran whole on every rank), and the gather of the
+    /// pieces every rank's outputs receive from the others (within launch_ms).
+    struct RankShare {
+        uint64_t indices = 0;  // launch indices it ran
+        unsigned pieces = 0;   // pieces it took from the shared counter
+        double busy_ms = 0;    // its devices' run, from the launch's start on that rank
+    };
+    std::vector<RankShare> ranks;
+    double gather_ms = 0;
     uint64_t exception_count() const;
     /// One line per exception code: "stack overflow: 12 (first at 3,4,0)".
     std::string summary() const;

@@ -137,6 +137,10 @@ PathScene build(Context& ctx, const RenderSettings& settings, const PathOptions&
     out.accum =
         ctx.create_buffer<float4>(BufferType::kInputOutput, settings.width, settings.height);
     out.output = ctx.create_buffer<float4>(BufferType::kOutput, settings.width, settings.height);
+    // Each pixel's frames add up in its own element: across ranks, a rank keeps the pixels
+    // it ran from frame to frame, and the image is gathered once (docs/distributed.md).
+    out.accum->set_launch_index_local(true);
+    out.output->set_launch_index_local(true);
     out.stream_offset = ctx.create_buffer<unsigned>(BufferType::kInput, 1);
     out.stream_offset->upload(std::vector<unsigned>{0});
     out.miss = ctx.create_program(LUCENT_PROGRAM(pathtracer::pt_miss));

@@ -38,7 +38,9 @@ RunOnWorkers worker_pool(unsigned workers) {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_backend(const ContextOptions& options, std::string& notice) {
+namespace {
+/// This process's devices: the multi-device backend over options.devices, or one device.
+std::unique_ptr<Backend> make_local_backend(const ContextOptions& options, std::string& notice) {
     if (!options.devices.empty()) {
         std::vector<std::unique_ptr<Backend>> devices;
         std::vector<std::string> names;
@@ -67,6 +69,13 @@ std::unique_ptr<Backend> make_backend(const ContextOptions& options, std::string
 #endif
     }
     return make_cpu_backend(options.threads);
+}
+}  // namespace
+
+std::unique_ptr<Backend> make_backend(const ContextOptions& options, std::string& notice) {
+    auto local = make_local_backend(options, notice);
+    if (!options.ranks) return local;
+    return make_distributed_backend(std::move(local), options.ranks);
 }
 
 int gpu_count() {

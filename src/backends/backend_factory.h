@@ -15,7 +15,8 @@ namespace lucent::core {
 
 /// The backend a Context with these options runs on: a multi-device backend over
 /// options.devices when they are listed, else the backend options.backend names (kAuto:
-/// the CUDA backend when it can run, else the CPU, with the reason in `notice`). Throws
+/// the CUDA backend when it can run, else the CPU, with the reason in `notice`); with
+/// options.ranks, that backend is this rank's part of a distributed one. Throws
 /// lucent::Error naming the device or backend that cannot run and what to use instead.
 std::unique_ptr<Backend> make_backend(const ContextOptions& options, std::string& notice);
 

@@ -7,7 +7,9 @@ namespace lucent::core {
 
 void Backend::launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report) {
     begin_launch(scene, spec, report);
-    if (spec.on_rows && uses_host_storage() && spec.by_rows()) {
+    if (spec.next_piece) {
+        while (auto piece = spec.next_piece()) run_piece(*piece);
+    } else if (spec.on_rows && uses_host_storage() && spec.by_rows()) {
         // Bands of rows, each reported as it finishes: about 32 per launch, at least 8 rows
         // (the CPU's tile height), so the pauses between bands cost little.
         const uint64_t rows = uint64_t(spec.size.y) * spec.size.z;

@@ -5,13 +5,21 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/compiled_scene.h"
 #include "lucent/display.h"
+#include "lucent/ranks.h"
 
 namespace lucent::core {
+
+/// Part of a launch: the launch indices with linear index (z * height + y) * width + x in
+/// [first, last). In launches of more than one row both are multiples of the width.
+struct LaunchPiece {
+    uint64_t first = 0, last = 0;
+};
 
 /// What a launch runs.
 struct LaunchSpec {
@@ -24,12 +32,11 @@ struct LaunchSpec {
     bool by_rows() const { return size.y > 1 || size.z > 1; }
     /// Called as bands of rows finish, where the device's copy is host memory; may be empty.
     std::function<void(unsigned rows_done, unsigned rows)> on_rows;
-};
-
-/// Part of a launch: the launch indices with linear index (z * height + y) * width + x in
-/// [first, last). In launches of more than one row both are multiples of the width.
-struct LaunchPiece {
-    uint64_t first = 0, last = 0;
+    /// Pieces handed out from outside this process's devices (the ranks' shared counter,
+    /// docs/distributed.md): every device takes its pieces from here, from any thread,
+    /// until it returns nothing. Empty: the backend runs the whole launch (spread over its
+    /// own devices as it sees fit).
+    std::function<std::optional<LaunchPiece>()> next_piece;
 };
 
 /// GPUs that share one tile counter in device memory (peer atomics over NVLink): each runs
@@ -107,6 +114,12 @@ std::unique_ptr<Backend> make_cpu_backend(unsigned threads);
 
 /// Runs job(worker) for every worker of a pool at once and returns when all are done.
 using RunOnWorkers = std::function<void(const std::function<void(unsigned worker)>& job)>;
+
+/// One launch spread over the ranks of `ranks` (docs/distributed.md): each rank runs pieces
+/// on `local` (its own devices) taken from a counter shared by all ranks, and every rank's
+/// copies of the launch's outputs then receive the others' pieces.
+std::unique_ptr<Backend> make_distributed_backend(std::unique_ptr<Backend> local,
+                                                  std::shared_ptr<Ranks> ranks);
 
 /// One launch spread over several backends (docs/multi-device.md), each driven from a
 /// worker of `run_on_devices` (one per device; the factory gives it the CPU's thread pool).

@@ -45,6 +45,10 @@ struct Context::Impl {
     /// options.backend chose).
     void use_backend(std::unique_ptr<core::Backend> next, const std::vector<DeviceSpec>& devices);
 
+    /// Compiles the scene if it changed and checks the launch against it.
+    void prepare_launch(unsigned entry, unsigned width, unsigned height, unsigned depth,
+                        LaunchReport& report, std::chrono::steady_clock::time_point t0);
+
     std::string next_name(const char* kind) {
         return std::string(kind) + "#" + std::to_string(++next_id);
     }
@@ -428,6 +432,45 @@ void Context::validate() {
                         std::to_string(e) + ", program) or lower the entry point count");
 }
 
+/// Compiles the scene if it changed and checks the launch against it.
+void Context::Impl::prepare_launch(unsigned entry, unsigned width, unsigned height,
+                                   unsigned depth, LaunchReport& report,
+                                   std::chrono::steady_clock::time_point t0) {
+    bool stale = !compiled || compiled->generation != shared->generation;
+    if (!stale && compiled->data_generation != shared->data_generation) {
+        // New buffer contents: a recompile only if something was built from them.
+        for (const auto& [buffer, version] : compiled->rebuild_inputs)
+            stale = stale || buffer->version() != version;
+        if (!stale) compiled->data_generation = shared->data_generation;
+    }
+    if (stale) {
+        compiled.reset();  // a failed compile must not leave a stale scene behind
+        core::SceneCompiler compiler(state, accel_cache,
+                                     backend->traces_on_host());
+        compiled = compiler.compile();
+        compiled->generation = shared->generation;
+        compiled->data_generation = shared->data_generation;
+        report.accel_ms = compiler.accel_ms();
+        report.compile_ms = ms_since(t0) - report.accel_ms;
+        report.recompiled = true;
+        if (const int sm = options.jit_check_sm)
+            core::jit_check(*compiled, sm, report);
+    }
+    const core::CompiledScene& scene = *compiled;
+    check_ray_generation(scene, entry);
+    unsigned dims = depth > 1 ? 3 : height > 1 ? 2 : 1;
+    for (const Buffer* out : scene.entries[entry].output_buffers) {
+        uint3 s = out->size();
+        if (out->dimensionality() == dims && (s.x != width || s.y != height || s.z != depth))
+            throw Error("Context::launch: " + out->describe() +
+                        " is written by the ray generation program of entry " +
+                        std::to_string(entry) + " but the launch is " + std::to_string(width) +
+                        "x" + std::to_string(height) +
+                        (dims == 3 ? "x" + std::to_string(depth) : "") +
+                        "; resize the buffer to the launch size");
+    }
+}
+
 void Context::launch(unsigned entry, unsigned width) {
     launch(entry, width, 1, 1);
 }
@@ -442,39 +485,19 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
                     " is empty; every dimension must be at least 1");
     LaunchReport report;
     auto t0 = Clock::now();
-    bool stale = !m_impl->compiled || m_impl->compiled->generation != m_impl->shared->generation;
-    if (!stale && m_impl->compiled->data_generation != m_impl->shared->data_generation) {
-        // New buffer contents: a recompile only if something was built from them.
-        for (const auto& [buffer, version] : m_impl->compiled->rebuild_inputs)
-            stale = stale || buffer->version() != version;
-        if (!stale) m_impl->compiled->data_generation = m_impl->shared->data_generation;
-    }
-    if (stale) {
-        m_impl->compiled.reset();  // a failed compile must not leave a stale scene behind
-        core::SceneCompiler compiler(m_impl->state, m_impl->accel_cache,
-                                     m_impl->backend->traces_on_host());
-        m_impl->compiled = compiler.compile();
-        m_impl->compiled->generation = m_impl->shared->generation;
-        m_impl->compiled->data_generation = m_impl->shared->data_generation;
-        report.accel_ms = compiler.accel_ms();
-        report.compile_ms = ms_since(t0) - report.accel_ms;
-        report.recompiled = true;
-        if (const int sm = m_impl->options.jit_check_sm)
-            core::jit_check(*m_impl->compiled, sm, report);
+    try {
+        m_impl->prepare_launch(entry, width, height, depth, report, t0);
+    } catch (const RankError&) {
+        throw;
+    } catch (const std::exception& e) {
+        // The other ranks wait in this launch's agreement: they learn of the failure there
+        // (agree throws the RankError every rank throws).
+        if (!m_impl->options.ranks) throw;
+        const std::string failure = e.what();
+        m_impl->options.ranks->agree(&failure);
+        throw;
     }
     const core::CompiledScene& scene = *m_impl->compiled;
-    check_ray_generation(scene, entry);
-    unsigned dims = depth > 1 ? 3 : height > 1 ? 2 : 1;
-    for (const Buffer* out : scene.entries[entry].output_buffers) {
-        uint3 s = out->size();
-        if (out->dimensionality() == dims && (s.x != width || s.y != height || s.z != depth))
-            throw Error("Context::launch: " + out->describe() +
-                        " is written by the ray generation program of entry " +
-                        std::to_string(entry) + " but the launch is " + std::to_string(width) +
-                        "x" + std::to_string(height) +
-                        (dims == 3 ? "x" + std::to_string(depth) : "") +
-                        "; resize the buffer to the launch size");
-    }
     core::LaunchSpec spec;
     spec.entry = entry;
     spec.size = uint3{width, height, depth};

@@ -13,6 +13,7 @@
 #include <set>
 
 #include "core/backend.h"
+#include "core/launch_buffers.h"
 #include "core/piece_queue.h"
 #include "lucent/error.h"
 
@@ -23,50 +24,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_between(Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-/// Calls add(program) for every program a launch of `entry` can run: its ray-generation
-/// and exception programs, and every program a trace can reach.
-template <class Fn>
-void for_each_program(const CompiledScene& scene, unsigned entry, const Fn& add) {
-    add(scene.entries[entry].ray_generation);
-    add(scene.entries[entry].exception);
-    for (const CompiledProgram& p : scene.miss) add(p);
-    for (const CompiledProgram& p : scene.callables) add(p);
-    for (const CompiledNode& n : scene.nodes) add(n.visit);
-    for (const CompiledInstance& inst : scene.instances) {
-        add(inst.intersection);
-        add(inst.attribute);
-        for (const CompiledMaterial& m : inst.materials) {
-            for (const CompiledProgram& p : m.closest_hit) add(p);
-            for (const CompiledProgram& p : m.any_hit) add(p);
-        }
-    }
-}
-
-using BufferList = std::vector<std::shared_ptr<const Buffer>> CompiledProgram::*;
-
-/// The buffers not of type input that a launch of `entry` views through `list`:
-/// CompiledProgram::writable_buffers (those it may write: BufferView<T>, not
-/// BufferView<const T>) or CompiledProgram::buffers (those it may read or write).
-std::vector<std::shared_ptr<const Buffer>> launch_buffers(const CompiledScene& scene,
-                                                          unsigned entry, BufferList list) {
-    std::set<const Buffer*> seen;
-    std::vector<std::shared_ptr<const Buffer>> out;
-    for_each_program(scene, entry, [&](const CompiledProgram& p) {
-        for (const auto& b : p.*list)
-            if (b && b->type() != BufferType::kInput && seen.insert(b.get()).second)
-                out.push_back(b);
-    });
-    return out;
-}
-
-/// A buffer the size and shape of the launch grid: launch index i owns element i, so a
-/// piece's part of it is one byte range.
-bool launch_shaped(const Buffer& b, uint3 size) {
-    const unsigned dims = size.z > 1 ? 3 : size.y > 1 ? 2 : 1;
-    const uint3 s = b.size();
-    return b.dimensionality() == dims && s.x == size.x && s.y == size.y && s.z == size.z;
 }
 
 /// Per entry point and launch size: is spreading the launch worth its exchange? A small
@@ -144,6 +101,14 @@ class MultiDeviceBackend final : public Backend {
         const bool split = can_split && (m_piece_rows > 0 || choice.next_spread());
         const unsigned whole_on = fastest(speeds);
         const auto viewed = launch_buffers(scene, spec.entry, &CompiledProgram::buffers);
+        if (spec.next_piece) {  // pieces from the ranks' counter: every device takes them
+            if (!other.empty())
+                throw Error(
+                    "multi-device backend: pieces given for a launch that writes "
+                    "buffers of another shape than the launch");
+            run_in_pieces(scene, spec, shaped, other, viewed, nullptr, whole_on, speeds, report);
+            return;
+        }
         const auto t0 = Clock::now();
         if (split && m_tile_queue)
             run_with_shared_tiles(scene, spec, shaped, viewed, report);
@@ -199,7 +164,8 @@ class MultiDeviceBackend final : public Backend {
                        const std::vector<std::shared_ptr<const Buffer>>& viewed, PieceQueue* queue,
                        unsigned whole_on, std::vector<double>& speeds, LaunchReport& report) {
         const unsigned n = unsigned(m_devices.size());
-        const bool split = queue != nullptr;
+        const bool external = bool(spec.next_piece);  // pieces from the ranks' counter
+        const bool split = queue != nullptr || external;
         std::vector<LaunchReport> reports(n);
         std::vector<std::vector<LaunchPiece>> pieces(n);
         std::vector<double> busy(n, 0.0);
@@ -215,7 +181,7 @@ class MultiDeviceBackend final : public Backend {
             if (!runs(d)) return;
             const auto t0 = Clock::now();
             if (split) {
-                while (auto piece = queue->take(d)) {
+                while (auto piece = external ? spec.next_piece() : queue->take(d)) {
                     m_devices[d]->run_piece(*piece);
                     pieces[d].push_back(*piece);
                 }
@@ -236,7 +202,7 @@ class MultiDeviceBackend final : public Backend {
         report.exchange_ms = ms_between(t_exchange, Clock::now());
         merge_reports(reports, pieces, busy, spec, report);
         trace(spec, split ? "pieces" : "whole", report);
-        if (split) {
+        if (split && !external) {
             // Each device's speed on this entry and size, for the next launch's pieces.
             for (unsigned d = 0; d < n; ++d) {
                 const double indices = double(report.devices[d].indices);

@@ -1,0 +1,29 @@
+#!/bin/bash
+# The device measurements of docs/distributed.md ("Figures"), as run: copy to
+# /work/main/build-carry-<name>/go.sh beside bundle.tar.xz (scripts/gpu-bundle.sh, then
+# scripts/gpu-bundle-mpi.sh, then tar + xz of .gpu-bundle), run with that folder carried.
+here=$(cd "$(dirname "$0")" && pwd); cd "$here/.."
+t0=$(date +%s)
+tar xJf "$here/bundle.tar.xz"
+B=$PWD/.gpu-bundle
+L="$B/run $B/bin/lucent"
+M="$B/mpirun --bind-to none --oversubscribe"
+{ nproc; nvidia-smi -L; lscpu | grep -E "Model name|Thread|Core|Socket"; echo "untar $(( $(date +%s) - t0 )) s"; } > $OUT/machine.txt 2>&1
+for n in 2 4 8 16; do timeout 30 $M -np $n $B/run $B/bin/lucent-ranks-bench; done > $OUT/ranks-bench.txt 2>&1
+PT="render --sample pathtracer --size 3840x2160 --backend cpu"
+stamp() { echo "== $1: $(( $(date +%s) - t0 )) s since start"; }
+{
+stamp "1x16 64spp"; timeout 60 $L $PT --spp 64 --threads 16 --out /tmp/pt-1x16.pfm
+stamp "4x4 64spp"; timeout 60 $M -np 4 -x LUCENT_MULTI_TRACE=1 $L $PT --spp 64 --threads 4 --out /tmp/pt-4x4.pfm
+cmp /tmp/pt-1x16.pfm /tmp/pt-4x4.pfm && echo "4x4 image == 1x16 image (cmp)"
+stamp "2x8 16spp"; timeout 40 $M -np 2 $L $PT --spp 16 --threads 8 --out /tmp/pt-2x8.pfm
+stamp "8x2 16spp"; timeout 40 $M -np 8 $L $PT --spp 16 --threads 2 --out /tmp/pt-8x2.pfm
+stamp "1x16 16spp"; timeout 40 $L $PT --spp 16 --threads 16 --out /tmp/pt-1x16-16.pfm
+cmp /tmp/pt-1x16-16.pfm /tmp/pt-8x2.pfm && echo "8x2 image == 1x16 image (cmp)"
+cmp /tmp/pt-1x16-16.pfm /tmp/pt-2x8.pfm && echo "2x8 image == 1x16 image (cmp)"
+stamp "gpu alone 16spp"; timeout 50 $L render --sample pathtracer --size 3840x2160 --backend cuda --spp 16 --out /tmp/pt-gpu.pfm
+stamp "gpu rank + cpu rank (15 threads) 16spp"; timeout 40 $M -x LUCENT_MULTI_TRACE=1 -np 1 $L render --sample pathtracer --size 3840x2160 --backend cuda --spp 16 --out /tmp/pt-mix.pfm : -np 1 $L $PT --spp 16 --threads 15 --out /tmp/pt-mix.pfm
+$L compare /tmp/pt-gpu.pfm /tmp/pt-mix.pfm
+stamp done
+} > $OUT/pathtracer.txt 2>&1
+grep -v "^distributed" $OUT/pathtracer.txt | tail -5

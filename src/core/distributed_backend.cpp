@@ -1,0 +1,340 @@
+// One launch spread over the ranks of an MPI communicator (docs/distributed.md), the
+// multi-device design (docs/multi-device.md) carried across processes: every rank holds the
+// whole scene and runs the same host code (SPMD); a launch opens with an agreement (no rank
+// failed, every rank's launch digest equal); the rows are taken in pieces from a counter
+// shared by all ranks, each rank running its pieces on its own devices; a second agreement;
+// then every rank's copy of each written buffer receives the pieces the others ran, so each
+// rank's outputs hold the image of a one-process run.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <map>
+#include <mutex>
+
+#include "core/backend.h"
+#include "core/launch_buffers.h"
+#include "core/launch_digest.h"
+#include "core/rank_group.h"
+#include "lucent/error.h"
+
+namespace lucent::core {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+/// Pieces per rank: enough that the last pieces, taken while the others finish theirs,
+/// are a small tail (1/16 of a rank's share), few enough that each piece keeps a rank's
+/// devices busy. LUCENT_RANK_PIECES overrides it (docs/distributed.md, "Pieces").
+unsigned pieces_per_rank() {
+    if (const char* v = std::getenv("LUCENT_RANK_PIECES")) {
+        const int n = std::atoi(v);
+        if (n >= 1 && n <= 4096) return unsigned(n);
+    }
+    return 16;
+}
+
+/// How a launch is cut: units are rows (one-row launches: runs of 64 indices), a piece is
+/// `piece_units` units (a multiple of 8 rows where there are enough: the CPU's tiles).
+struct Cut {
+    uint64_t unit_indices = 0, units = 0, piece_units = 1, pieces = 0;
+    Cut(const LaunchSpec& spec, unsigned ranks) {
+        unit_indices = spec.by_rows() ? spec.size.x : 64;
+        units = (spec.count() + unit_indices - 1) / unit_indices;
+        const uint64_t wanted = uint64_t(ranks) * pieces_per_rank();
+        piece_units = std::max<uint64_t>(1, units / wanted);
+        if (spec.by_rows() && piece_units > 8) piece_units = piece_units / 8 * 8;
+        pieces = (units + piece_units - 1) / piece_units;
+    }
+    LaunchPiece piece(uint64_t k, uint64_t count) const {
+        const uint64_t first = k * piece_units * unit_indices;
+        return {first, std::min(count, (k + 1) * piece_units * unit_indices)};
+    }
+};
+
+/// Appends/reads 8-byte words of the gathered streams.
+void put(std::vector<unsigned char>& out, uint64_t w) {
+    const size_t at = out.size();
+    out.resize(at + 8);
+    std::memcpy(out.data() + at, &w, 8);
+}
+uint64_t get(const unsigned char*& p) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    p += 8;
+    return w;
+}
+
+class DistributedBackend final : public Backend {
+  private:
+    /// A launch's entry point and size.
+    struct Key {
+        unsigned entry, x, y, z;
+        auto operator<=>(const Key&) const = default;
+    };
+    /// An index-local buffer whose elements are where the ranks computed them.
+    struct Partial {
+        std::shared_ptr<const Buffer> buffer;
+        Key key;                          // of the launches that wrote it
+        std::vector<LaunchPiece> pieces;  // this rank's
+        uint64_t version = 0;             // its host contents' then
+        bool kept_rows = false;           // written on the rows this rank keeps for `key`
+    };
+
+  public:
+    DistributedBackend(std::unique_ptr<Backend> local, std::shared_ptr<Ranks> ranks)
+        : m_local(std::move(local)), m_ranks(std::move(ranks)), m_group(m_ranks->impl()) {}
+
+    std::string name() const override {
+        return std::to_string(m_group.size()) + " ranks, rank " + std::to_string(m_group.rank()) +
+               " on " + m_local->name();
+    }
+    bool traces_on_host() const override { return m_local->traces_on_host(); }
+    bool uses_host_storage() const override { return m_local->uses_host_storage(); }
+    void fetch(const Buffer& buffer) override {
+        // A host read of an index-local buffer whose elements are spread over the ranks:
+        // collective, as every rank's host code makes the same reads (SPMD).
+        auto found = m_partial.find(&buffer);
+        if (found != m_partial.end()) return gather_partial(found, true);
+        m_local->fetch(buffer);
+    }
+    std::vector<std::shared_ptr<const Buffer>> host_copies_behind() const override {
+        auto behind = m_local->host_copies_behind();
+        for (const auto& [raw, partial] : m_partial) behind.push_back(partial.buffer);
+        return behind;
+    }
+    std::shared_ptr<DisplayFrame> display_frame(const Buffer& output) override {
+        return m_local->display_frame(output);
+    }
+    void begin_launch(const CompiledScene&, const LaunchSpec&, LaunchReport&) override {
+        throw Error("distributed backend: launches whole, not in pieces");
+    }
+    void run_piece(LaunchPiece) override {}
+    void end_launch(LaunchReport&) override {}
+
+    void launch(const CompiledScene& scene, const LaunchSpec& spec, LaunchReport& report) override {
+        const unsigned ranks = unsigned(m_group.size());
+        // As on several local devices: only launch-shaped outputs can be cut into pieces.
+        std::vector<std::shared_ptr<const Buffer>> shaped;
+        bool other = false;
+        for (auto& b : launch_buffers(scene, spec.entry, &CompiledProgram::writable_buffers)) {
+            if (launch_shaped(*b, spec.size))
+                shaped.push_back(b);
+            else
+                other = true;
+        }
+        const Cut cut(spec, ranks);
+        // A launch that writes elsewhere runs whole on every rank: each computes the same
+        // (SPMD, same inputs), so no rank waits for another's copy.
+        const bool split = !other && ranks > 1 && cut.pieces >= 2 * uint64_t(ranks);
+        // Index-local outputs only (an accumulation): each rank keeps its rows from the
+        // first such launch on, and nothing is gathered until something else reads them.
+        bool sticky = split && !shaped.empty();
+        for (const auto& b : shaped) sticky = sticky && b->launch_index_local();
+        const Key key{spec.entry, spec.size.x, spec.size.y, spec.size.z};
+        auto kept = m_kept_rows.find(key);
+        const bool run_kept = sticky && kept != m_kept_rows.end();
+        const bool take_from_counter = split && !run_kept;
+        if (take_from_counter && m_group.rank() == 0)
+            m_group.reset_counter();  // before anyone takes
+        agree(m_group, nullptr, m_digest.of(scene, spec), "launch");
+        // Elements another launch left on other ranks, which this one reads: gathered now,
+        // in the order of the launch's buffers (the same on every rank).
+        for (const auto& b : launch_buffers(scene, spec.entry, &CompiledProgram::buffers)) {
+            auto found = m_partial.find(b.get());
+            if (found == m_partial.end()) continue;
+            if (found->second.version != b->version()) {  // new host contents since
+                m_partial.erase(found);
+                continue;
+            }
+            if (!(run_kept && found->second.key == key && found->second.kept_rows))
+                gather_partial(found, false);
+        }
+
+        LaunchSpec local = spec;
+        local.on_rows = nullptr;  // a rank's pieces are not bands of the image
+        std::mutex mutex;
+        std::vector<LaunchPiece> mine;
+        size_t next_kept = 0;
+        if (take_from_counter)
+            local.next_piece = [&]() -> std::optional<LaunchPiece> {
+                const uint64_t k = m_group.fetch_add_counter(1);
+                if (k >= cut.pieces) return std::nullopt;
+                const LaunchPiece piece = cut.piece(k, spec.count());
+                std::lock_guard lock(mutex);
+                mine.push_back(piece);
+                return piece;
+            };
+        else if (split)  // the rows this rank ran in the first launch of this entry and size
+            local.next_piece = [&]() -> std::optional<LaunchPiece> {
+                std::lock_guard lock(mutex);
+                if (next_kept == kept->second.size()) return std::nullopt;
+                mine.push_back(kept->second[next_kept]);
+                return kept->second[next_kept++];
+            };
+        const auto t0 = Clock::now();
+        std::string failure;
+        bool failed = false;
+        try {
+            m_local->launch(scene, local, report);
+        } catch (const std::exception& e) {
+            failed = true;
+            failure = e.what();
+        }
+        const double busy_ms = ms_between(t0, Clock::now());
+        // Every rank learns whether one failed before any waits for another's pieces.
+        agree(m_group, failed ? &failure : nullptr, 0, "launch");
+        if (!split) return;
+        const auto t_gather = Clock::now();
+        if (sticky) {
+            // The rows of the second launch are kept: the first one's shares include
+            // warming up (a GPU's kernel compile), not the devices' speeds.
+            if (take_from_counter && ++m_sticky_launches[key] == 2) m_kept_rows[key] = mine;
+            exchange(mine, busy_ms, spec, {}, report, false);
+            for (const auto& b : shaped) {
+                b->mark_device_newer();  // a host read gathers it (fetch)
+                m_partial[b.get()] =
+                    Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
+            }
+        } else {
+            exchange(mine, busy_ms, spec, shaped, report, false);
+        }
+        report.gather_ms = ms_between(t_gather, Clock::now());
+        trace(spec,
+              run_kept ? "index-local, rows kept"
+              : sticky ? "index-local, pieces"
+                       : "pieces",
+              report);
+    }
+
+  private:
+    /// The elements an index-local buffer's last launches left on each rank reach every
+    /// rank (`in_fetch`: inside a host read, whose flag is already cleared).
+    void gather_partial(std::map<const Buffer*, Partial>::iterator found, bool in_fetch) {
+        const Partial partial = found->second;
+        m_partial.erase(found);
+        LaunchReport ignored;
+        LaunchSpec spec;
+        spec.size = uint3{partial.key.x, partial.key.y, partial.key.z};
+        exchange(partial.pieces, 0, spec, {partial.buffer}, ignored, in_fetch);
+    }
+
+    /// Every rank sends the pieces it ran (their ranges, its exceptions, then each written
+    /// buffer's bytes of each piece) to every other; each writes the others' pieces into
+    /// its host copies, which then are the one-process image on every rank.
+    void exchange(const std::vector<LaunchPiece>& mine, double busy_ms, const LaunchSpec& spec,
+                  const std::vector<std::shared_ptr<const Buffer>>& shaped, LaunchReport& report,
+                  bool in_fetch) {
+        const uint3 size = spec.size;
+        auto linear = [&](uint3 i) { return (uint64_t(i.z) * size.y + i.y) * size.x + i.x; };
+        std::vector<unsigned char>& out = m_send;
+        out.clear();
+        double busy = busy_ms;
+        uint64_t busy_bits;
+        std::memcpy(&busy_bits, &busy, 8);
+        put(out, busy_bits);
+        put(out, report.exceptions.size());
+        for (const auto& [code, e] : report.exceptions) {
+            put(out, uint64_t(int64_t(code)));
+            put(out, e.count);
+            put(out, linear(e.first_index));
+        }
+        put(out, mine.size());
+        for (const LaunchPiece& p : mine) {
+            put(out, p.first);
+            put(out, p.last);
+        }
+        for (const auto& b : shaped) {
+            // A GPU rank's pieces reach its host copy.
+            if (in_fetch)
+                m_local->fetch(*b);
+            else
+                b->sync_from_device();
+            const size_t element = b->element().size;
+            const auto* bytes = static_cast<const unsigned char*>(b->raw());
+            for (const LaunchPiece& p : mine)
+                out.insert(out.end(), bytes + p.first * element, bytes + p.last * element);
+        }
+        std::vector<uint64_t> counts;
+        m_group.all_gather_bytes(out, m_received, counts);
+
+        report.exceptions.clear();
+        report.ranks.assign(counts.size(), {});
+        const unsigned char* p = m_received.data();
+        for (int r = 0; r < int(counts.size()); ++r) {
+            const unsigned char* end = p + counts[size_t(r)];
+            LaunchReport::RankShare& share = report.ranks[size_t(r)];
+            const uint64_t bits = get(p);
+            std::memcpy(&share.busy_ms, &bits, 8);
+            for (uint64_t n = get(p); n > 0; --n) {
+                const int code = int(int64_t(get(p)));
+                const uint64_t count = get(p), first = get(p);
+                const uint3 index{unsigned(first % size.x), unsigned(first / size.x % size.y),
+                                  unsigned(first / (uint64_t(size.x) * size.y))};
+                auto [it, fresh] = report.exceptions.try_emplace(code);
+                if (fresh || first < linear(it->second.first_index)) it->second.first_index = index;
+                it->second.count += count;
+            }
+            std::vector<LaunchPiece> pieces(get(p));
+            for (LaunchPiece& piece : pieces) {
+                piece.first = get(p);
+                piece.last = get(p);
+                share.indices += piece.last - piece.first;
+            }
+            share.pieces = unsigned(pieces.size());
+            for (const auto& b : shaped) {
+                const size_t element = b->element().size;
+                auto* bytes = static_cast<unsigned char*>(const_cast<Buffer&>(*b).raw());
+                for (const LaunchPiece& piece : pieces) {
+                    const size_t n = (piece.last - piece.first) * element;
+                    if (r != m_group.rank()) std::memcpy(bytes + piece.first * element, p, n);
+                    p += n;
+                }
+            }
+            if (p != end)
+                throw Error("distributed backend: rank " + std::to_string(r) +
+                            "'s gathered pieces do not add up (internal error)");
+        }
+        // New host contents on every rank alike: a GPU uploads them before it next reads
+        // them, and the versions (which launch digests do not hash) stay equal across ranks.
+        for (const auto& b : shaped) const_cast<Buffer&>(*b).unmap();
+    }
+
+    void trace(const LaunchSpec& spec, const char* how, const LaunchReport& report) const {
+        if (!m_trace || m_group.rank() != 0) return;
+        std::fprintf(
+            stderr,
+            "distributed: entry %u, %llu indices, %s, gather %.3f ms of %zu bytes:", spec.entry,
+            (unsigned long long)spec.count(), how, report.gather_ms, m_received.size());
+        for (size_t r = 0; r < report.ranks.size(); ++r)
+            std::fprintf(stderr, " [rank %zu: %u pieces %llu indices %.3f ms]", r,
+                         report.ranks[r].pieces, (unsigned long long)report.ranks[r].indices,
+                         report.ranks[r].busy_ms);
+        std::fprintf(stderr, "\n");
+    }
+
+    std::unique_ptr<Backend> m_local;
+    std::shared_ptr<Ranks> m_ranks;
+    std::map<Key, std::vector<LaunchPiece>> m_kept_rows;  // per entry and size: this rank's
+    std::map<Key, unsigned> m_sticky_launches;            // index-local launches taken so far
+    std::map<const Buffer*, Partial> m_partial;
+    Ranks::Impl& m_group;
+    LaunchDigest m_digest;
+    std::vector<unsigned char> m_send, m_received;  // kept: a 4K image's pieces each launch
+    const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_distributed_backend(std::unique_ptr<Backend> local,
+                                                  std::shared_ptr<Ranks> ranks) {
+    return std::make_unique<DistributedBackend>(std::move(local), std::move(ranks));
+}
+
+}  // namespace lucent::core
