@@ -82,7 +82,8 @@ TEST(LaunchShapes, TuningTriesEachShapeOnceAfterTwoLaunchesOfTheFirstThenKeepsTh
 
 TEST(LaunchShapes, AddedShapesReopenTheChoiceAfterOneUntimedLaunch) {
     ShapeTuning tuning(2);
-    for (const auto& [shape, ms] : std::vector<std::pair<int, double>>{{0, 9.0}, {0, 2.0}, {1, 3.0}})
+    for (const auto& [shape, ms] :
+         std::vector<std::pair<int, double>>{{0, 9.0}, {0, 2.0}, {1, 3.0}})
         tuning.record(shape, ms);
     ASSERT_EQ(tuning.choice(), 0);
     tuning.add_shapes(2);  // shapes 2 and 3: shape 3 is the fastest of all

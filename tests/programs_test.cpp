@@ -152,10 +152,12 @@ TEST_F(ClosestHitTest, RegisterCappedVariantGivesTheSameHitsAsTheKernelAsCompile
     const ScopedEnv variants("LUCENT_GPU_REGISTER_VARIANTS", "sync");
     std::vector<float4> centres;
     for (int i = 0; i < 64; ++i)
-        centres.push_back(make_float4(float(i % 8) - 3.5f, float(i / 8) - 3.5f, 10.0f + i % 3, 0.45f));
+        centres.push_back(
+            make_float4(float(i % 8) - 3.5f, float(i / 8) - 3.5f, 10.0f + i % 3, 0.45f));
     auto top = make_geometry_group(
-        ctx, {make_instance(ctx, make_spheres(ctx, centres),
-                            make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
+        ctx,
+        {make_instance(ctx, make_spheres(ctx, centres),
+                       make_material(ctx, program(ctx, LUCENT_PROGRAM(common_sphere_hit)), 1))});
     std::vector<CastRay> rays;
     for (int i = 0; i < 4096; ++i) {
         const float x = float(i % 64) / 8.0f - 4.0f, y = float(i / 64) / 8.0f - 4.0f;

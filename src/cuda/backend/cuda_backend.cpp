@@ -193,8 +193,7 @@ class CudaBackend final : public core::Backend {
         void* no_owners = nullptr;
         unsigned device = 0;
         void* args[] = {&first, &last, &counter_arg, &no_owners, &device};
-        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1,
-                                      kBlock, 1, 1, 0,
+        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1, kBlock, 1, 1, 0,
                                       stream, args, nullptr),
               "launch the megakernel");
         check(m_driver.cuEventRecord(m_piece_done[slot], stream), "cuEventRecord");
@@ -214,8 +213,7 @@ class CudaBackend final : public core::Backend {
         void* counter_arg = reinterpret_cast<void*>(counter);
         void* owners_arg = reinterpret_cast<void*>(owners);
         void* args[] = {&first, &last, &counter_arg, &owners_arg, &device};
-        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1,
-                                      kBlock, 1, 1, 0,
+        check(m_driver.cuLaunchKernel(m_code->function, unsigned(m_grid), 1, 1, kBlock, 1, 1, 0,
                                       m_streams[0], args, nullptr),
               "launch the megakernel");
     }
@@ -380,9 +378,9 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuModuleGetFunction(&code.function, code.module, name.c_str()),
               ("find " + name).c_str());
         size_t bytes = 0;
-        check(m_driver.cuModuleGetGlobal(&code.params, &bytes, code.module,
-                                         "_ZN6lucent3gpu6paramsE"),
-              "find the launch parameters");
+        check(
+            m_driver.cuModuleGetGlobal(&code.params, &bytes, code.module, "_ZN6lucent3gpu6paramsE"),
+            "find the launch parameters");
         return code;
     }
 
@@ -413,9 +411,8 @@ class CudaBackend final : public core::Backend {
             adopt_capped(compile_units(requests));
             return;
         }
-        m_capped = std::async(std::launch::async, [requests = std::move(requests)] {
-            return compile_units(requests);
-        });
+        m_capped = std::async(std::launch::async,
+                              [requests = std::move(requests)] { return compile_units(requests); });
     }
 
     /// At a launch's start: the capped variants, once compiled, become shapes of their
@@ -474,7 +471,6 @@ class CudaBackend final : public core::Backend {
             throw Error("CUDA backend: " + buffer.describe() + " has no copy on " + name());
         return ptr;
     }
-
 
     /// The launch shapes of `kernel` (launch_shapes.h): for each count of blocks per SM up to
     /// what its registers allow, just the shared memory those blocks need (the runtime's
