@@ -18,6 +18,7 @@
 #include "core/launch_buffers.h"
 #include "core/launch_digest.h"
 #include "core/rank_group.h"
+#include "core/row_balance.h"
 #include "lucent/error.h"
 
 namespace lucent::core {
@@ -40,6 +41,26 @@ unsigned pieces_per_rank() {
     return 16;
 }
 
+/// Index-local launches' kept rows are re-balanced from the ranks' busy times summed over
+/// this many launches (enough that one launch's noise does not move rows back and forth).
+constexpr unsigned kBalanceWindow = 4;
+
+/// How far above the balanced time the slowest rank may be before rows move:
+/// LUCENT_RANK_REBALANCE = a fraction (default 0.02), or "off" (rows stay where the second
+/// launch put them). docs/distributed.md, "Re-balancing the kept rows".
+double rebalance_threshold() {
+    const char* v = std::getenv("LUCENT_RANK_REBALANCE");
+    if (!v) return 0.02;
+    if (std::strcmp(v, "off") == 0) return -1;
+    char* end = nullptr;
+    const double t = std::strtod(v, &end);
+    if (end == v || *end != '\0' || !(t >= 0))
+        throw Error(std::string("LUCENT_RANK_REBALANCE='") + v +
+                    "': expected a fraction such as 0.02 (the slowest rank's excess over the "
+                    "balanced time that moves rows) or off");
+    return t;
+}
+
 /// How a launch is cut: units are rows (one-row launches: runs of 64 indices), a piece is
 /// `piece_units` units (a multiple of 8 rows where there are enough: the CPU's tiles).
 struct Cut {
@@ -51,6 +72,10 @@ struct Cut {
         piece_units = std::max<uint64_t>(1, units / wanted);
         if (spec.by_rows() && piece_units > 8) piece_units = piece_units / 8 * 8;
         pieces = (units + piece_units - 1) / piece_units;
+    }
+    /// The finest cut between ranks' rows: a unit, or 8 rows where pieces are whole tiles.
+    uint64_t granule(const LaunchSpec& spec) const {
+        return unit_indices * (spec.by_rows() && piece_units % 8 == 0 ? 8 : 1);
     }
     LaunchPiece piece(uint64_t k, uint64_t count) const {
         const uint64_t first = k * piece_units * unit_indices;
@@ -85,6 +110,14 @@ class DistributedBackend final : public Backend {
         std::vector<LaunchPiece> pieces;  // this rank's
         uint64_t version = 0;             // its host contents' then
         bool kept_rows = false;           // written on the rows this rank keeps for `key`
+    };
+    /// The rows the ranks keep for one entry and size, and their busy times since the
+    /// last re-balancing.
+    struct KeptRows {
+        std::vector<LaunchPiece> mine;
+        std::vector<std::vector<LaunchPiece>> of_ranks;
+        std::vector<double> busy_ms;  // per rank, summed over `launches`
+        unsigned launches = 0;
     };
 
   public:
@@ -174,9 +207,10 @@ class DistributedBackend final : public Backend {
         else if (split)  // the rows this rank ran in the first launch of this entry and size
             local.next_piece = [&]() -> std::optional<LaunchPiece> {
                 std::lock_guard lock(mutex);
-                if (next_kept == kept->second.size()) return std::nullopt;
-                mine.push_back(kept->second[next_kept]);
-                return kept->second[next_kept++];
+                const std::vector<LaunchPiece>& rows = kept->second.mine;
+                if (next_kept == rows.size()) return std::nullopt;
+                mine.push_back(rows[next_kept]);
+                return rows[next_kept++];
             };
         const auto t0 = Clock::now();
         std::string failure;
@@ -195,13 +229,16 @@ class DistributedBackend final : public Backend {
         if (sticky) {
             // The rows of the second launch are kept: the first one's shares include
             // warming up (a GPU's kernel compile), not the devices' speeds.
-            if (take_from_counter && ++m_sticky_launches[key] == 2) m_kept_rows[key] = mine;
-            exchange(mine, busy_ms, spec, {}, report, false);
+            if (take_from_counter && ++m_sticky_launches[key] == 2) m_kept_rows[key].mine = mine;
+            std::vector<std::vector<LaunchPiece>> of_ranks;
+            exchange(mine, busy_ms, spec, {}, report, false, &of_ranks);
             for (const auto& b : shaped) {
                 b->mark_device_newer();  // a host read gathers it (fetch)
                 m_partial[b.get()] =
                     Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
             }
+            if (run_kept) balance_kept_rows(key, cut.granule(spec), spec, shaped, report,
+                                            std::move(of_ranks));
         } else {
             exchange(mine, busy_ms, spec, shaped, report, false);
         }
@@ -214,6 +251,51 @@ class DistributedBackend final : public Backend {
     }
 
   private:
+    /// After a launch on the kept rows: every kBalanceWindow such launches, the ranks'
+    /// shares follow their measured speeds (balance_rows; the same answer on every rank,
+    /// from the gathered busy times), and the elements of the rows that change owner move
+    /// to their new rank, so each pixel's accumulation goes on where its frames were added.
+    void balance_kept_rows(const Key& key, uint64_t granule, const LaunchSpec& spec,
+                           const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                           const LaunchReport& report,
+                           std::vector<std::vector<LaunchPiece>> of_ranks) {
+        if (m_rebalance_threshold < 0) return;
+        KeptRows& kept = m_kept_rows[key];
+        kept.of_ranks = std::move(of_ranks);
+        kept.busy_ms.resize(report.ranks.size(), 0.0);
+        for (size_t r = 0; r < report.ranks.size(); ++r)
+            kept.busy_ms[r] += report.ranks[r].busy_ms;
+        if (++kept.launches < kBalanceWindow) return;
+        const RowBalance balance =
+            balance_rows(kept.of_ranks, kept.busy_ms, granule, m_rebalance_threshold);
+        kept.busy_ms.assign(kept.busy_ms.size(), 0.0);
+        kept.launches = 0;
+        if (!balance.moved) return;
+        const auto rank = size_t(m_group.rank());
+        // The given rows' elements reach every rank (the new owner among them); a GPU
+        // rank's come from its device first (as in a host read: not through the buffer).
+        LaunchReport ignored;
+        exchange(balance.given[rank], 0, spec, shaped, ignored, true);
+        kept.mine = balance.kept[rank];
+        for (const auto& b : shaped)
+            m_partial[b.get()] = Partial{b, key, kept.mine, b->version(), true};
+        if (m_trace && rank == 0) {
+            std::fprintf(stderr,
+                         "distributed: entry %u, kept rows re-balanced (the slowest rank took "
+                         "%.3fx the balanced time):",
+                         spec.entry, balance.imbalance);
+            for (size_t r = 0; r < balance.kept.size(); ++r) {
+                uint64_t before = 0, after = 0;
+                for (const LaunchPiece& p : kept.of_ranks[r]) before += p.last - p.first;
+                for (const LaunchPiece& p : balance.kept[r]) after += p.last - p.first;
+                std::fprintf(stderr, " [rank %zu: %llu -> %llu indices]", r,
+                             (unsigned long long)before, (unsigned long long)after);
+            }
+            std::fprintf(stderr, "\n");
+        }
+        kept.of_ranks = balance.kept;
+    }
+
     /// The elements an index-local buffer's last launches left on each rank reach every
     /// rank (`in_fetch`: inside a host read, whose flag is already cleared).
     void gather_partial(std::map<const Buffer*, Partial>::iterator found, bool in_fetch) {
@@ -228,9 +310,10 @@ class DistributedBackend final : public Backend {
     /// Every rank sends the pieces it ran (their ranges, its exceptions, then each written
     /// buffer's bytes of each piece) to every other; each writes the others' pieces into
     /// its host copies, which then are the one-process image on every rank.
+    /// `of_ranks` (if given) receives every rank's pieces.
     void exchange(const std::vector<LaunchPiece>& mine, double busy_ms, const LaunchSpec& spec,
                   const std::vector<std::shared_ptr<const Buffer>>& shaped, LaunchReport& report,
-                  bool in_fetch) {
+                  bool in_fetch, std::vector<std::vector<LaunchPiece>>* of_ranks = nullptr) {
         const uint3 size = spec.size;
         auto linear = [&](uint3 i) { return (uint64_t(i.z) * size.y + i.y) * size.x + i.x; };
         std::vector<unsigned char>& out = m_send;
@@ -288,6 +371,7 @@ class DistributedBackend final : public Backend {
                 share.indices += piece.last - piece.first;
             }
             share.pieces = unsigned(pieces.size());
+            if (of_ranks) of_ranks->push_back(pieces);
             for (const auto& b : shaped) {
                 const size_t element = b->element().size;
                 auto* bytes = static_cast<unsigned char*>(const_cast<Buffer&>(*b).raw());
@@ -321,13 +405,14 @@ class DistributedBackend final : public Backend {
 
     std::unique_ptr<Backend> m_local;
     std::shared_ptr<Ranks> m_ranks;
-    std::map<Key, std::vector<LaunchPiece>> m_kept_rows;  // per entry and size: this rank's
+    std::map<Key, KeptRows> m_kept_rows;                  // per entry and size
     std::map<Key, unsigned> m_sticky_launches;            // index-local launches taken so far
     std::map<const Buffer*, Partial> m_partial;
     Ranks::Impl& m_group;
     LaunchDigest m_digest;
     std::vector<unsigned char> m_send, m_received;  // kept: a 4K image's pieces each launch
     const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;
+    const double m_rebalance_threshold = rebalance_threshold();
 };
 
 }  // namespace
