@@ -41,7 +41,8 @@ std::vector<int> owners(const Pieces& kept, uint64_t count) {
 
 void expect_consistent(const Pieces& before, const RowBalance& balance, uint64_t count,
                        uint64_t granule) {
-    const std::vector<int> old_owner = owners(before, count), new_owner = owners(balance.kept, count);
+    const std::vector<int> old_owner = owners(before, count),
+                           new_owner = owners(balance.kept, count);
     for (uint64_t i = 0; i < count; ++i) {
         ASSERT_EQ(old_owner[i] >= 0, true) << i;
         ASSERT_GE(new_owner[i], 0) << "index " << i << " kept by no rank or by two";

@@ -118,6 +118,7 @@ class DistributedBackend final : public Backend {
         std::vector<std::vector<LaunchPiece>> of_ranks;
         std::vector<double> busy_ms;  // per rank, summed over `launches`
         unsigned launches = 0;
+        std::vector<double> speed;  // per rank: indices per ms, averaged over windows
     };
 
   public:
@@ -237,8 +238,9 @@ class DistributedBackend final : public Backend {
                 m_partial[b.get()] =
                     Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
             }
-            if (run_kept) balance_kept_rows(key, cut.granule(spec), spec, shaped, report,
-                                            std::move(of_ranks));
+            if (run_kept)
+                balance_kept_rows(key, cut.granule(spec), spec, shaped, report,
+                                  std::move(of_ranks));
         } else {
             exchange(mine, busy_ms, spec, shaped, report, false);
         }
@@ -263,13 +265,28 @@ class DistributedBackend final : public Backend {
         KeptRows& kept = m_kept_rows[key];
         kept.of_ranks = std::move(of_ranks);
         kept.busy_ms.resize(report.ranks.size(), 0.0);
-        for (size_t r = 0; r < report.ranks.size(); ++r)
-            kept.busy_ms[r] += report.ranks[r].busy_ms;
+        for (size_t r = 0; r < report.ranks.size(); ++r) kept.busy_ms[r] += report.ranks[r].busy_ms;
         if (++kept.launches < kBalanceWindow) return;
-        const RowBalance balance =
-            balance_rows(kept.of_ranks, kept.busy_ms, granule, m_rebalance_threshold);
+        // Each window's speeds, averaged with the earlier windows' (an exponential average
+        // of weight 1/2): ranks sharing a machine's cores run at speeds that wander by a
+        // few percent from window to window, and following each window alone would move
+        // rows back and forth after the noise. The balance is of the times the averaged
+        // speeds give for the rows each rank holds.
+        const size_t ranks = kept.of_ranks.size();
+        kept.speed.resize(ranks, 0.0);
+        std::vector<double> expected_ms(ranks, 0.0);
+        for (size_t r = 0; r < ranks && r < kept.busy_ms.size(); ++r) {
+            uint64_t held = 0;
+            for (const LaunchPiece& p : kept.of_ranks[r]) held += p.last - p.first;
+            if (held == 0 || !(kept.busy_ms[r] > 0)) continue;
+            const double speed = double(held) * kept.launches / kept.busy_ms[r];
+            kept.speed[r] = kept.speed[r] > 0 ? 0.5 * (kept.speed[r] + speed) : speed;
+            expected_ms[r] = double(held) / kept.speed[r];
+        }
         kept.busy_ms.assign(kept.busy_ms.size(), 0.0);
         kept.launches = 0;
+        const RowBalance balance =
+            balance_rows(kept.of_ranks, expected_ms, granule, m_rebalance_threshold);
         if (!balance.moved) return;
         const auto rank = size_t(m_group.rank());
         // The given rows' elements reach every rank (the new owner among them); a GPU
@@ -280,10 +297,11 @@ class DistributedBackend final : public Backend {
         for (const auto& b : shaped)
             m_partial[b.get()] = Partial{b, key, kept.mine, b->version(), true};
         if (m_trace && rank == 0) {
-            std::fprintf(stderr,
-                         "distributed: entry %u, kept rows re-balanced (the slowest rank took "
-                         "%.3fx the balanced time):",
-                         spec.entry, balance.imbalance);
+            std::fprintf(
+                stderr,
+                "distributed: entry %u, kept rows re-balanced (at the averaged speeds the slowest "
+                "rank takes %.3fx the balanced time):",
+                spec.entry, balance.imbalance);
             for (size_t r = 0; r < balance.kept.size(); ++r) {
                 uint64_t before = 0, after = 0;
                 for (const LaunchPiece& p : kept.of_ranks[r]) before += p.last - p.first;
@@ -405,8 +423,8 @@ class DistributedBackend final : public Backend {
 
     std::unique_ptr<Backend> m_local;
     std::shared_ptr<Ranks> m_ranks;
-    std::map<Key, KeptRows> m_kept_rows;                  // per entry and size
-    std::map<Key, unsigned> m_sticky_launches;            // index-local launches taken so far
+    std::map<Key, KeptRows> m_kept_rows;        // per entry and size
+    std::map<Key, unsigned> m_sticky_launches;  // index-local launches taken so far
     std::map<const Buffer*, Partial> m_partial;
     Ranks::Impl& m_group;
     LaunchDigest m_digest;
