@@ -2,7 +2,7 @@
 // shares follow the measured speeds, every index stays with exactly one rank, what a rank
 // gives away is exactly what it held and no longer keeps, cuts fall on granules, rows move
 // only between neighbours in rank order, and nothing moves when the ranks are balanced or
-// a time is missing.
+// a time is missing; the shared tail is the last rows of each rank, in granules.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -148,6 +148,43 @@ TEST(RowBalance, RepeatedBalancingConverges) {
     EXPECT_EQ(moves, 1);
     for (size_t r = 0; r < 3; ++r)
         EXPECT_NEAR(double(held(kept[r])), count * speed[r] / 6.0, double(granule)) << r;
+}
+
+TEST(SharedTail, EachRankGivesItsLastRowsInGranules) {
+    const uint64_t width = 64, count = width * 480, granule = 8 * width;
+    const Pieces before = taken_in_turn(3, count, 16 * width);
+    const SharedTail tail = share_tail(before, 1.0 / 16, granule);
+    ASSERT_EQ(tail.kept.size(), 3u);
+    // Kept and shared cover the launch once; the shared pieces are a granule each.
+    std::vector<int> owner = owners(tail.kept, count);
+    for (const LaunchPiece& p : tail.shared) {
+        EXPECT_EQ(p.last - p.first, granule);
+        EXPECT_EQ(p.first % granule, 0u);
+        for (uint64_t i = p.first; i < p.last; ++i) {
+            ASSERT_EQ(owner[i], -1) << "index " << i << " both kept and shared";
+            owner[i] = 99;
+        }
+    }
+    for (uint64_t i = 0; i < count; ++i) ASSERT_NE(owner[i], -1) << i;
+    for (size_t r = 0; r < 3; ++r) {
+        // A sixteenth of 160 rows is 10: rounded to whole granules of 8 rows, one granule.
+        EXPECT_EQ(held(tail.given[r]), granule) << r;
+        EXPECT_EQ(held(tail.kept[r]) + held(tail.given[r]), held(before[r])) << r;
+        // Given from the end of the rank's pieces.
+        EXPECT_EQ(tail.given[r].back().last, before[r].back().last) << r;
+    }
+    EXPECT_EQ(tail.shared.size(), 3u);
+}
+
+TEST(SharedTail, NoneWithoutAFractionOrWithFewRows) {
+    const uint64_t granule = 64;
+    const Pieces before = taken_in_turn(2, 64 * 3, 64);  // ranks of 2 and 1 granules
+    EXPECT_TRUE(share_tail(before, 0.0, granule).shared.empty());
+    const SharedTail tail = share_tail(before, 0.5, granule);
+    // Rank 0 keeps one of its two granules; rank 1, holding one, gives none.
+    EXPECT_EQ(held(tail.kept[0]), 64u);
+    EXPECT_EQ(held(tail.kept[1]), 64u);
+    EXPECT_EQ(tail.shared.size(), 1u);
 }
 
 }  // namespace

@@ -41,6 +41,21 @@ unsigned pieces_per_rank() {
     return 16;
 }
 
+/// The fraction of an index-local launch's rows that no rank keeps (SharedTail): ranks take
+/// them from the counter each launch, and their elements go to every rank after it.
+/// LUCENT_RANK_SHARED = a fraction (default 1/16), or 0 for none.
+double shared_fraction() {
+    const char* v = std::getenv("LUCENT_RANK_SHARED");
+    if (!v) return 1.0 / 16;
+    char* end = nullptr;
+    const double f = std::strtod(v, &end);
+    if (end == v || *end != '\0' || !(f >= 0 && f < 1))
+        throw Error(std::string("LUCENT_RANK_SHARED='") + v +
+                    "': expected a fraction from 0 to below 1 (0.0625: a sixteenth of the rows "
+                    "go to whichever rank is free; 0: every row stays with a rank)");
+    return f;
+}
+
 /// Index-local launches' kept rows are re-balanced from the ranks' busy times summed over
 /// this many launches (enough that one launch's noise does not move rows back and forth).
 constexpr unsigned kBalanceWindow = 4;
@@ -116,7 +131,9 @@ class DistributedBackend final : public Backend {
     struct KeptRows {
         std::vector<LaunchPiece> mine;
         std::vector<std::vector<LaunchPiece>> of_ranks;
-        std::vector<double> busy_ms;  // per rank, summed over `launches`
+        std::vector<LaunchPiece> shared;  // the tail no rank keeps (SharedTail)
+        std::vector<double> busy_ms;      // per rank, summed over `launches`
+        std::vector<uint64_t> indices;    // per rank: kept and shared, over `launches`
         unsigned launches = 0;
         std::vector<double> speed;  // per rank: indices per ms, averaged over windows
     };
@@ -175,7 +192,8 @@ class DistributedBackend final : public Backend {
         auto kept = m_kept_rows.find(key);
         const bool run_kept = sticky && kept != m_kept_rows.end();
         const bool take_from_counter = split && !run_kept;
-        if (take_from_counter && m_group.rank() == 0)
+        const bool take_shared = run_kept && !kept->second.shared.empty();
+        if ((take_from_counter || take_shared) && m_group.rank() == 0)
             m_group.reset_counter();  // before anyone takes
         agree(m_group, nullptr, m_digest.of(scene, spec), "launch");
         // Elements another launch left on other ranks, which this one reads: gathered now,
@@ -194,7 +212,7 @@ class DistributedBackend final : public Backend {
         LaunchSpec local = spec;
         local.on_rows = nullptr;  // a rank's pieces are not bands of the image
         std::mutex mutex;
-        std::vector<LaunchPiece> mine;
+        std::vector<LaunchPiece> mine, mine_shared;
         size_t next_kept = 0;
         if (take_from_counter)
             local.next_piece = [&]() -> std::optional<LaunchPiece> {
@@ -205,13 +223,23 @@ class DistributedBackend final : public Backend {
                 mine.push_back(piece);
                 return piece;
             };
-        else if (split)  // the rows this rank ran in the first launch of this entry and size
+        else if (split)  // the rows this rank keeps, then pieces of the shared tail
             local.next_piece = [&]() -> std::optional<LaunchPiece> {
+                const KeptRows& rows = kept->second;
+                {
+                    std::lock_guard lock(mutex);
+                    if (next_kept < rows.mine.size()) {
+                        mine.push_back(rows.mine[next_kept]);
+                        return rows.mine[next_kept++];
+                    }
+                }
+                if (!take_shared) return std::nullopt;
+                const uint64_t k = m_group.fetch_add_counter(1);
+                if (k >= rows.shared.size()) return std::nullopt;
                 std::lock_guard lock(mutex);
-                const std::vector<LaunchPiece>& rows = kept->second.mine;
-                if (next_kept == rows.size()) return std::nullopt;
-                mine.push_back(rows[next_kept]);
-                return rows[next_kept++];
+                mine.push_back(rows.shared[k]);
+                mine_shared.push_back(rows.shared[k]);
+                return rows.shared[k];
             };
         const auto t0 = Clock::now();
         std::string failure;
@@ -230,42 +258,73 @@ class DistributedBackend final : public Backend {
         if (sticky) {
             // The rows of the second launch are kept: the first one's shares include
             // warming up (a GPU's kernel compile), not the devices' speeds.
-            if (take_from_counter && ++m_sticky_launches[key] == 2) m_kept_rows[key].mine = mine;
+            const bool keep_now = take_from_counter && ++m_sticky_launches[key] == 2;
             std::vector<std::vector<LaunchPiece>> of_ranks;
-            exchange(mine, busy_ms, spec, {}, report, false, &of_ranks);
+            // The shared tail's elements reach every rank (the buffers' elements this rank
+            // kept are already current on its devices: fetched locally, not gathered).
+            exchange(mine, mine_shared, busy_ms, spec,
+                     take_shared ? shaped : std::vector<std::shared_ptr<const Buffer>>{}, report,
+                     true, &of_ranks);
+            if (keep_now) keep_rows(key, cut.granule(spec), spec, shaped, std::move(of_ranks));
+            if (run_kept) balance_kept_rows(key, cut.granule(spec), spec, shaped, report);
             for (const auto& b : shaped) {
                 b->mark_device_newer();  // a host read gathers it (fetch)
                 m_partial[b.get()] =
                     Partial{b, key, mine, b->version(), run_kept || m_kept_rows.count(key)};
             }
-            if (run_kept)
-                balance_kept_rows(key, cut.granule(spec), spec, shaped, report,
-                                  std::move(of_ranks));
         } else {
-            exchange(mine, busy_ms, spec, shaped, report, false);
+            exchange(mine, mine, busy_ms, spec, shaped, report, false);
         }
         report.gather_ms = ms_between(t_gather, Clock::now());
         trace(spec,
-              run_kept ? "index-local, rows kept"
-              : sticky ? "index-local, pieces"
-                       : "pieces",
+              take_shared ? "index-local, rows kept and a shared tail"
+              : run_kept  ? "index-local, rows kept"
+              : sticky    ? "index-local, pieces"
+                          : "pieces",
               report);
     }
 
   private:
+    /// The second index-local launch of an entry and size: each rank keeps the rows it ran
+    /// (`of_ranks`: every rank's), less its part of the shared tail where every rank's
+    /// elements live on the host (CPU ranks: the tail's elements go to every rank after
+    /// each launch, which on a GPU would cost a download and an upload of the buffers).
+    void keep_rows(const Key& key, uint64_t granule, const LaunchSpec& spec,
+                   const std::vector<std::shared_ptr<const Buffer>>& shaped,
+                   std::vector<std::vector<LaunchPiece>> of_ranks) {
+        KeptRows& kept = m_kept_rows[key];
+        const auto rank = size_t(m_group.rank());
+        const auto host = m_group.all_gather_words({m_local->uses_host_storage() ? 1u : 0u, 0});
+        bool all_host = m_shared_fraction > 0;
+        for (const auto& words : host) all_host = all_host && words[0] == 1;
+        if (!all_host) {
+            kept.mine = of_ranks[rank];
+            kept.of_ranks = std::move(of_ranks);
+            return;
+        }
+        SharedTail tail = share_tail(of_ranks, m_shared_fraction, granule);
+        LaunchReport ignored;
+        exchange(tail.given[rank], tail.given[rank], 0, spec, shaped, ignored, true);
+        kept.mine = tail.kept[rank];
+        kept.of_ranks = std::move(tail.kept);
+        kept.shared = std::move(tail.shared);
+    }
+
     /// After a launch on the kept rows: every kBalanceWindow such launches, the ranks'
     /// shares follow their measured speeds (balance_rows; the same answer on every rank,
     /// from the gathered busy times), and the elements of the rows that change owner move
     /// to their new rank, so each pixel's accumulation goes on where its frames were added.
     void balance_kept_rows(const Key& key, uint64_t granule, const LaunchSpec& spec,
                            const std::vector<std::shared_ptr<const Buffer>>& shaped,
-                           const LaunchReport& report,
-                           std::vector<std::vector<LaunchPiece>> of_ranks) {
+                           const LaunchReport& report) {
         if (m_rebalance_threshold < 0) return;
         KeptRows& kept = m_kept_rows[key];
-        kept.of_ranks = std::move(of_ranks);
         kept.busy_ms.resize(report.ranks.size(), 0.0);
-        for (size_t r = 0; r < report.ranks.size(); ++r) kept.busy_ms[r] += report.ranks[r].busy_ms;
+        kept.indices.resize(report.ranks.size(), 0);
+        for (size_t r = 0; r < report.ranks.size(); ++r) {
+            kept.busy_ms[r] += report.ranks[r].busy_ms;
+            kept.indices[r] += report.ranks[r].indices;
+        }
         if (++kept.launches < kBalanceWindow) return;
         // Each window's speeds, averaged with the earlier windows' (an exponential average
         // of weight 1/2): ranks sharing a machine's cores run at speeds that wander by a
@@ -278,12 +337,15 @@ class DistributedBackend final : public Backend {
         for (size_t r = 0; r < ranks && r < kept.busy_ms.size(); ++r) {
             uint64_t held = 0;
             for (const LaunchPiece& p : kept.of_ranks[r]) held += p.last - p.first;
-            if (held == 0 || !(kept.busy_ms[r] > 0)) continue;
-            const double speed = double(held) * kept.launches / kept.busy_ms[r];
+            if (held == 0 || kept.indices[r] == 0 || !(kept.busy_ms[r] > 0)) continue;
+            // Indices run (kept and shared) per ms: a rank that took more of the tail
+            // was busier for it, not slower.
+            const double speed = double(kept.indices[r]) / kept.busy_ms[r];
             kept.speed[r] = kept.speed[r] > 0 ? 0.5 * (kept.speed[r] + speed) : speed;
             expected_ms[r] = double(held) / kept.speed[r];
         }
         kept.busy_ms.assign(kept.busy_ms.size(), 0.0);
+        kept.indices.assign(kept.indices.size(), 0);
         kept.launches = 0;
         const RowBalance balance =
             balance_rows(kept.of_ranks, expected_ms, granule, m_rebalance_threshold);
@@ -292,10 +354,8 @@ class DistributedBackend final : public Backend {
         // The given rows' elements reach every rank (the new owner among them); a GPU
         // rank's come from its device first (as in a host read: not through the buffer).
         LaunchReport ignored;
-        exchange(balance.given[rank], 0, spec, shaped, ignored, true);
+        exchange(balance.given[rank], balance.given[rank], 0, spec, shaped, ignored, true);
         kept.mine = balance.kept[rank];
-        for (const auto& b : shaped)
-            m_partial[b.get()] = Partial{b, key, kept.mine, b->version(), true};
         if (m_trace && rank == 0) {
             std::fprintf(
                 stderr,
@@ -322,16 +382,22 @@ class DistributedBackend final : public Backend {
         LaunchReport ignored;
         LaunchSpec spec;
         spec.size = uint3{partial.key.x, partial.key.y, partial.key.z};
-        exchange(partial.pieces, 0, spec, {partial.buffer}, ignored, in_fetch);
+        exchange(partial.pieces, partial.pieces, 0, spec, {partial.buffer}, ignored, in_fetch);
     }
 
-    /// Every rank sends the pieces it ran (their ranges, its exceptions, then each written
-    /// buffer's bytes of each piece) to every other; each writes the others' pieces into
-    /// its host copies, which then are the one-process image on every rank.
-    /// `of_ranks` (if given) receives every rank's pieces.
-    void exchange(const std::vector<LaunchPiece>& mine, double busy_ms, const LaunchSpec& spec,
+    /// Every rank sends its busy time, its exceptions, the ranges of the pieces it ran and
+    /// of those it sends, then each buffer's bytes of each piece sent, to every other;
+    /// each writes the others' pieces into its host copies (sending every piece ran: the
+    /// one-process image on every rank).
+    /// `ran`: the pieces this rank ran (reported); `sent`: those whose elements of `shaped`
+    /// it sends. `fetch_locally`: a GPU rank's pieces come from its device directly, not
+    /// through the buffer (inside a host read, whose flag is already cleared, or for a
+    /// buffer whose host read would gather it). `of_ranks` (if given) receives every
+    /// rank's `ran`.
+    void exchange(const std::vector<LaunchPiece>& ran, const std::vector<LaunchPiece>& sent,
+                  double busy_ms, const LaunchSpec& spec,
                   const std::vector<std::shared_ptr<const Buffer>>& shaped, LaunchReport& report,
-                  bool in_fetch, std::vector<std::vector<LaunchPiece>>* of_ranks = nullptr) {
+                  bool fetch_locally, std::vector<std::vector<LaunchPiece>>* of_ranks = nullptr) {
         const uint3 size = spec.size;
         auto linear = [&](uint3 i) { return (uint64_t(i.z) * size.y + i.y) * size.x + i.x; };
         std::vector<unsigned char>& out = m_send;
@@ -346,20 +412,22 @@ class DistributedBackend final : public Backend {
             put(out, e.count);
             put(out, linear(e.first_index));
         }
-        put(out, mine.size());
-        for (const LaunchPiece& p : mine) {
-            put(out, p.first);
-            put(out, p.last);
+        for (const auto* pieces : {&ran, &sent}) {
+            put(out, pieces->size());
+            for (const LaunchPiece& p : *pieces) {
+                put(out, p.first);
+                put(out, p.last);
+            }
         }
         for (const auto& b : shaped) {
             // A GPU rank's pieces reach its host copy.
-            if (in_fetch)
+            if (fetch_locally)
                 m_local->fetch(*b);
             else
                 b->sync_from_device();
             const size_t element = b->element().size;
             const auto* bytes = static_cast<const unsigned char*>(b->raw());
-            for (const LaunchPiece& p : mine)
+            for (const LaunchPiece& p : sent)
                 out.insert(out.end(), bytes + p.first * element, bytes + p.last * element);
         }
         std::vector<uint64_t> counts;
@@ -382,18 +450,23 @@ class DistributedBackend final : public Backend {
                 if (fresh || first < linear(it->second.first_index)) it->second.first_index = index;
                 it->second.count += count;
             }
-            std::vector<LaunchPiece> pieces(get(p));
-            for (LaunchPiece& piece : pieces) {
-                piece.first = get(p);
-                piece.last = get(p);
-                share.indices += piece.last - piece.first;
-            }
-            share.pieces = unsigned(pieces.size());
-            if (of_ranks) of_ranks->push_back(pieces);
+            auto read_pieces = [&] {
+                std::vector<LaunchPiece> pieces(get(p));
+                for (LaunchPiece& piece : pieces) {
+                    piece.first = get(p);
+                    piece.last = get(p);
+                }
+                return pieces;
+            };
+            std::vector<LaunchPiece> its_ran = read_pieces();
+            const std::vector<LaunchPiece> its_sent = read_pieces();
+            for (const LaunchPiece& piece : its_ran) share.indices += piece.last - piece.first;
+            share.pieces = unsigned(its_ran.size());
+            if (of_ranks) of_ranks->push_back(std::move(its_ran));
             for (const auto& b : shaped) {
                 const size_t element = b->element().size;
                 auto* bytes = static_cast<unsigned char*>(const_cast<Buffer&>(*b).raw());
-                for (const LaunchPiece& piece : pieces) {
+                for (const LaunchPiece& piece : its_sent) {
                     const size_t n = (piece.last - piece.first) * element;
                     if (r != m_group.rank()) std::memcpy(bytes + piece.first * element, p, n);
                     p += n;
@@ -431,6 +504,7 @@ class DistributedBackend final : public Backend {
     std::vector<unsigned char> m_send, m_received;  // kept: a 4K image's pieces each launch
     const bool m_trace = std::getenv("LUCENT_MULTI_TRACE") != nullptr;
     const double m_rebalance_threshold = rebalance_threshold();
+    const double m_shared_fraction = shared_fraction();
 };
 
 }  // namespace

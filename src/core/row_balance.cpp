@@ -102,4 +102,45 @@ RowBalance balance_rows(const std::vector<std::vector<LaunchPiece>>& kept,
     return out;
 }
 
+SharedTail share_tail(const std::vector<std::vector<LaunchPiece>>& kept, double fraction,
+                      uint64_t granule) {
+    SharedTail out;
+    out.kept = kept;
+    out.given.assign(kept.size(), {});
+    if (granule == 0 || !(fraction > 0)) return out;
+    for (size_t r = 0; r < kept.size(); ++r) {
+        std::vector<LaunchPiece>& pieces = out.kept[r];
+        uint64_t held = 0;
+        for (const LaunchPiece& p : pieces) held += p.last - p.first;
+        if (held < 2 * granule) continue;
+        const uint64_t granules = std::max<uint64_t>(
+            1, uint64_t(std::llround(fraction * double(held) / double(granule))));
+        uint64_t remaining = std::min(granules, held / granule - 1) * granule;
+        std::vector<LaunchPiece> given;
+        while (remaining > 0 && !pieces.empty()) {
+            LaunchPiece& last = pieces.back();
+            const uint64_t length = last.last - last.first;
+            if (length <= remaining) {
+                given.push_back(last);
+                remaining -= length;
+                pieces.pop_back();
+                continue;
+            }
+            // Keep whole granules from the piece's start; give the rest.
+            const uint64_t keep = (length - remaining + granule - 1) / granule * granule;
+            if (keep < length) {
+                given.push_back({last.first + keep, last.last});
+                last.last = last.first + keep;
+            }
+            break;
+        }
+        std::reverse(given.begin(), given.end());  // in the order of the rank's pieces
+        for (const LaunchPiece& g : given)
+            for (uint64_t first = g.first; first < g.last; first += granule)
+                out.shared.push_back({first, std::min(g.last, first + granule)});
+        out.given[r] = std::move(given);
+    }
+    return out;
+}
+
 }  // namespace lucent::core

@@ -31,4 +31,20 @@ struct RowBalance {
 RowBalance balance_rows(const std::vector<std::vector<LaunchPiece>>& kept,
                         const std::vector<double>& busy_ms, uint64_t granule, double threshold);
 
+/// The rows that no rank keeps: each frame they go to whichever rank is free first, which
+/// evens out what the kept rows cannot (a rank slower in one frame than the frames before).
+struct SharedTail {
+    /// Per rank: the pieces it keeps, its others given to the tail.
+    std::vector<std::vector<LaunchPiece>> kept;
+    /// Per rank: the ranges it gave to the tail (their elements go to every rank).
+    std::vector<std::vector<LaunchPiece>> given;
+    /// The tail, in pieces of a granule (rank order).
+    std::vector<LaunchPiece> shared;
+};
+
+/// Each rank gives the tail the last `fraction` of its rows (whole granules, cut as in
+/// balance_rows), where it holds at least two granules.
+SharedTail share_tail(const std::vector<std::vector<LaunchPiece>>& kept, double fraction,
+                      uint64_t granule);
+
 }  // namespace lucent::core
