@@ -2,7 +2,7 @@
 """The efficiency model of docs/distributed.md ("Model"), for 1 to 256 nodes.
 
 Each figure it rests on is a measurement of docs/distributed.md: per-frame work on one node,
-the bytes a frame's launches gather, the imbalance of kept rows, and MPI's latency and
+the bytes a frame's launches gather, the ranks' imbalance, and MPI's latency and
 bandwidth (lucent-ranks-bench). Network figures between nodes were not measured (one
 machine): NET_* below are the assumed InfiniBand HDR link, and the model is also evaluated
 with the shared-memory figures measured between ranks on the device machine.
@@ -19,7 +19,11 @@ PT_IMAGE = 3840 * 2160 * 16  # one float4 image, bytes
 IGI_1080_FRAME_H200 = 24.0  # IGI Sponza canonical 1920x1080, 180 VPLs (docs/multi-device.md)
 IGI_BYTES_PER_PIXEL = 305   # gathered per frame (bench igi canonical, LUCENT_MULTI_TRACE)
 IGI_LAUNCHES = 3            # spread launches per frame (VPL generation runs whole)
-IMBALANCE = 1.105           # max/mean busy of kept rows, 4 ranks x 4 threads (device)
+# Max/mean of the ranks' busy times per frame, 4 ranks x 4 threads (device), path tracer:
+IMBALANCE_TAIL = 1.029      # kept rows re-balanced, and the shared tail (CPU ranks)
+IMBALANCE_KEPT = 1.08       # kept rows re-balanced alone (what GPU ranks do; measured on
+                            # CPU ranks, whose speeds wander more than a GPU's)
+SHARED_TAIL = 1 / 16        # of the rows, all-gathered each frame (accumulation + image)
 PIECE_TAIL = 1 / (2 * 16)   # dynamic pieces: half a piece of 16 per rank, on average
 
 # Links: (name, small-message latency in us, all-gather bandwidth per rank in GB/s).
@@ -40,12 +44,16 @@ def agreement_ms(n, latency_us):
     return 0.0 if n == 1 else latency_us * 1e-3 * math.log2(n)
 
 
-def path_tracer(n, frame_ms, link):
-    """Index-local accumulation: per frame two agreements and the report's all-gather;
-    once: the gather before the kept rows (accumulation + image) and the image's at the end."""
+def path_tracer(n, frame_ms, link, shared_tail):
+    """Index-local accumulation: per frame two agreements and the report's all-gather (with
+    the shared tail's elements on CPU ranks); once: the gather before the kept rows
+    (accumulation + image) and the image's at the end."""
     _, lat, bw = link
     work = PT_FRAMES * frame_ms
-    per_frame = frame_ms / n * (IMBALANCE if n > 1 else 1) + 3 * agreement_ms(n, lat)
+    imbalance = IMBALANCE_TAIL if shared_tail else IMBALANCE_KEPT
+    per_frame = frame_ms / n * (imbalance if n > 1 else 1) + 3 * agreement_ms(n, lat)
+    if shared_tail:
+        per_frame += allgather_ms(2 * PT_IMAGE * SHARED_TAIL, n, lat, bw)
     once = 3 * allgather_ms(PT_IMAGE, n, lat, bw)
     return work / (n * (PT_FRAMES * per_frame + once) / 1) if n > 1 else 1.0
 
@@ -65,6 +73,6 @@ if __name__ == "__main__":
     for link in LINKS:
         print(f"== {link[0]}: latency {link[1]} us, all-gather {link[2]} GB/s per rank")
         print("nodes      " + " ".join(f"{n:>7}" for n in nodes))
-        print("PT 4K CPU  " + " ".join(f"{path_tracer(n, PT_4K_FRAME_CPU16, link):7.3f}" for n in nodes))
-        print("PT 4K H200 " + " ".join(f"{path_tracer(n, PT_4K_FRAME_H200, link):7.3f}" for n in nodes))
+        print("PT 4K CPU  " + " ".join(f"{path_tracer(n, PT_4K_FRAME_CPU16, link, True):7.3f}" for n in nodes))
+        print("PT 4K H200 " + " ".join(f"{path_tracer(n, PT_4K_FRAME_H200, link, False):7.3f}" for n in nodes))
         print("IGI 1080p  " + " ".join(f"{igi(n, link):7.3f}" for n in nodes))
