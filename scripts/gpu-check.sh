@@ -296,16 +296,6 @@ profile_igi_pass)
     ncu -i $work/igi_pass.ncu-rep --print-summary none 2>&1 | grep -vE "^==PROF==|^ +-+$" | \
         grep -E "Duration|Registers|Occupancy|Warp Cycles|Issued|Eligible|Stall|Block Limit|Threads|Grid" | head -40
     ;;
-profile_cwbvh)
-    echo "== ncu: the binary and the compressed wide layout's closest-hit kernels, Sponza primary rays"
-    for k in lucent_bench_closest lucent_bench_cwbvh_closest; do
-        ncu --kernel-name $k --launch-skip 1 --launch-count 1 --section SpeedOfLight \
-            --section WarpStateStats --section Occupancy --section InstructionStats \
-            --section MemoryWorkloadAnalysis \
-            $R $B/bin/lucent bench rays --backend cuda --repeat 1 --scene /work/shared/scenes/sponza.obj 2>&1 | \
-            grep -E "Duration|Throughput|Executed Ipc|Issue Slots|Warp Cycles|Achieved Occ|Registers|Stall|L1/TEX Hit|L2 Hit|Instructions" | head -30
-    done
-    ;;
 hotspots)
     echo "== ncu: per-source-line stall samples of the Whitted megakernel (source.csv, sass.csv)"
     LUCENT_NVRTC_OPTIONS="-lineinfo" ncu --kernel-name regex:lucent_ray_generation_ --launch-skip 2 --launch-count 1 \

@@ -1,6 +1,6 @@
-// The benchmarks' own device sources (device/lucent_bench/*.cuh: the trace kernels and the
-// compressed wide BVH layout), embedded for NVRTC by the lucent_bench target, so the
-// library carries only what the engine runs.
+// The benchmarks' own device sources (device/lucent_bench/*.cuh: the trace kernels, the TEA
+// kernels), embedded for NVRTC by the lucent_bench target, so the library carries only what
+// the engine runs.
 #pragma once
 
 #include <string>

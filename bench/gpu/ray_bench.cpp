@@ -57,15 +57,13 @@ RayBench::RayBench(const DriverApi& api, const ContextScope& ctx, const RaySetsS
     k.any = m_module->function("lucent_bench_any");
     k.primary_rays = m_module->function("lucent_bench_primary_rays");
     k.secondary_rays = m_module->function("lucent_bench_secondary_rays");
-    k.cwbvh_closest = m_module->function("lucent_bench_cwbvh_closest");
-    k.cwbvh_any = m_module->function("lucent_bench_cwbvh_any");
     auto attr = [&](CUfunction f, CUfunction_attribute a) {
         int v = 0;
         check(api.cuFuncGetAttribute(&v, a, f), "cuFuncGetAttribute");
         return v;
     };
     k.block = 1 << 30;
-    for (CUfunction f : {k.closest, k.any, k.cwbvh_closest, k.cwbvh_any})
+    for (CUfunction f : {k.closest, k.any})
         k.block = std::min(k.block, attr(f, CU_FUNC_ATTRIBUTE_MAX_THREADS_PER_BLOCK));
     auto resident = [&](CUfunction f) {
         int blocks = 0;
@@ -76,9 +74,6 @@ RayBench::RayBench(const DriverApi& api, const ContextScope& ctx, const RaySetsS
     const int res_closest = resident(k.closest), res_any = resident(k.any);
     k.grid_closest = sm_count * res_closest;
     k.grid_any = sm_count * res_any;
-    const int res_cw_closest = resident(k.cwbvh_closest), res_cw_any = resident(k.cwbvh_any);
-    k.grid_cwbvh_closest = sm_count * res_cw_closest;
-    k.grid_cwbvh_any = sm_count * res_cw_any;
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "%s, %s, block %d; closest %d regs %d B local %d blocks/SM; any %d regs %d B "
@@ -91,14 +86,6 @@ RayBench::RayBench(const DriverApi& api, const ContextScope& ctx, const RaySetsS
                   attr(k.any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_any, compiled.ms,
                   compiled.from_cache ? " (cache)" : "");
     k.describe = buf;
-    std::snprintf(buf, sizeof buf,
-                  "closest %d regs %d B local %d blocks/SM; any %d regs %d B local %d "
-                  "blocks/SM",
-                  attr(k.cwbvh_closest, CU_FUNC_ATTRIBUTE_NUM_REGS),
-                  attr(k.cwbvh_closest, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_cw_closest,
-                  attr(k.cwbvh_any, CU_FUNC_ATTRIBUTE_NUM_REGS),
-                  attr(k.cwbvh_any, CU_FUNC_ATTRIBUTE_LOCAL_SIZE_BYTES), res_cw_any);
-    k.describe_cwbvh = buf;
     counter = DeviceBuffer(sizeof(unsigned));
 }
 

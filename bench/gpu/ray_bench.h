@@ -1,5 +1,5 @@
 // BENCH.md's three ray sets in device memory and the bench's trace kernels
-// (device/lucent_bench/trace_kernels.cuh) that time them over a BVH of either GPU layout:
+// (device/lucent_bench/trace_kernels.cuh) that time them over a BVH of the GPU layout:
 // `lucent bench rays --backend cuda` times the host SAH tree with them, `lucent bench build
 // --backend cuda` compares the GPU builder's tree with that one.
 #pragma once
@@ -12,7 +12,6 @@
 
 #include "bench/common/bench_camera.h"
 #include "bench/common/rate.h"
-#include "bench/gpu/gpu_cwbvh.h"
 #include "bench/gpu/gpu_session.h"
 #include "cuda/accel/gpu_bvh_builder.h"
 #include "cuda/accel/gpu_triangle_bvh.h"
@@ -33,12 +32,10 @@ GpuBvhBuildOptions gpu_build_options();
 /// The compiled bench module and how to launch its trace kernels.
 struct TraceKernels {
     CUfunction closest = nullptr, any = nullptr, primary_rays = nullptr, secondary_rays = nullptr;
-    CUfunction cwbvh_closest = nullptr, cwbvh_any = nullptr;  // the compressed wide layout
     bool persistent = true;
     int block = 128;
     int grid_closest = 0, grid_any = 0;  // persistent grids: SMs x resident blocks
-    int grid_cwbvh_closest = 0, grid_cwbvh_any = 0;
-    std::string describe, describe_cwbvh;
+    std::string describe;
 };
 
 /// The trace kernels for compute capability `sm` (x10), persistent threads or one per ray.
@@ -75,18 +72,6 @@ class RayBench {
     Rate time_diffuse(const gpu::GpuTriangleBvhView& view) {
         return time_trace(k.closest, k.grid_closest, view, diffuse.ptr(), m, diffuse_hits.ptr());
     }
-    /// The same three through the compressed wide layout.
-    Rate time_primary(const gpu::GpuCwbvhView& view) {
-        return time_trace(k.cwbvh_closest, k.grid_cwbvh_closest, view, primary.ptr(), n,
-                          primary_hits.ptr());
-    }
-    Rate time_shadow(const gpu::GpuCwbvhView& view) {
-        return time_trace(k.cwbvh_any, k.grid_cwbvh_any, view, shadow.ptr(), m, occluded.ptr());
-    }
-    Rate time_diffuse(const gpu::GpuCwbvhView& view) {
-        return time_trace(k.cwbvh_closest, k.grid_cwbvh_closest, view, diffuse.ptr(), m,
-                          diffuse_hits.ptr());
-    }
 
     int sm = 0, sm_count = 0;
     TraceKernels k;
@@ -95,11 +80,9 @@ class RayBench {
     DeviceBuffer primary, primary_hits, slots, shadow, diffuse, occluded, diffuse_hits;
 
   private:
-    /// One launch of a trace kernel over a BVH view (either layout); returns its time in ms
-    /// (CUDA events).
-    template <class View>
-    float trace(CUfunction f, int grid_persistent, View view, CUdeviceptr rays, unsigned count,
-                CUdeviceptr out) {
+    /// One launch of a trace kernel over a BVH view; returns its time in ms (CUDA events).
+    float trace(CUfunction f, int grid_persistent, gpu::GpuTriangleBvhView view, CUdeviceptr rays,
+                unsigned count, CUdeviceptr out) {
         CUdeviceptr counter_ptr = counter.ptr();
         void* args[] = {&view, &rays, &count, &out, &counter_ptr};
         const unsigned grid =
@@ -114,9 +97,8 @@ class RayBench {
         check(m_api.cuEventElapsedTime(&ms, m_start.get(), m_stop.get()), "cuEventElapsedTime");
         return ms;
     }
-    template <class View>
-    Rate time_trace(CUfunction f, int grid_persistent, const View& view, CUdeviceptr rays,
-                    unsigned count, CUdeviceptr out) {
+    Rate time_trace(CUfunction f, int grid_persistent, const gpu::GpuTriangleBvhView& view,
+                    CUdeviceptr rays, unsigned count, CUdeviceptr out) {
         std::vector<double> mrays;
         if (count == 0) return Rate{};
         for (int run = -1; run < m_in.repeat; ++run) {

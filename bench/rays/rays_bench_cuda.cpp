@@ -1,6 +1,6 @@
-// `lucent bench rays --backend cuda`: the host SAH tree in the GPU's binary layout and in the
-// compressed wide layout, each timed on BENCH.md's ray sets, then the same rays traced by
-// TriangleAccel on the CPU; every ray's result is compared.
+// `lucent bench rays --backend cuda`: the host SAH tree in the GPU's layout, timed on BENCH.md's
+// ray sets, then the same rays traced by TriangleAccel on the CPU; every ray's result is
+// compared.
 #include "bench/rays/rays_bench_cuda.h"
 
 #include <algorithm>
@@ -13,7 +13,6 @@
 #include "accel/triangle_accel.h"
 #include "bench/common/ray_checksums.h"
 #include "bench/common/report.h"
-#include "bench/gpu/gpu_cwbvh.h"
 #include "bench/gpu/ray_bench.h"
 #include "lucent/error.h"
 
@@ -49,16 +48,15 @@ float3 xyz(float4 v) {
     return make_float3(v.x, v.y, v.z);
 }
 
-/// One BVH layout on the three ray sets: its rates, and every ray's result.
+/// The GPU layout on the three ray sets: its rates, and every ray's result.
 struct LayoutRun {
     Rate primary, shadow, diffuse;
     std::vector<uint2> primary_hits, diffuse_hits;  // (t bits, triangle), t < 0 on a miss
     std::vector<unsigned char> occluded;
 };
 
-/// Times the three ray sets on `view` (either layout) and downloads what they found.
-template <class View>
-LayoutRun time_layout(RayBench& bench, const View& view) {
+/// Times the three ray sets on `view` and downloads what they found.
+LayoutRun time_layout(RayBench& bench, const gpu::GpuTriangleBvhView& view) {
     LayoutRun run;
     run.primary = bench.time_primary(view);
     run.primary_hits.resize(bench.n);
@@ -82,7 +80,7 @@ void for_secondary_in_pixel_order(const RayBench& bench, const std::vector<uint2
     }
 }
 
-/// The checksums of a layout's results, summed in pixel order as the CPU bench does.
+/// The checksums of the GPU's results, summed in pixel order as the CPU bench does.
 Checksums checksums_of(const RayBench& bench, const LayoutRun& run) {
     Checksums sums;
     for (unsigned p = 0; p < bench.n; ++p) {
@@ -98,32 +96,8 @@ Checksums checksums_of(const RayBench& bench, const LayoutRun& run) {
     return sums;
 }
 
-/// Rays whose result differs between two layouts; of the closest hits, those at another
-/// distance (the rest: another triangle at the same distance, a tie on a shared edge, which
-/// the layouts' different visiting orders break apart).
-struct LayoutDifferences {
-    size_t primary = 0, shadow = 0, diffuse = 0, primary_t = 0, diffuse_t = 0;
-};
-
-LayoutDifferences compare_layouts(const LayoutRun& a, const LayoutRun& b) {
-    auto same_hit = [](uint2 x, uint2 y) {
-        return x.x == y.x && (std::bit_cast<float>(x.x) < 0.0f || x.y == y.y);
-    };
-    LayoutDifferences d;
-    for (size_t i = 0; i < a.primary_hits.size(); ++i) {
-        d.primary += !same_hit(a.primary_hits[i], b.primary_hits[i]);
-        d.primary_t += a.primary_hits[i].x != b.primary_hits[i].x;
-    }
-    for (size_t i = 0; i < a.occluded.size(); ++i) {
-        d.shadow += a.occluded[i] != b.occluded[i];
-        d.diffuse += !same_hit(a.diffuse_hits[i], b.diffuse_hits[i]);
-        d.diffuse_t += a.diffuse_hits[i].x != b.diffuse_hits[i].x;
-    }
-    return d;
-}
-
 /// The CPU backend's traversal (TriangleAccel) on the very rays the GPU made: its checksums
-/// and the rays whose result differs from the GPU's binary layout.
+/// and the rays whose result differs from the GPU's.
 struct CpuReference {
     Checksums sums;
     size_t differ_primary = 0, differ_shadow = 0, differ_diffuse = 0;
@@ -180,19 +154,17 @@ struct CudaRaysResult {
     unsigned threads = 0;  // of the CPU reference
     TraceKernels kernels;
     size_t triangles = 0;
-    GpuBvhStats binary_stats, cwbvh_stats;  // the host SAH tree in each layout
-    double binary_mb = 0, cwbvh_mb = 0;     // of nodes
-    LayoutRun binary, cwbvh;
+    GpuBvhStats bvh_stats;  // the host SAH tree in the GPU layout
+    LayoutRun gpu_run;
     Checksums gpu;
-    LayoutDifferences cwbvh_vs_binary;
     CpuReference cpu;
     std::string differences;  // of the checksums, gpu against cpu ("" when they agree)
 };
 
 Json to_json(const CudaRaysResult& r) {
     const CudaRaysInput& in = *r.in;
-    Json primary = rate_json(r.binary.primary), shadow = rate_json(r.binary.shadow),
-         diffuse = rate_json(r.binary.diffuse);
+    Json primary = rate_json(r.gpu_run.primary), shadow = rate_json(r.gpu_run.shadow),
+         diffuse = rate_json(r.gpu_run.diffuse);
     primary["hits"] = r.gpu.primary_hits;
     primary["sum_t"] = r.gpu.primary_sum_t;
     shadow["rays"] = r.gpu.shadow_rays;
@@ -200,46 +172,33 @@ Json to_json(const CudaRaysResult& r) {
     diffuse["rays"] = r.gpu.diffuse_rays;
     diffuse["hits"] = r.gpu.diffuse_hits;
     diffuse["sum_t"] = r.gpu.diffuse_sum_t;
-    const LayoutDifferences& d = r.cwbvh_vs_binary;
-    return Json{
-        {"scene", in.scene},
-        {"backend", "cuda"},
-        {"device", r.device},
-        {"sm", r.sm},
-        {"triangles", r.triangles},
-        {"width", in.width},
-        {"height", in.height},
-        {"repeat", in.repeat},
-        {"persistent", r.kernels.persistent},
-        {"build_ms", rounded(r.binary_stats.build_ms + r.binary_stats.convert_ms, 3)},
-        {"bvh_nodes", r.binary_stats.node_count},
-        {"sah_cost", rounded(r.binary_stats.sah_cost, 4)},
-        {"lucent", Json{{"primary", primary}, {"shadow", shadow}, {"diffuse", diffuse}}},
-        {"cpu", Json{{"primary",
-                      Json{{"hits", r.cpu.sums.primary_hits}, {"sum_t", r.cpu.sums.primary_sum_t}}},
-                     {"shadow", Json{{"occluded", r.cpu.sums.occluded}}},
-                     {"diffuse", Json{{"hits", r.cpu.sums.diffuse_hits},
-                                      {"sum_t", r.cpu.sums.diffuse_sum_t}}}}},
-        {"rays_differing", Json{{"primary", r.cpu.differ_primary},
-                                {"shadow", r.cpu.differ_shadow},
-                                {"diffuse", r.cpu.differ_diffuse}}},
-        {"checksums_agree", r.differences.empty()},
-        {"cwbvh", Json{{"nodes", r.cwbvh_stats.node_count},
-                       {"node_mb", rounded(r.cwbvh_mb, 4)},
-                       {"binary_node_mb", rounded(r.binary_mb, 4)},
-                       {"build_ms", rounded(r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms, 3)},
-                       {"primary", rate_json(r.cwbvh.primary)},
-                       {"shadow", rate_json(r.cwbvh.shadow)},
-                       {"diffuse", rate_json(r.cwbvh.diffuse)},
-                       {"rays_differing_from_binary",
-                        Json{{"primary", d.primary}, {"shadow", d.shadow}, {"diffuse", d.diffuse}}},
-                       {"distances_differing_from_binary",
-                        Json{{"primary", d.primary_t}, {"diffuse", d.diffuse_t}}}}}};
+    return Json{{"scene", in.scene},
+                {"backend", "cuda"},
+                {"device", r.device},
+                {"sm", r.sm},
+                {"triangles", r.triangles},
+                {"width", in.width},
+                {"height", in.height},
+                {"repeat", in.repeat},
+                {"persistent", r.kernels.persistent},
+                {"build_ms", rounded(r.bvh_stats.build_ms + r.bvh_stats.convert_ms, 3)},
+                {"bvh_nodes", r.bvh_stats.node_count},
+                {"sah_cost", rounded(r.bvh_stats.sah_cost, 4)},
+                {"lucent", Json{{"primary", primary}, {"shadow", shadow}, {"diffuse", diffuse}}},
+                {"cpu", Json{{"primary", Json{{"hits", r.cpu.sums.primary_hits},
+                                              {"sum_t", r.cpu.sums.primary_sum_t}}},
+                             {"shadow", Json{{"occluded", r.cpu.sums.occluded}}},
+                             {"diffuse", Json{{"hits", r.cpu.sums.diffuse_hits},
+                                              {"sum_t", r.cpu.sums.diffuse_sum_t}}}}},
+                {"rays_differing", Json{{"primary", r.cpu.differ_primary},
+                                        {"shadow", r.cpu.differ_shadow},
+                                        {"diffuse", r.cpu.differ_diffuse}}},
+                {"checksums_agree", r.differences.empty()}};
 }
 
 void print_text(const CudaRaysResult& r) {
     const CudaRaysInput& in = *r.in;
-    const LayoutRun &b = r.binary, &cw = r.cwbvh;
+    const LayoutRun& b = r.gpu_run;
     const Checksums &gpu = r.gpu, &cpu = r.cpu.sums;
     std::printf(
         "scene %s: %zu triangles, %ux%u, GPU %s (sm_%d, %d SMs), median of %d repeats, trace "
@@ -248,31 +207,14 @@ void print_text(const CudaRaysResult& r) {
         in.repeat);
     std::printf("kernels: %s\n", r.kernels.describe.c_str());
     std::printf("build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u)\n",
-                r.binary_stats.build_ms, r.binary_stats.convert_ms, r.binary_stats.sah_cost,
-                r.binary_stats.node_count, r.binary_stats.leaf_count, r.binary_stats.depth);
+                r.bvh_stats.build_ms, r.bvh_stats.convert_ms, r.bvh_stats.sah_cost,
+                r.bvh_stats.node_count, r.bvh_stats.leaf_count, r.bvh_stats.depth);
     std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(b.primary).c_str(), gpu.primary_hits,
                 gpu.primary_sum_t);
     std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(b.shadow).c_str(), gpu.shadow_rays,
                 gpu.occluded);
     std::printf("diffuse %s rays=%zu hits=%zu sum_t=%.6e\n", rate_text(b.diffuse).c_str(),
                 gpu.diffuse_rays, gpu.diffuse_hits, gpu.diffuse_sum_t);
-    std::printf(
-        "compressed wide layout (cwbvh): %zu nodes, %.2f MB of nodes (binary %.2f MB), "
-        "build %.1f ms; %s\n",
-        r.cwbvh_stats.node_count, r.cwbvh_mb, r.binary_mb,
-        r.cwbvh_stats.build_ms + r.cwbvh_stats.convert_ms, r.kernels.describe_cwbvh.c_str());
-    std::printf("cwbvh primary %s (%.3fx binary)\n", rate_text(cw.primary).c_str(),
-                bench::median_ratio(cw.primary, b.primary));
-    std::printf("cwbvh shadow %s (%.3fx binary)\n", rate_text(cw.shadow).c_str(),
-                bench::median_ratio(cw.shadow, b.shadow));
-    std::printf("cwbvh diffuse %s (%.3fx binary)\n", rate_text(cw.diffuse).c_str(),
-                bench::median_ratio(cw.diffuse, b.diffuse));
-    const LayoutDifferences& d = r.cwbvh_vs_binary;
-    std::printf(
-        "cwbvh results differing from the binary layout's: primary %zu, shadow %zu, "
-        "diffuse %zu; of them another distance: primary %zu, diffuse %zu (the rest: "
-        "another triangle at the same distance)\n",
-        d.primary, d.shadow, d.diffuse, d.primary_t, d.diffuse_t);
     std::printf(
         "cpu primary hits=%zu sum_t=%.6e, shadow occluded=%zu, diffuse hits=%zu "
         "sum_t=%.6e (TriangleAccel, %u threads, the same rays)\n",
@@ -305,32 +247,22 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
     result.sm_count = bench.sm_count;
     result.kernels = bench.k;
 
-    // The host SAH tree in the binary layout.
+    // The host SAH tree in the GPU layout.
     const GpuTriangleBvh bvh =
         build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
     GpuTriangleBvhDevice dbvh;
     upload_gpu_triangle_bvh(bvh, dbvh);
     result.triangles = bvh.triangle_ids.size();
-    result.binary_stats = bvh.stats;
-    result.binary_mb = (bvh.nodes.size() * sizeof(float4)) / 1e6;
+    result.bvh_stats = bvh.stats;
 
     // The rays (BENCH.md), generated on the GPU. The CPU reference traces the very rays the
     // GPU made, so the comparison is exact even where the host compiler contracts the ray
     // formulas differently.
     bench.make_rays(dbvh.view(), triangles_by_prim(bvh));
-    result.binary = time_layout(bench, dbvh.view());
-    result.gpu = checksums_of(bench, result.binary);
+    result.gpu_run = time_layout(bench, dbvh.view());
+    result.gpu = checksums_of(bench, result.gpu_run);
 
-    // The compressed wide layout (cwbvh.cuh) on the same rays.
-    const GpuCwbvh cwbvh = build_gpu_cwbvh(in.positions, in.indices);
-    GpuCwbvhDevice dcwbvh;
-    upload_gpu_cwbvh(cwbvh, dcwbvh);
-    result.cwbvh_stats = cwbvh.stats;
-    result.cwbvh_mb = (cwbvh.nodes.size() * sizeof(float4)) / 1e6;
-    result.cwbvh = time_layout(bench, dcwbvh.view());
-    result.cwbvh_vs_binary = compare_layouts(result.binary, result.cwbvh);
-
-    result.cpu = trace_on_cpu(in, bench, result.binary, result.threads);
+    result.cpu = trace_on_cpu(in, bench, result.gpu_run, result.threads);
     result.differences = bench::checksum_differences(result.gpu, result.cpu.sums, "gpu", "cpu");
     if (in.json && in.json_out)
         *in.json_out = to_json(result);

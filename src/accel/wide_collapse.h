@@ -1,7 +1,7 @@
 // Which nodes of a binary BVH become the children of each 8-wide node: the optimal collapse
 // of Ylitie, Karras and Laine 2017 ("Efficient incoherent ray traversal on GPUs through
 // compressed wide BVHs", Sec. 3.1), without its leaf formation: the binary leaves stay the
-// leaves. Shared by TriangleAccel's CPU layout and the GPU's compressed wide layout.
+// leaves. TriangleAccel's CPU layout (wide_bvh.h).
 #pragma once
 
 #include <array>

@@ -30,26 +30,26 @@ void set_children(float4* n, int child0, int child1) {
     n[3] = make_float4(std::bit_cast<float>(child0), std::bit_cast<float>(child1), 0.0f, 0.0f);
 }
 
-}  // namespace
-
-accel::Bvh build_gpu_source_bvh(std::span<const float3> positions, std::span<const uint3> indices,
-                                const GpuBvhBuildOptions& options, const char* layout,
-                                int max_leaf_size, accel::BuildStats& stats) {
+/// The binned-SAH binary BVH the layout is made from, after checking the input: every vertex
+/// index in range, no more triangles than a leaf reference holds, max_leaf_size within
+/// 1..kGpuMaxLeafSize, and a depth the traversal stack holds.
+accel::Bvh build_source_bvh(std::span<const float3> positions, std::span<const uint3> indices,
+                            const GpuBvhBuildOptions& options, accel::BuildStats& stats) {
+    const std::string layout = "GPU triangle BVH";  // names it in the errors
     const size_t tri_count = indices.empty() ? positions.size() / 3 : indices.size();
     if (tri_count > gpu::kGpuLeafFirstMask)
-        throw Error(std::string(layout) + ": " + std::to_string(tri_count) +
+        throw Error(layout + ": " + std::to_string(tri_count) +
                     " triangles, the layout holds at most " +
                     std::to_string(gpu::kGpuLeafFirstMask));
-    if (options.max_leaf_size < 1 || options.max_leaf_size > max_leaf_size)
-        throw Error(std::string(layout) + ": max_leaf_size must be 1.." +
-                    std::to_string(max_leaf_size));
+    if (options.max_leaf_size < 1 || options.max_leaf_size > gpu::kGpuMaxLeafSize)
+        throw Error(layout + ": max_leaf_size must be 1.." + std::to_string(gpu::kGpuMaxLeafSize));
 
     // Triangle boxes.
     std::vector<Aabb> boxes(tri_count);
     for (size_t i = 0; i < tri_count; ++i) {
         const uint3 t = triangle(indices, i);
         if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size())
-            throw Error(std::string(layout) + ": triangle " + std::to_string(i) +
+            throw Error(layout + ": triangle " + std::to_string(i) +
                         " has a vertex index out of range");
         const float3 a = positions[t.x], b = positions[t.y], c = positions[t.z];
         boxes[i].lo = fminf(a, fminf(b, c));
@@ -64,11 +64,13 @@ accel::Bvh build_gpu_source_bvh(std::span<const float3> positions, std::span<con
     accel::Bvh bvh;
     bvh.build(boxes, build, &stats);
     if (stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)
-        throw Error(std::string(layout) + ": depth " + std::to_string(stats.depth) +
+        throw Error(layout + ": depth " + std::to_string(stats.depth) +
                     " exceeds the traversal stack (" + std::to_string(gpu::kGpuStackSize) + ")");
     return bvh;
 }
 
+/// Appends the triangles of a leaf of `bvh` in leaf order (three float4 each, w = 0) and
+/// their input indices; returns the index of the first.
 unsigned append_leaf_triangles(std::span<const float3> positions, std::span<const uint3> indices,
                                const accel::Bvh& bvh, const accel::BvhNode& leaf,
                                std::vector<float4>& triangles,
@@ -85,13 +87,14 @@ unsigned append_leaf_triangles(std::span<const float3> positions, std::span<cons
     return first;
 }
 
+}  // namespace
+
 GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
                                       std::span<const uint3> indices,
                                       const GpuBvhBuildOptions& options) {
     const size_t tri_count = indices.empty() ? positions.size() / 3 : indices.size();
     accel::BuildStats bs;
-    const accel::Bvh bvh = build_gpu_source_bvh(positions, indices, options, "GPU triangle BVH",
-                                                gpu::kGpuMaxLeafSize, bs);
+    const accel::Bvh bvh = build_source_bvh(positions, indices, options, bs);
 
     const auto start = std::chrono::steady_clock::now();
     GpuTriangleBvh out;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "accel/bvh.h"
-#include "cuda/device/lucent_gpu/triangle_bvh.cuh"
 #include "cuda/backend/device_buffer.h"
+#include "cuda/device/lucent_gpu/triangle_bvh.cuh"
 
 namespace lucent::cuda {
 
@@ -50,19 +50,6 @@ struct GpuTriangleBvh {
         return {nodes.data(), triangles.data(), triangle_ids.data()};
     }
 };
-
-/// The binned-SAH binary BVH the GPU layouts are made from, after checking the input: every
-/// vertex index in range, no more triangles than a leaf reference holds, max_leaf_size within
-/// 1..max_leaf_size of the layout, and a depth the traversal stacks hold. Errors name `layout`.
-accel::Bvh build_gpu_source_bvh(std::span<const float3> positions, std::span<const uint3> indices,
-                                const GpuBvhBuildOptions& options, const char* layout,
-                                int max_leaf_size, accel::BuildStats& stats);
-
-/// Appends the triangles of a leaf of `bvh` in leaf order (three float4 each, w = 0) and
-/// their input indices; returns the index of the first.
-unsigned append_leaf_triangles(std::span<const float3> positions, std::span<const uint3> indices,
-                               const accel::Bvh& bvh, const accel::BvhNode& leaf,
-                               std::vector<float4>& triangles, std::vector<uint32_t>& triangle_ids);
 
 /// Builds over triangles (indices may be empty: then triangle i is vertices 3i..3i+2).
 /// Throws lucent::Error for an index out of range or a mesh too big for the format.

@@ -12,7 +12,6 @@
 #pragma once
 
 #include "lucent/device/types.h"
-#include "lucent_bench/cwbvh.cuh"
 #include "lucent_gpu/ray_order.cuh"
 #include "lucent_gpu/triangle_bvh.cuh"
 
@@ -88,37 +87,6 @@ __device__ inline void bench_trace(const GpuTriangleBvhView& bvh, const float4* 
 #endif
 }
 
-/// Traces rays[0, count) through the compressed wide layout (cwbvh.cuh) with query kQuery
-/// and writes each ray's result with store(i, found, hit). Persistent threads take one ray
-/// at a time, a warp's lanes that need one from one atomic, and trace it to the end (the
-/// traversal keeps its state in locals, so there is no fetch in the middle of a ray).
-template <int kQuery, class Store>
-__device__ inline void bench_trace_cwbvh(const GpuCwbvhView& bvh, const float4* __restrict__ rays,
-                                         unsigned count, unsigned* counter, Store&& store) {
-    GpuNoFilter none;
-    GpuCwbvhStack stack;
-    auto trace_one = [&](unsigned ray) {
-        const float4 o = __ldg(rays + 2 * ray);
-        const float4 d = __ldg(rays + 2 * ray + 1);
-        GpuHit hit{};
-        const bool found = gpu_cwbvh_trace<kQuery>(bvh, make_float3(o.x, o.y, o.z),
-                                                   make_float3(d.x, d.y, d.z), o.w, d.w, hit, none,
-                                                   stack);
-        store(ray, found, hit);
-    };
-#if LUCENT_BENCH_PERSISTENT
-    for (;;) {
-        const unsigned ray = bench_claim_rays(__activemask(), counter);
-        if (ray >= count) break;
-        trace_one(ray);
-    }
-#else
-    (void)counter;
-    const unsigned ray = blockIdx.x * blockDim.x + threadIdx.x;
-    if (ray < count) trace_one(ray);
-#endif
-}
-
 }  // namespace lucent::gpu
 
 /// Closest hit of every ray: hits[i] = (t or -1, triangle index).
@@ -141,30 +109,6 @@ extern "C" __global__ void __launch_bounds__(LUCENT_BENCH_BLOCK, LUCENT_BENCH_MI
     bench_trace<kGpuAny>(bvh, rays, count, counter, [&](unsigned i, const GpuBvhTraversal& tr) {
         occluded[i] = tr.hit() ? 1 : 0;
     });
-}
-
-/// lucent_bench_closest through the compressed wide layout: the same results.
-extern "C" __global__ void __launch_bounds__(LUCENT_BENCH_BLOCK, LUCENT_BENCH_MIN_BLOCKS)
-    lucent_bench_cwbvh_closest(lucent::gpu::GpuCwbvhView bvh, const float4* __restrict__ rays,
-                               unsigned count, uint2* __restrict__ hits, unsigned* counter) {
-    using namespace lucent::gpu;
-    bench_trace_cwbvh<kGpuClosest>(bvh, rays, count, counter,
-                                   [&](unsigned i, bool found, const GpuHit& hit) {
-                                       hits[i] = make_uint2(__float_as_uint(found ? hit.t : -1.0f),
-                                                            found ? hit.prim : 0u);
-                                   });
-}
-
-/// lucent_bench_any through the compressed wide layout.
-extern "C" __global__ void __launch_bounds__(LUCENT_BENCH_BLOCK, LUCENT_BENCH_MIN_BLOCKS)
-    lucent_bench_cwbvh_any(lucent::gpu::GpuCwbvhView bvh, const float4* __restrict__ rays,
-                           unsigned count, unsigned char* __restrict__ occluded,
-                           unsigned* counter) {
-    using namespace lucent::gpu;
-    bench_trace_cwbvh<kGpuAny>(bvh, rays, count, counter,
-                               [&](unsigned i, bool found, const GpuHit&) {
-                                   occluded[i] = found ? 1 : 0;
-                               });
 }
 
 /// Primary rays of BENCH.md, pixel y * width + x, y = 0 the top row. fwd, right, up2,

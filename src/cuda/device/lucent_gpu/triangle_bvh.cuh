@@ -127,7 +127,7 @@ LUCENT_HD inline int gpu_active_lanes() {
 }
 
 /// The watertight test of leaf-order triangle i (three float4 at tris + 3i) within
-/// (tmin, tmax): the CPU's test, so both layouts find the CPU's hits.
+/// (tmin, tmax): the CPU's test, so the GPU finds the CPU's hits.
 LUCENT_HD inline bool gpu_intersect_triangle(const float4* tris, unsigned i,
                                              const WatertightRay& wt, float tmin, float tmax,
                                              float& t, float& u, float& v) {
@@ -203,8 +203,7 @@ struct GpuBvhTraversal {
 
     /// Near and far distances of one child box: the CPU's slab test (near planes chosen by
     /// the sign of the direction, far distance * kGpuFarScale). An empty box (lo > hi) is
-    /// never entered. `r` is any state with this struct's idx .. ohiz, tmin and tmax (the
-    /// compressed wide layout's traversal uses it too).
+    /// never entered. `r` is any state with this struct's idx .. ohiz, tmin and tmax.
     template <class Ray>
     LUCENT_HD static void slab(float lox, float hix, float loy, float hiy, float loz, float hiz,
                                const Ray& r, float& t_near, float& t_far) {
