@@ -64,8 +64,7 @@ void bind_context(py::module_& m) {
                                           "What one device of a multi-device launch ran.")
         .def_readonly("device", &LaunchReport::DeviceShare::device, "'cpu' or 'cuda:0'")
         .def_readonly("indices", &LaunchReport::DeviceShare::indices, "launch indices it ran")
-        .def_readonly("pieces", &LaunchReport::DeviceShare::pieces,
-                      "pieces it took from the queue")
+        .def_readonly("pieces", &LaunchReport::DeviceShare::pieces, "pieces it took from the queue")
         .def_readonly("busy_ms", &LaunchReport::DeviceShare::busy_ms,
                       "from its first piece's start to its last piece's end")
         .def("__repr__", [](const LaunchReport::DeviceShare& d) {
@@ -81,11 +80,10 @@ void bind_context(py::module_& m) {
         .def_readonly("busy_ms", &LaunchReport::RankShare::busy_ms,
                       "its devices' run, from the launch's start on that rank")
         .def("__repr__", [](const LaunchReport::RankShare& r) {
-            return "<lucent.LaunchReport.RankShare: " + std::to_string(r.indices) +
-                   " indices in " + std::to_string(r.pieces) + " pieces>";
+            return "<lucent.LaunchReport.RankShare: " + std::to_string(r.indices) + " indices in " +
+                   std::to_string(r.pieces) + " pieces>";
         });
-    report
-        .def_readonly("compile_ms", &LaunchReport::compile_ms)
+    report.def_readonly("compile_ms", &LaunchReport::compile_ms)
         .def_readonly("accel_ms", &LaunchReport::accel_ms)
         .def_readonly("launch_ms", &LaunchReport::launch_ms)
         .def_readonly("recompiled", &LaunchReport::recompiled)
@@ -105,17 +103,16 @@ void bind_context(py::module_& m) {
                       "Launches spread over ranks: the gather of the other ranks' pieces "
                       "(within launch_ms).")
         .def_property_readonly("exception_count", &LaunchReport::exception_count)
-        .def_property_readonly("exceptions",
-                               [](const LaunchReport& r) {
-                                   py::dict d;
-                                   for (const auto& [code, e] : r.exceptions)
-                                       d[py::str(exception_name(code))] = py::make_tuple(
-                                           e.count, py::make_tuple(e.first_index.x,
-                                                                   e.first_index.y,
-                                                                   e.first_index.z));
-                                   return d;
-                               },
-                               "{name: (count, first launch index)}")
+        .def_property_readonly(
+            "exceptions",
+            [](const LaunchReport& r) {
+                py::dict d;
+                for (const auto& [code, e] : r.exceptions)
+                    d[py::str(exception_name(code))] = py::make_tuple(
+                        e.count, py::make_tuple(e.first_index.x, e.first_index.y, e.first_index.z));
+                return d;
+            },
+            "{name: (count, first launch index)}")
         .def("summary", &LaunchReport::summary)
         .def("__repr__", [](const LaunchReport& r) {
             return "<lucent.LaunchReport: launch " + std::to_string(r.launch_ms) + " ms, " +
@@ -175,7 +172,8 @@ void bind_context(py::module_& m) {
                                                   expects_closest_hit, std::move(roots)});
             },
             py::arg("index"), py::arg("name"), py::arg("payload"),
-            py::arg("expects_closest_hit") = true, py::arg("roots") = std::vector<std::shared_ptr<Node>>{},
+            py::arg("expects_closest_hit") = true,
+            py::arg("roots") = std::vector<std::shared_ptr<Node>>{},
             "Declares ray type `index`; payload: the payload's type name, or a program that "
             "takes it (its miss or closest hit).")
         .def_property_readonly("ray_type_count", &Context::ray_type_count)
@@ -278,7 +276,8 @@ void bind_context(py::module_& m) {
             "Runs entry point `entry` over width (x height (x depth)) launch indices; "
             "returns the LaunchReport.")
         .def_property_readonly("last_launch", &Context::last_launch)
-        .def("__repr__", [](const Context& c) { return "<lucent.Context on " + c.backend_name() + ">"; });
+        .def("__repr__",
+             [](const Context& c) { return "<lucent.Context on " + c.backend_name() + ">"; });
     add_variable_access(ctx);
     m.attr("ALL_EXCEPTIONS") = kAllExceptions;
 }

@@ -21,13 +21,15 @@ std::string failure_text(const py::object& failure) {
         text = py::str(failure).cast<std::string>();
         if (text.empty()) text = py::type::of(failure).attr("__name__").cast<std::string>();
     } else {
-        throw py::type_error("Ranks.agree: failure must be None (this rank did not fail), a str "
-                             "saying what failed, or the exception caught; got " +
-                             py::repr(failure).cast<std::string>());
+        throw py::type_error(
+            "Ranks.agree: failure must be None (this rank did not fail), a str "
+            "saying what failed, or the exception caught; got " +
+            py::repr(failure).cast<std::string>());
     }
     if (text.empty())
-        throw py::value_error("Ranks.agree: failure must say what failed; got an empty string "
-                              "(pass None when this rank did not fail)");
+        throw py::value_error(
+            "Ranks.agree: failure must say what failed; got an empty string "
+            "(pass None when this rank did not fail)");
     return text;
 }
 

@@ -1,8 +1,8 @@
-// The samples from Python, through the Sample classes of samples/sample.h: lucent.render(name, scene=..., size=...,
-// backend=..., **options) renders a sample as `lucent render --sample name` does and returns
-// its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples() lists the
-// samples and their typed options. Options are the CLI's --set values: each keyword becomes
-// "name=value" (True/False become 1/0), checked by the sample's own option declarations.
+// The samples from Python, through the Sample classes of samples/sample.h: lucent.render(name,
+// scene=..., size=..., backend=..., **options) renders a sample as `lucent render --sample name`
+// does and returns its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples()
+// lists the samples and their typed options. Options are the CLI's --set values: each keyword
+// becomes "name=value" (True/False become 1/0), checked by the sample's own option declarations.
 // ranks= spreads the render over MPI ranks as `mpirun lucent render` does (docs/distributed.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -41,12 +41,12 @@ std::optional<float3> camera_point(const py::object& value, const char* name) {
 }
 
 py::object render(const std::string& name, const std::optional<std::string>& scene,
-                  std::pair<unsigned, unsigned> size, const std::string& backend,
-                  unsigned threads, unsigned spp, int jit_check_sm, const py::object& eye,
-                  const py::object& look, const py::object& up, std::optional<float> fov,
-                  std::optional<unsigned> camera, bool denoise, unsigned denoise_passes,
-                  const std::optional<std::vector<std::string>>& aovs,
-                  const py::object& ranks, bool want_report, const py::kwargs& options) {
+                  std::pair<unsigned, unsigned> size, const std::string& backend, unsigned threads,
+                  unsigned spp, int jit_check_sm, const py::object& eye, const py::object& look,
+                  const py::object& up, std::optional<float> fov, std::optional<unsigned> camera,
+                  bool denoise, unsigned denoise_passes,
+                  const std::optional<std::vector<std::string>>& aovs, const py::object& ranks,
+                  bool want_report, const py::kwargs& options) {
     samples::RenderSettings settings;
     settings.width = size.first;
     settings.height = size.second;
@@ -165,10 +165,9 @@ void bind_samples(py::module_& m) {
           py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
           py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
           py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
-          py::arg("fov") = py::none(), py::arg("camera") = py::none(),
-          py::arg("denoise") = false, py::arg("denoise_passes") = 0u,
-          py::arg("aovs") = py::none(), py::arg("ranks") = py::none(),
-          py::arg("report") = false,
+          py::arg("fov") = py::none(), py::arg("camera") = py::none(), py::arg("denoise") = false,
+          py::arg("denoise_passes") = 0u, py::arg("aovs") = py::none(),
+          py::arg("ranks") = py::none(), py::arg("report") = false,
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
           "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
