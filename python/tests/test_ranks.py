@@ -86,3 +86,11 @@ def test_a_failed_render_over_one_rank_is_a_rank_error(world):
         lucent.render("pathtracer", scene="/no-such-scene.obj", size=SIZE, backend="cpu",
                       ranks=world)
     assert caught.value.failed_rank == 0
+
+
+def test_a_buffer_can_be_declared_index_local():
+    ctx = lucent.Context(backend="cpu")
+    accumulation = ctx.create_buffer("input_output", "float4", SIZE)
+    assert accumulation.launch_index_local is False
+    accumulation.launch_index_local = True
+    assert accumulation.launch_index_local is True

@@ -86,6 +86,18 @@ def test_a_context_across_ranks_launches_the_image_of_one_process(world):
     assert np.count_nonzero(spread["image"].numpy()[..., 0] > 0.2) > 100  # the triangle
 
 
+def test_an_index_local_image_is_gathered_when_the_host_reads_it(world):
+    alone = first_program_context(None)
+    alone.launch(0, *SIZE)
+    spread = first_program_context(world)
+    spread["image"].launch_index_local = True
+    for _ in range(4):  # from the third launch on, each rank runs again the rows it took
+        report = spread.launch(0, *SIZE)
+    expect_shares_cover(report, SIZE[0] * SIZE[1], world)
+    # The host read is collective here: every rank makes it and gets the whole image.
+    assert spread["image"].numpy().tobytes() == alone["image"].numpy().tobytes()
+
+
 def test_a_variable_set_on_one_rank_only_is_divergence_on_every_rank(world):
     ctx = first_program_context(world)
     if world.rank == 1:
