@@ -9,7 +9,8 @@
 # the CUDA backend (Lucent_HAS_CUDA in its LucentConfig.cmake) and NVRTC is present, run it
 # again with --jit-check 90 (the GPU megakernel generated and compiled by NVRTC, no GPU
 # needed) and check that the CPU's output did not change. Also checks that a bad argument
-# exits with 2.
+# exits with 2, and, when the package has MPI (Lucent_HAS_MPI) and mpirun is here, that
+# across-ranks under `mpirun -np 3` writes the image of one process.
 #
 # Last, first-program is built again with Lucent as a FetchContent subproject (its
 # find_package answered by the declaration), and must give the same image
@@ -111,6 +112,12 @@ else
   echo "no JIT check: Lucent_HAS_CUDA=$has_cuda, NVRTC found=$nvrtc"
 fi
 
+has_mpi=0  # the package spans MPI ranks and mpirun is here: across-ranks also runs under it
+if [ -n "$config" ] && grep -Eq '^ *set\(Lucent_HAS_MPI +(ON|TRUE|1)\)' "$config" &&
+   command -v mpirun > /dev/null; then
+  has_mpi=1
+fi
+
 generator=()
 if command -v ninja > /dev/null; then generator=(-G Ninja); fi
 
@@ -119,7 +126,7 @@ if command -v ninja > /dev/null; then generator=(-G Ninja); fi
 check_output() {
   local name=$1 log=$2 out=$3 size
   case "$name" in
-    first-program)
+    first-program | across-ranks)
       size=$(png_size "$out") || { fail "$name: $out is not a PNG"; return; }
       [ "$size" = 640x480 ] || fail "$name: $out is $size, expected 640x480"
       local lit
@@ -184,6 +191,18 @@ for dir in "$root"/examples/*/; do
     check_output "$name" "$log" "$out"
   else
     fail "$name --backend cpu (log: $log)"
+  fi
+
+  # across-ranks under mpirun (a package with MPI): three ranks give the image of one.
+  if [ "$name" = across-ranks ] && [ "$has_mpi" = 1 ]; then
+    mpi_out=$work/out/$name-3-ranks.$ext
+    if run "$name-mpirun" mpirun --allow-run-as-root --oversubscribe -np 3 "$bin" \
+         --backend cpu --out "$mpi_out"; then
+      grep -q "^rank 2: " "$log" || fail "$name under mpirun -np 3: no share of rank 2 printed"
+      cmp -s "$out" "$mpi_out" || fail "$name under mpirun -np 3: its image differs from one process's"
+    else
+      fail "$name under mpirun -np 3 (log: $log)"
+    fi
   fi
 
   "$bin" --backend bogus > /dev/null 2>&1

@@ -6,6 +6,8 @@
   graph, variables, programs of the modules compiled into this extension), and launches.
 - The samples: ``render("igi", scene="cornell", size=(512, 512), vpls=64)`` returns an
   (H, W, 4) float32 image; ``samples()`` lists them with their options.
+- Processes: ``Context(ranks=Ranks.world())`` and ``render(..., ranks=Ranks.world())``
+  spread launches over the ranks of ``mpirun -np N python3 script.py``.
 - Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
   FLIP, as ``lucent compare``).
 
@@ -52,6 +54,8 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     Node,
     NodeWithChildren,
     Program,
+    RankError,
+    Ranks,
     RayHits,
     Selector,
     TextureSampler,

@@ -3,6 +3,8 @@
 
 #include <pybind11/pybind11.h>
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,7 +14,8 @@ namespace lucent::python {
 
 namespace py = pybind11;
 
-void bind_errors(py::module_& m);          // module.cpp: lucent.Error
+void bind_errors(py::module_& m);          // module.cpp: lucent.Error, lucent.RankError
+void bind_ranks(py::module_& m);           // ranks_binding.cpp
 void bind_context(py::module_& m);         // context_binding.cpp
 void bind_buffers(py::module_& m);         // buffer_binding.cpp
 void bind_nodes(py::module_& m);           // nodes_binding.cpp
@@ -20,6 +23,17 @@ void bind_programs(py::module_& m);        // programs_binding.cpp
 void bind_triangle_mesh(py::module_& m);   // mesh_binding.cpp
 void bind_samples(py::module_& m);         // samples_binding.cpp
 void bind_images(py::module_& m);          // images_binding.cpp
+
+/// The class lucent.RankError (module.cpp), for code that tells it from other errors.
+PyObject* rank_error_type();
+
+/// A `ranks=` argument: None (null: this process alone) or a lucent.Ranks; a TypeError
+/// naming `what` otherwise (ranks_binding.cpp).
+std::shared_ptr<Ranks> ranks_argument(const py::object& ranks, const char* what);
+/// Runs `work` (call it without the GIL: it may wait for other ranks); with ranks, a rank's error
+/// becomes every rank's RankError at the agreement that follows, as the CLI's run_agreed does
+/// (ranks_binding.cpp).
+void run_agreed(const std::shared_ptr<Ranks>& ranks, const std::function<void()>& work);
 
 /// "auto", "cpu" or "cuda"; a ValueError naming `what` otherwise.
 BackendKind backend_kind(const std::string& name, const char* what);

@@ -58,8 +58,16 @@ std::unordered_map<const Buffer*, int>& live_views() {
     return views;
 }
 
+/// Brings the host copy up to date: a GPU download, or, for an index-local buffer of a
+/// Context spanning ranks, a gather every rank makes (docs/distributed.md), so the GIL is
+/// released while it may wait.
+void sync_host_copy(const Buffer& buffer) {
+    py::gil_scoped_release release;
+    buffer.sync_from_device();
+}
+
 py::array view_of(const std::shared_ptr<Buffer>& buffer, bool writable) {
-    buffer->sync_from_device();
+    sync_host_copy(*buffer);
     ++live_views()[buffer.get()];
     auto* keep = new std::shared_ptr<Buffer>(buffer);
     py::capsule owner(keep, [](void* p) {
@@ -138,6 +146,13 @@ void bind_buffers(py::module_& m) {
                                "The shape of its numpy views: (depth, height, width) as far "
                                "as it has dimensions, then the element's axes")
         .def("__len__", [](const Buffer& b) { return b.count(); })
+        .def_property("launch_index_local", &Buffer::launch_index_local,
+                      &Buffer::set_launch_index_local,
+                      "True: launches touch element i only at launch index i (an "
+                      "accumulation). A Context spanning ranks then keeps each rank's elements "
+                      "where they were computed until something else reads the buffer; a "
+                      "host read (numpy, map, download) is then collective: every rank makes "
+                      "it (docs/distributed.md). No effect in one process.")
         .def(
             "resize",
             [](Buffer& b, unsigned width, unsigned height, unsigned depth) {
@@ -177,7 +192,7 @@ void bind_buffers(py::module_& m) {
                                           " (resize the buffer first)");
                 }
                 a = py::module_::import("numpy").attr("ascontiguousarray")(a);
-                b.sync_from_device();
+                sync_host_copy(b);
                 std::memcpy(b.raw(), a.data(), size_t(a.nbytes()));
                 b.unmap();
             },

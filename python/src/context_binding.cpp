@@ -45,8 +45,9 @@ std::vector<DeviceSpec> device_list(const py::object& devices) {
 }
 
 ContextOptions context_options(const std::string& backend, unsigned threads, int jit_check_sm,
-                               const py::object& devices) {
+                               const py::object& devices, const py::object& ranks) {
     ContextOptions options;
+    options.ranks = ranks_argument(ranks, "Context: ranks");
     options.backend = backend_kind(backend, "Context: backend");
     options.threads = threads;
     options.jit_check_sm = jit_check_sm;
@@ -57,9 +58,32 @@ ContextOptions context_options(const std::string& backend, unsigned threads, int
 }  // namespace
 
 void bind_context(py::module_& m) {
-    py::class_<LaunchReport>(m, "LaunchReport",
-                             "Exceptions and timings of a launch (milliseconds).")
-        .def_readonly("compile_ms", &LaunchReport::compile_ms)
+    py::class_<LaunchReport> report(m, "LaunchReport",
+                                    "Exceptions and timings of a launch (milliseconds).");
+    py::class_<LaunchReport::DeviceShare>(report, "DeviceShare",
+                                          "What one device of a multi-device launch ran.")
+        .def_readonly("device", &LaunchReport::DeviceShare::device, "'cpu' or 'cuda:0'")
+        .def_readonly("indices", &LaunchReport::DeviceShare::indices, "launch indices it ran")
+        .def_readonly("pieces", &LaunchReport::DeviceShare::pieces, "pieces it took from the queue")
+        .def_readonly("busy_ms", &LaunchReport::DeviceShare::busy_ms,
+                      "from its first piece's start to its last piece's end")
+        .def("__repr__", [](const LaunchReport::DeviceShare& d) {
+            return "<lucent.LaunchReport.DeviceShare " + d.device + ": " +
+                   std::to_string(d.indices) + " indices in " + std::to_string(d.pieces) +
+                   " pieces>";
+        });
+    py::class_<LaunchReport::RankShare>(report, "RankShare",
+                                        "What one rank of a launch spread over ranks ran.")
+        .def_readonly("indices", &LaunchReport::RankShare::indices, "launch indices it ran")
+        .def_readonly("pieces", &LaunchReport::RankShare::pieces,
+                      "pieces it took from the shared counter")
+        .def_readonly("busy_ms", &LaunchReport::RankShare::busy_ms,
+                      "its devices' run, from the launch's start on that rank")
+        .def("__repr__", [](const LaunchReport::RankShare& r) {
+            return "<lucent.LaunchReport.RankShare: " + std::to_string(r.indices) + " indices in " +
+                   std::to_string(r.pieces) + " pieces>";
+        });
+    report.def_readonly("compile_ms", &LaunchReport::compile_ms)
         .def_readonly("accel_ms", &LaunchReport::accel_ms)
         .def_readonly("launch_ms", &LaunchReport::launch_ms)
         .def_readonly("recompiled", &LaunchReport::recompiled)
@@ -69,18 +93,26 @@ void bind_context(py::module_& m) {
         .def_readonly("launch_shape_trial", &LaunchReport::launch_shape_trial)
         .def_readonly("registers_capped", &LaunchReport::registers_capped)
         .def_readonly("exchange_ms", &LaunchReport::exchange_ms)
+        .def_readonly("devices", &LaunchReport::devices,
+                      "Multi-device launches: a DeviceShare per device, in the Context's "
+                      "device order (empty on one device).")
+        .def_readonly("ranks", &LaunchReport::ranks,
+                      "Launches spread over ranks (Context(ranks=...)): a RankShare per rank, "
+                      "in rank order (empty when the launch ran whole on every rank).")
+        .def_readonly("gather_ms", &LaunchReport::gather_ms,
+                      "Launches spread over ranks: the gather of the other ranks' pieces "
+                      "(within launch_ms).")
         .def_property_readonly("exception_count", &LaunchReport::exception_count)
-        .def_property_readonly("exceptions",
-                               [](const LaunchReport& r) {
-                                   py::dict d;
-                                   for (const auto& [code, e] : r.exceptions)
-                                       d[py::str(exception_name(code))] = py::make_tuple(
-                                           e.count, py::make_tuple(e.first_index.x,
-                                                                   e.first_index.y,
-                                                                   e.first_index.z));
-                                   return d;
-                               },
-                               "{name: (count, first launch index)}")
+        .def_property_readonly(
+            "exceptions",
+            [](const LaunchReport& r) {
+                py::dict d;
+                for (const auto& [code, e] : r.exceptions)
+                    d[py::str(exception_name(code))] = py::make_tuple(
+                        e.count, py::make_tuple(e.first_index.x, e.first_index.y, e.first_index.z));
+                return d;
+            },
+            "{name: (count, first launch index)}")
         .def("summary", &LaunchReport::summary)
         .def("__repr__", [](const LaunchReport& r) {
             return "<lucent.LaunchReport: launch " + std::to_string(r.launch_ms) + " ms, " +
@@ -90,17 +122,21 @@ void bind_context(py::module_& m) {
     py::class_<Context, std::shared_ptr<Context>> ctx(
         m, "Context", "Owns the entry points, ray types and objects of a scene, and launches.");
     ctx.def(py::init([](const std::string& backend, unsigned threads, int jit_check_sm,
-                        const py::object& devices) {
-                ContextOptions options = context_options(backend, threads, jit_check_sm, devices);
+                        const py::object& devices, const py::object& ranks) {
+                ContextOptions options =
+                    context_options(backend, threads, jit_check_sm, devices, ranks);
                 py::gil_scoped_release release;  // a CUDA context takes a while to start
                 return std::make_shared<Context>(std::move(options));
             }),
             py::arg("backend") = "auto", py::arg("threads") = 0u, py::arg("jit_check_sm") = 0,
-            py::arg("devices") = py::none(),
+            py::arg("devices") = py::none(), py::arg("ranks") = py::none(),
             "backend: 'auto', 'cpu' or 'cuda'; threads: CPU workers (0: one per core); "
             "jit_check_sm: with the CPU backend, also compile the GPU megakernel for this "
             "compute capability (90: sm_90) at each compile, without a GPU; devices: '0,1', "
-            "'cpu,0', 'all' or a list, to spread launches over several devices.")
+            "'cpu,0', 'all' or a list, to spread launches over several devices; ranks: a "
+            "lucent.Ranks (lucent.Ranks.world() under mpirun) to spread them over the "
+            "processes of an MPI job, each on its own devices (every rank runs the same "
+            "script; docs/distributed.md).")
         .def_property_readonly("backend", &Context::backend_name)
         .def_property_readonly("backend_notice", &Context::backend_notice)
         .def_property_readonly("device_count", &Context::device_count)
@@ -136,7 +172,8 @@ void bind_context(py::module_& m) {
                                                   expects_closest_hit, std::move(roots)});
             },
             py::arg("index"), py::arg("name"), py::arg("payload"),
-            py::arg("expects_closest_hit") = true, py::arg("roots") = std::vector<std::shared_ptr<Node>>{},
+            py::arg("expects_closest_hit") = true,
+            py::arg("roots") = std::vector<std::shared_ptr<Node>>{},
             "Declares ray type `index`; payload: the payload's type name, or a program that "
             "takes it (its miss or closest hit).")
         .def_property_readonly("ray_type_count", &Context::ray_type_count)
@@ -239,7 +276,8 @@ void bind_context(py::module_& m) {
             "Runs entry point `entry` over width (x height (x depth)) launch indices; "
             "returns the LaunchReport.")
         .def_property_readonly("last_launch", &Context::last_launch)
-        .def("__repr__", [](const Context& c) { return "<lucent.Context on " + c.backend_name() + ">"; });
+        .def("__repr__",
+             [](const Context& c) { return "<lucent.Context on " + c.backend_name() + ">"; });
     add_variable_access(ctx);
     m.attr("ALL_EXCEPTIONS") = kAllExceptions;
 }

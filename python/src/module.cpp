@@ -15,16 +15,37 @@ BackendKind backend_kind(const std::string& name, const char* what) {
                           "'");
 }
 
+namespace {
+py::exception<Error>* g_error = nullptr;
+py::exception<RankError>* g_rank_error = nullptr;
+}  // namespace
+
+PyObject* rank_error_type() {
+    return g_rank_error->ptr();
+}
+
 void bind_errors(py::module_& m) {
     // lucent::Error (a wrong call, a failed compile or launch) as lucent.Error, a
     // RuntimeError; its message names the object and the fix.
     // Never freed: a static object's destructor would run after the interpreter is gone.
-    static auto* error = new py::exception<Error>(m, "Error", PyExc_RuntimeError);
+    g_error = new py::exception<Error>(m, "Error", PyExc_RuntimeError);
+    // lucent::RankError (a rank failed, or ranks diverged: docs/distributed.md) as
+    // lucent.RankError, a lucent.Error that every rank raises alike, with failed_rank.
+    g_rank_error = new py::exception<RankError>(m, "RankError", g_error->ptr());
+    g_rank_error->attr("__doc__") =
+        "A rank failed, as every rank of the group learns it at the same point: the message "
+        "names the rank and the cause ('rank 2: ...'); failed_rank is that rank (the lowest "
+        "that failed), or -1 when the ranks diverged (their launches differ).";
+    g_rank_error->attr("failed_rank") = py::none();
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
+        } catch (const RankError& e) {
+            py::object error = py::reinterpret_borrow<py::object>(g_rank_error->ptr())(e.what());
+            error.attr("failed_rank") = e.failed_rank();
+            PyErr_SetObject(g_rank_error->ptr(), error.ptr());
         } catch (const Error& e) {
-            PyErr_SetString(error->ptr(), e.what());
+            PyErr_SetString(g_error->ptr(), e.what());
         }
     });
 }
@@ -46,6 +67,7 @@ PYBIND11_MODULE(_lucent, m) {
     bind_programs(m);
     bind_buffers(m);
     bind_nodes(m);
+    bind_ranks(m);
     bind_context(m);
     bind_triangle_mesh(m);
     bind_samples(m);

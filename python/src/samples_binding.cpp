@@ -1,8 +1,9 @@
-// The samples from Python, through the Sample classes of samples/sample.h: lucent.render(name, scene=..., size=...,
-// backend=..., **options) renders a sample as `lucent render --sample name` does and returns
-// its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples() lists the
-// samples and their typed options. Options are the CLI's --set values: each keyword becomes
-// "name=value" (True/False become 1/0), checked by the sample's own option declarations.
+// The samples from Python, through the Sample classes of samples/sample.h: lucent.render(name,
+// scene=..., size=..., backend=..., **options) renders a sample as `lucent render --sample name`
+// does and returns its linear RGB image as an (H, W, 4) float32 array (alpha 1); lucent.samples()
+// lists the samples and their typed options. Options are the CLI's --set values: each keyword
+// becomes "name=value" (True/False become 1/0), checked by the sample's own option declarations.
+// ranks= spreads the render over MPI ranks as `mpirun lucent render` does (docs/distributed.md).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -40,12 +41,12 @@ std::optional<float3> camera_point(const py::object& value, const char* name) {
 }
 
 py::object render(const std::string& name, const std::optional<std::string>& scene,
-                  std::pair<unsigned, unsigned> size, const std::string& backend,
-                  unsigned threads, unsigned spp, int jit_check_sm, const py::object& eye,
-                  const py::object& look, const py::object& up, std::optional<float> fov,
-                  std::optional<unsigned> camera, bool denoise, unsigned denoise_passes,
-                  const std::optional<std::vector<std::string>>& aovs,
-                  const py::kwargs& options) {
+                  std::pair<unsigned, unsigned> size, const std::string& backend, unsigned threads,
+                  unsigned spp, int jit_check_sm, const py::object& eye, const py::object& look,
+                  const py::object& up, std::optional<float> fov, std::optional<unsigned> camera,
+                  bool denoise, unsigned denoise_passes,
+                  const std::optional<std::vector<std::string>>& aovs, const py::object& ranks,
+                  bool want_report, const py::kwargs& options) {
     samples::RenderSettings settings;
     settings.width = size.first;
     settings.height = size.second;
@@ -71,6 +72,7 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
         throw py::value_error("render: denoise_passes must be 0..10; got " +
                               std::to_string(denoise_passes));
     if (denoise_passes) settings.denoise_options.iterations = denoise_passes;
+    settings.ranks = ranks_argument(ranks, "render: ranks");
     samples::RenderResult result;
     try {
         const samples::Sample& sample = samples::find_sample(name);
@@ -81,7 +83,9 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
         }
         samples::check_aov_support(sample, settings);
         py::gil_scoped_release release;
-        result = sample.render(settings);
+        // Under ranks, a rank that fails (a scene file missing on one node) tells the others,
+        // which would otherwise wait for it in the next launch; every rank raises RankError.
+        run_agreed(settings.ranks, [&] { result = sample.render(settings); });
     } catch (const samples::SettingsError& e) {
         throw py::value_error(std::string("render: ") + e.what());
     }
@@ -94,7 +98,14 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
         out[4 * i + 2] = image.pixels[i].z;
         out[4 * i + 3] = 1.0f;
     }
-    if (!aovs) return rgba;
+    // report=True: the LaunchReport of the sample's last launch comes last in a tuple.
+    const auto with_report = [&](py::tuple answer) -> py::object {
+        if (!want_report) return answer.size() == 1 ? answer[0] : py::object(answer);
+        py::list items(answer);
+        items.append(py::cast(result.report));
+        return py::tuple(items);
+    };
+    if (!aovs) return with_report(py::make_tuple(rgba));
     // With aovs: alpha is the coverage, and the layers come as {channel: (H, W) array}.
     py::dict layers;
     for (const scene::ExrChannel& c : result.aovs) {
@@ -106,7 +117,7 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
         std::copy(c.values.begin(), c.values.end(), values.mutable_data());
         layers[py::str(c.name)] = values;
     }
-    return py::make_tuple(rgba, layers);
+    return with_report(py::make_tuple(rgba, layers));
 }
 
 const char* kind_name(samples::OptionKind kind) {
@@ -154,9 +165,9 @@ void bind_samples(py::module_& m) {
           py::arg("size") = std::pair<unsigned, unsigned>{512, 512}, py::arg("backend") = "auto",
           py::arg("threads") = 0u, py::arg("spp") = 0u, py::arg("jit_check_sm") = 0,
           py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
-          py::arg("fov") = py::none(), py::arg("camera") = py::none(),
-          py::arg("denoise") = false, py::arg("denoise_passes") = 0u,
-          py::arg("aovs") = py::none(),
+          py::arg("fov") = py::none(), py::arg("camera") = py::none(), py::arg("denoise") = false,
+          py::arg("denoise_passes") = 0u, py::arg("aovs") = py::none(),
+          py::arg("ranks") = py::none(), py::arg("report") = false,
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
           "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
@@ -168,7 +179,12 @@ void bind_samples(py::module_& m) {
           "linear RGB image as an (H, W, 4) float32 array, row 0 at the top, alpha 1; with "
           "aovs=['albedo', 'normal', 'depth', 'position', 'instance'] (any of them, --aov) "
           "returns (image, layers): alpha is the coverage and layers maps each EXR channel "
-          "name ('Albedo.R', 'Nx', 'Z', ...) to an (H, W) float32 array.");
+          "name ('Albedo.R', 'Nx', 'Z', ...) to an (H, W) float32 array. ranks=lucent.Ranks."
+          "world() under mpirun spreads every launch over the ranks (every rank calls render "
+          "alike and gets the whole image, the image of one process; a rank's failure is "
+          "every rank's lucent.RankError; docs/distributed.md). report=True also returns the "
+          "LaunchReport of the sample's last launch, last: (image, report) or (image, "
+          "layers, report).");
     m.def("samples", &list_samples,
           "{name: {'description': ..., 'options': {option: {'kind': 'integer'|'number'|'switch'|'text', "
           "'default': ..., 'help': ..., 'range': (lo, hi) for numbers and integers}}}}");
