@@ -7,6 +7,7 @@
 #include <string>
 
 #include "lucent/ranks.h"
+#include "lucent/run_agreed.h"
 
 namespace lucent::cli {
 
@@ -18,10 +19,5 @@ std::shared_ptr<Ranks> join_ranks();
 /// The launcher's rank of this process from its environment (0 without a launcher), known
 /// before MPI is initialised: errors every rank meets alike are printed by rank 0 alone.
 int launcher_rank();
-
-/// Runs `work` on every rank; a rank's error (a scene file missing on one node) becomes
-/// every rank's RankError "rank R: ..." at the agreement that follows, so no rank waits for
-/// a failed one. Without ranks: runs `work`.
-void run_agreed(const std::shared_ptr<Ranks>& ranks, const std::function<void()>& work);
 
 }  // namespace lucent::cli

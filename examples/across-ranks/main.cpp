@@ -41,21 +41,6 @@ static bool parse_args(int argc, char** argv, lucent::ContextOptions& options, s
     return true;
 }
 
-// Runs `work` on every rank; a rank's error becomes every rank's RankError "rank R: ..." at
-// the agreement that follows, so no rank waits in a launch for one that failed before it.
-template <class Work>
-static void run_agreed(lucent::Ranks& ranks, Work&& work) {
-    try {
-        work();
-    } catch (const lucent::RankError&) {
-        throw;  // every rank has it already
-    } catch (const std::exception& e) {
-        const std::string failure = e.what();
-        ranks.agree(&failure);
-    }
-    ranks.agree();
-}
-
 int main(int argc, char** argv) {
     lucent::ContextOptions options;
     std::string out = "across-ranks.png";
@@ -64,15 +49,15 @@ int main(int argc, char** argv) {
     try {
         options.ranks = lucent::Ranks::world();  // every rank: initialises MPI under mpirun
         rank = options.ranks->rank();
-        lucent::Ranks& ranks = *options.ranks;
+        const std::shared_ptr<lucent::Ranks>& ranks = options.ranks;
 
         // The same host code on every rank: each launch checks that it is (its digest). A
         // rank that fails while building (a file missing on its node) tells the others in
-        // run_agreed instead of leaving them waiting in the launch.
+        // lucent::run_agreed instead of leaving them waiting in the launch.
         const unsigned width = 640, height = 480;
         std::unique_ptr<lucent::Context> ctx;
         std::shared_ptr<lucent::Buffer> image;
-        run_agreed(ranks, [&] {
+        lucent::run_agreed(ranks, [&] {
             ctx = std::make_unique<lucent::Context>(options);
             ctx->set_ray_type<first_program::Payload>(0, "radiance");
             ctx->set_ray_generation_program(
@@ -102,7 +87,7 @@ int main(int argc, char** argv) {
         // whether it could, so all exit alike.
         const float3* pixels = image->data<float3>();
         const lucent::scene::Image png{width, height, {pixels, pixels + width * height}};
-        run_agreed(ranks, [&] {
+        lucent::run_agreed(ranks, [&] {
             if (rank == 0) lucent::scene::write_image(out, png);
         });
         if (rank != 0) return 0;

@@ -8,5 +8,6 @@
 #include "lucent/module.h"
 #include "lucent/nodes.h"
 #include "lucent/program.h"
+#include "lucent/run_agreed.h"
 #include "lucent/variables.h"
 #include "lucent/version.h"

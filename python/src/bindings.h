@@ -30,10 +30,6 @@ PyObject* rank_error_type();
 /// A `ranks=` argument: None (null: this process alone) or a lucent.Ranks; a TypeError
 /// naming `what` otherwise (ranks_binding.cpp).
 std::shared_ptr<Ranks> ranks_argument(const py::object& ranks, const char* what);
-/// Runs `work` (call it without the GIL: it may wait for other ranks); with ranks, a rank's error
-/// becomes every rank's RankError at the agreement that follows, as the CLI's run_agreed does
-/// (ranks_binding.cpp).
-void run_agreed(const std::shared_ptr<Ranks>& ranks, const std::function<void()>& work);
 
 /// "auto", "cpu" or "cuda"; a ValueError naming `what` otherwise.
 BackendKind backend_kind(const std::string& name, const char* what);

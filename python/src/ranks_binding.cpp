@@ -70,22 +70,6 @@ std::shared_ptr<Ranks> ranks_argument(const py::object& ranks, const char* what)
     return ranks.cast<std::shared_ptr<Ranks>>();
 }
 
-void run_agreed(const std::shared_ptr<Ranks>& ranks, const std::function<void()>& work) {
-    // As the CLI's run_agreed (apps/cli_ranks.cpp): a rank's error outside a launch (a scene
-    // file missing on one node) reaches every rank at the agreement that follows, so no rank
-    // waits in a launch for a rank that failed before it.
-    if (!ranks) return work();
-    try {
-        work();
-    } catch (const RankError&) {
-        throw;  // already agreed on by every rank
-    } catch (const std::exception& e) {
-        const std::string failure = e.what();
-        ranks->agree(&failure);  // throws the RankError every rank throws
-    }
-    ranks->agree();
-}
-
 void bind_ranks(py::module_& m) {
     py::class_<Ranks, std::shared_ptr<Ranks>>(
         m, "Ranks",
