@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <set>
@@ -419,7 +421,14 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirro
     const auto start = std::chrono::steady_clock::now();
     const Acceleration& accel = acceleration_of(node);
     if (accel.builder() == Builder::kGpuHploc || accel.builder() == Builder::kAuto) {
-        if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
+        if (!m_bvh_builder) {
+            m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
+            if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+                std::fprintf(stderr, "lucent: GPU BVH builder made in %.3f ms\n",
+                             std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - start)
+                                 .count());
+        }
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
                            mirror.bvh.triangle_count == ga.indices.size();
         if (refit) {
