@@ -101,6 +101,7 @@ struct GpuBvhBuilder::Impl {
                scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr;
     CUfunction sah[int(gpu::GpuSahPass::kPassCount)] = {};
     CUevent start = nullptr, stop = nullptr;
+    CUevent phase[2] = {};  // LUCENT_GPU_ACCEL_TIMES: after the big levels, after the small tasks
     // Scratch, grown to the largest mesh seen.
     DeviceBuffer keys, keys_alt, order, order_alt, split_slots, clusters, node_lo, node_hi,
         node_children, node_inner, node_parent, histogram_buffer, counters, arrivals;
@@ -189,12 +190,15 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     for (size_t k = 0; k < std::size(sah_names); ++k) m->sah[k] = fn(sah_names[k]);
     check(d.cuEventCreate(&m->start, CU_EVENT_DEFAULT), "cuEventCreate");
     check(d.cuEventCreate(&m->stop, CU_EVENT_DEFAULT), "cuEventCreate");
+    for (CUevent& e : m->phase) check(d.cuEventCreate(&e, CU_EVENT_DEFAULT), "cuEventCreate");
 }
 
 GpuBvhBuilder::~GpuBvhBuilder() {
     if (const DriverApi* d = driver()) {  // errors while tearing down are not actionable
         if (m->start) d->cuEventDestroy(m->start);
         if (m->stop) d->cuEventDestroy(m->stop);
+        for (CUevent e : m->phase)
+            if (e) d->cuEventDestroy(e);
         if (m->module) d->cuModuleUnload(m->module);
     }
 }
@@ -369,10 +373,17 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
         "BVH build (SAH): split",     "BVH build (SAH): partition",
         "BVH build (SAH): small tasks", "BVH build (SAH): counts", "BVH build (SAH): layout",
         "BVH build (SAH): triangles"};
+    const auto t0 = std::chrono::steady_clock::now();
+    unsigned levels = 0;
     check(api().cuEventRecord(start, nullptr), "cuEventRecord");
     gpu::gpu_sah_build_passes(
         n, small_limit,
         [&](gpu::GpuSahPass pass, unsigned level) {
+            if (print_times() && pass == gpu::GpuSahPass::kSmall)
+                check(api().cuEventRecord(phase[0], nullptr), "cuEventRecord");
+            if (print_times() && pass == gpu::GpuSahPass::kCount)
+                check(api().cuEventRecord(phase[1], nullptr), "cuEventRecord");
+            if (pass == gpu::GpuSahPass::kBin) levels = level + 1;
             p.level = level;
             void* args[] = {&p};
             const gpu::GpuSahShape shape = gpu::gpu_sah_shape(pass, n, small_limit);
@@ -387,6 +398,17 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
     GpuBvhStats stats;
     stats.builder = "binned SAH (GPU)";
     stats.build_ms = elapsed_ms();
+    if (print_times()) {
+        float big = 0, small_ms = 0;
+        check(api().cuEventElapsedTime(&big, start, phase[0]), "cuEventElapsedTime");
+        check(api().cuEventElapsedTime(&small_ms, phase[0], phase[1]), "cuEventElapsedTime");
+        std::fprintf(stderr,
+                     "lucent: GPU BVH build (binned SAH) of %u triangles: %.3f ms on the host; "
+                     "GPU %.3f ms: boxes and %u levels of big tasks %.3f ms, small tasks (up to "
+                     "%u triangles) %.3f ms, layout %.3f ms\n",
+                     n, ms_since(t0), stats.build_ms, levels, big, small_limit, small_ms,
+                     stats.build_ms - big - small_ms);
+    }
 
     unsigned counters[gpu::kSahCounterCount];
     check(api().cuMemcpyDtoH(counters, counters_ptr, sizeof counters), "GPU BVH build: counters");
@@ -421,15 +443,10 @@ GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<co
                                  GpuTriangleBvhDevice& out, const GpuBvhBuildOptions& options) {
     const auto t0 = std::chrono::steady_clock::now();
     const DeviceTriangles tris = m->upload(positions, indices);
-    const double upload_ms = ms_since(t0);
-    const GpuBvhStats stats = build(tris, out, options);
     if (print_times())
-        std::fprintf(stderr,
-                     "lucent: GPU BVH build of %u triangles: upload %.3f ms, build %.3f ms "
-                     "(GPU %.3f ms, %s)\n",
-                     tris.triangle_count, upload_ms, ms_since(t0) - upload_ms, stats.build_ms,
-                     stats.builder);
-    return stats;
+        std::fprintf(stderr, "lucent: GPU BVH build: upload of %u triangles %.3f ms\n",
+                     tris.triangle_count, ms_since(t0));
+    return build(tris, out, options);
 }
 
 double GpuBvhBuilder::refit(const DeviceTriangles& tris, GpuTriangleBvhDevice& bvh) {

@@ -59,7 +59,7 @@ constexpr unsigned kSahWarp = 32;       // threads of the per-task passes (split
 /// bins) to this.
 constexpr unsigned kSahSmallMax = 256;
 constexpr unsigned kSahSmallMin = kSahBins - 4;
-constexpr unsigned kSahSmallDefault = 128;
+constexpr unsigned kSahSmallDefault = 64;
 /// Pending nodes of a small task: the smaller child is built first, so at most
 /// log2(kSahSmallMax) + 1 wait.
 constexpr unsigned kSahSmallStack = 16;
