@@ -271,25 +271,25 @@ EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
 TEST(GpuSahBuildEmulation, MakesTheHostTree) {
     const Mesh mesh = test_mesh(7, 1500);
     for (int leaf : {1, 4, 8})
-    for (unsigned limit : {gpu::kSahSmallMin, gpu::kSahSmallDefault}) {
-        SCOPED_TRACE("leaf size " + std::to_string(leaf) + ", small tasks of up to " +
-                     std::to_string(limit));
-        cuda::GpuBvhBuildOptions options;
-        options.max_leaf_size = leaf;
-        const EmulatedSahBuild gpu =
-            emulate_gpu_sah_build(mesh.positions, mesh.indices, options, limit);
-        const GpuTriangleBvh host =
-            cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
-        EXPECT_EQ(gpu.fault, 0u);
-        // The same splits: the same nodes, depth and cost (summed in another order).
-        EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
-        EXPECT_EQ(gpu.depth, host.stats.depth);
-        EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
-        expect_complete(gpu.bvh, mesh);
-        if (HasFatalFailure()) return;
-        EXPECT_TRUE(boxes_bound_children(gpu.bvh));
-        expect_brute_force_hits(gpu.bvh, mesh, 11, 3000);
-    }
+        for (unsigned limit : {gpu::kSahSmallMin, gpu::kSahSmallDefault}) {
+            SCOPED_TRACE("leaf size " + std::to_string(leaf) + ", small tasks of up to " +
+                         std::to_string(limit));
+            cuda::GpuBvhBuildOptions options;
+            options.max_leaf_size = leaf;
+            const EmulatedSahBuild gpu =
+                emulate_gpu_sah_build(mesh.positions, mesh.indices, options, limit);
+            const GpuTriangleBvh host =
+                cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
+            EXPECT_EQ(gpu.fault, 0u);
+            // The same splits: the same nodes, depth and cost (summed in another order).
+            EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
+            EXPECT_EQ(gpu.depth, host.stats.depth);
+            EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+            expect_complete(gpu.bvh, mesh);
+            if (HasFatalFailure()) return;
+            EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+            expect_brute_force_hits(gpu.bvh, mesh, 11, 3000);
+        }
 }
 
 TEST(GpuSahBuildEmulation, SmallUnindexedAndDegenerateMeshes) {

@@ -182,10 +182,9 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     m->scatter = fn("lucent_radix_scatter");
     m->refit_triangles = fn("lucent_refit_triangles");
     m->refit_nodes = fn("lucent_refit_nodes");
-    const char* sah_names[] = {"lucent_sah_reset",     "lucent_sah_init",  "lucent_sah_bin",
-                               "lucent_sah_split",     "lucent_sah_partition",
-                               "lucent_sah_small",     "lucent_sah_count", "lucent_sah_emit",
-                               "lucent_sah_triangles"};
+    const char* sah_names[] = {"lucent_sah_reset", "lucent_sah_init",      "lucent_sah_bin",
+                               "lucent_sah_split", "lucent_sah_partition", "lucent_sah_small",
+                               "lucent_sah_count", "lucent_sah_emit",      "lucent_sah_triangles"};
     static_assert(std::size(sah_names) == size_t(gpu::GpuSahPass::kPassCount));
     for (size_t k = 0; k < std::size(sah_names); ++k) m->sah[k] = fn(sah_names[k]);
     check(d.cuEventCreate(&m->start, CU_EVENT_DEFAULT), "cuEventCreate");
@@ -327,6 +326,7 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
                                            const GpuBvhBuildOptions& options) {
     const unsigned n = tris.triangle_count;
     const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
+    const auto reserved = std::chrono::steady_clock::now();
     const unsigned small_limit = sah_small_limit();
     const gpu::GpuSahScratch scratch = gpu::gpu_sah_scratch(n, small_limit);
     reserve_layout(out, n);
@@ -366,13 +366,15 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
     };
     reserve(sah_scratch, carve(0));
     carve(sah_scratch.ptr());
+    if (print_times())
+        std::fprintf(stderr, "lucent: GPU BVH build: device memory (scratch, layout) %.3f ms\n",
+                     ms_since(reserved));
     const CUdeviceptr counters_ptr = reinterpret_cast<uintptr_t>(p.counters);
 
     static const char* const kPassNames[] = {
-        "BVH build (SAH): reset",     "BVH build (SAH): boxes",  "BVH build (SAH): bins",
-        "BVH build (SAH): split",     "BVH build (SAH): partition",
-        "BVH build (SAH): small tasks", "BVH build (SAH): counts", "BVH build (SAH): layout",
-        "BVH build (SAH): triangles"};
+        "BVH build (SAH): reset",  "BVH build (SAH): boxes",     "BVH build (SAH): bins",
+        "BVH build (SAH): split",  "BVH build (SAH): partition", "BVH build (SAH): small tasks",
+        "BVH build (SAH): counts", "BVH build (SAH): layout",    "BVH build (SAH): triangles"};
     const auto t0 = std::chrono::steady_clock::now();
     unsigned levels = 0;
     check(api().cuEventRecord(start, nullptr), "cuEventRecord");

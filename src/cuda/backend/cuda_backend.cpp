@@ -551,8 +551,9 @@ class CudaBackend final : public core::Backend {
     KernelCode* m_code = nullptr;                 // its variant in this launch's shape
     int m_grid = 1;                               // and that shape's grid
     std::future<std::vector<CompileResult>> m_capped;  // capped variants being compiled
-    std::future<std::unique_ptr<GpuBvhBuilder>> m_bvh_builder_on_the_way;  // until a GpuScene takes it
     std::vector<size_t> m_capped_kernels;              // the kernels they are of
+    // The GPU BVH builder being made on another thread, until a GpuScene takes it.
+    std::future<std::unique_ptr<GpuBvhBuilder>> m_bvh_builder_on_the_way;
     int m_largest_grid = 1;                       // of every kernel's shapes
     CUfunction m_gather = nullptr;
     std::string m_device_name, m_source;

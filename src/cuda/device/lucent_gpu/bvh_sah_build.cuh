@@ -122,7 +122,7 @@ struct GpuSahBuildParams {
     unsigned small_limit;  // tasks of up to this many triangles are small
     unsigned task_capacity, small_capacity;  // of tasks[k] and small
     // scratch, N = triangle_count
-    float4* prim_lo;          // N triangle boxes
+    float4* prim_lo;  // N triangle boxes
     float4* prim_hi;
     unsigned* work[2];        // N: the triangle at each place of the leaf order, by level parity
     unsigned* place_task[2];  // N: the big task of each place, kSahInvalid when it has none
@@ -130,9 +130,9 @@ struct GpuSahBuildParams {
     GpuSahTask* tasks[2];     // big tasks of even and odd levels
     unsigned* bins[2];        // kSahTaskBinWords per big task, by level parity
     GpuSahSmallTask* small;
-    float4* node_lo;          // 2N - 1 nodes: xyz, w = SAH cost of the subtree
-    float4* node_hi;          // xyz, w unused
-    uint2* node_range;        // inner: (child 0, 0); leaf: (first, count)
+    float4* node_lo;    // 2N - 1 nodes: xyz, w = SAH cost of the subtree
+    float4* node_hi;    // xyz, w unused
+    uint2* node_range;  // inner: (child 0, 0); leaf: (first, count)
     unsigned* node_parent;
     unsigned* node_inner;     // inner nodes of the subtree
     unsigned* node_arrivals;  // children counted so far (the bottom-up pass)
@@ -353,8 +353,8 @@ LUCENT_HD inline SahFrame sah_frame(const int* cbox, unsigned bins) {
 
 /// The host's bin_of: the bin of a triangle (box lo, hi) along axis k.
 LUCENT_HD inline int sah_bin_of(const SahFrame& f, float3 lo, float3 hi, int k) {
-    const int b = (int)((sah_axis(lo, k) + sah_axis(hi, k) - sah_axis(f.clo, k)) *
-                        sah_axis(f.scale, k));
+    const int b =
+        (int)((sah_axis(lo, k) + sah_axis(hi, k) - sah_axis(f.clo, k)) * sah_axis(f.scale, k));
     return b < 0 ? 0 : b > (int)f.bins - 1 ? (int)f.bins - 1 : b;
 }
 
@@ -372,7 +372,7 @@ LUCENT_HD inline void sah_add_to_bins(unsigned* bins, const SahFrame& f, float3 
 LUCENT_HD inline void sah_clear_bins(unsigned* bins, unsigned words, unsigned t, unsigned threads) {
     for (unsigned w = t; w < words; w += threads) {
         const unsigned word = w % kSahBinWords;
-        bins[w] = word == 0 ? 0u
+        bins[w] = word == 0   ? 0u
                   : word <= 3 ? (unsigned)sah_ordered(kSahEmpty)
                               : (unsigned)sah_ordered(-kSahEmpty);
     }
@@ -421,8 +421,7 @@ LUCENT_HD inline SahBest sah_sweep_axis(const unsigned* axis, unsigned nb) {
 
 /// The bins per axis of a node of `count` triangles at `depth` (the host's): none when the
 /// depth guard forces the median split.
-LUCENT_HD inline unsigned sah_bins_for(const GpuSahBuildParams& p, unsigned count,
-                                       unsigned depth) {
+LUCENT_HD inline unsigned sah_bins_for(const GpuSahBuildParams& p, unsigned count, unsigned depth) {
     const unsigned leaves = (count + p.max_leaf_size - 1) / p.max_leaf_size;
     unsigned levels_needed = 0;  // std::bit_width
     for (unsigned v = leaves; v; v >>= 1) ++levels_needed;
@@ -542,7 +541,7 @@ LUCENT_HD inline void sah_init(const GpuSahBuildParams& p, unsigned block, unsig
         const bool big_root = n > p.small_limit;
         p.work[0][i] = i;
         p.place_task[0][i] = big_root ? 0u : kSahInvalid;
-        p.order[i] = i;      // a small root reads its triangles from here
+        p.order[i] = i;          // a small root reads its triangles from here
         p.node_arrivals[i] = 0;  // 2N - 1 nodes: two each (the bottom-up pass counts on them)
         if (n + i < 2 * n - 1) p.node_arrivals[n + i] = 0;
         if (!big_root) return;
@@ -567,8 +566,8 @@ struct SahBinShared {
 };
 
 /// The task the block holds most of, about: the one of its middle place, if it bins.
-LUCENT_HD inline unsigned sah_main_task(const GpuSahBuildParams& p, unsigned parity,
-                                        unsigned block, unsigned threads) {
+LUCENT_HD inline unsigned sah_main_task(const GpuSahBuildParams& p, unsigned parity, unsigned block,
+                                        unsigned threads) {
     unsigned middle = block * threads + threads / 2;
     if (middle >= p.triangle_count) middle = p.triangle_count - 1;
     return p.place_task[parity][middle];
@@ -594,7 +593,8 @@ LUCENT_HD inline void sah_bin(const GpuSahBuildParams& p, unsigned block, unsign
     if (s.tasks == 0) return;  // an empty level: the build has no more big tasks
     const unsigned main = s.main;
     const unsigned words = main == kSahInvalid ? 0u : 3 * s.frame.bins * kSahBinWords;
-    if (words > 0) sah_step(threads, [&](unsigned t) { sah_clear_bins(s.bins, words, t, threads); });
+    if (words > 0)
+        sah_step(threads, [&](unsigned t) { sah_clear_bins(s.bins, words, t, threads); });
     sah_step(threads, [&](unsigned t) {
         const unsigned i = block * threads + t;
         if (i >= p.triangle_count) return;
@@ -637,8 +637,8 @@ struct SahSplitShared {
 /// Makes a child of `count` triangles over [begin, ...): kSahInvalid for one triangle (a
 /// leaf at once), a small task, or a big task of the next level (its bins cleared by the
 /// caller).
-LUCENT_HD inline unsigned sah_make_child(const GpuSahBuildParams& p, unsigned node,
-                                         unsigned begin, unsigned count, unsigned depth) {
+LUCENT_HD inline unsigned sah_make_child(const GpuSahBuildParams& p, unsigned node, unsigned begin,
+                                         unsigned count, unsigned depth) {
     p.node_range[node] = make_uint2(begin, count);  // a leaf unless it is split
     if (count <= 1) return kSahInvalid;
     if (count <= p.small_limit) {
@@ -732,11 +732,11 @@ LUCENT_HD inline void sah_split(const GpuSahBuildParams& p, unsigned block, unsi
 
 struct SahPartitionShared {
     unsigned tasks;
-    unsigned main;                    // the task whose places the block hands out
+    unsigned main;  // the task whose places the block hands out
     SahFrame frame;
-    unsigned count[2], base[2];       // its triangles of this block going to each side
-    int box[2][6], cbox[2][6];        // and their boxes, for big children
-    unsigned slot[kSahBlock];         // each thread's place among its side's, or kSahInvalid
+    unsigned count[2], base[2];  // its triangles of this block going to each side
+    int box[2][6], cbox[2][6];   // and their boxes, for big children
+    unsigned slot[kSahBlock];    // each thread's place among its side's, or kSahInvalid
     unsigned char side[kSahBlock];
 };
 
@@ -804,16 +804,15 @@ LUCENT_HD inline void sah_partition(const GpuSahBuildParams& p, unsigned block, 
             return;
         }
         if (task.decision == kSahDecideMedian) {  // the front half to child 0, in place
-            sah_place(p, task, i - task.begin < task.left_count ? 0u : 1u, i, prim, lo, hi,
-                      false);
+            sah_place(p, task, i - task.begin < task.left_count ? 0u : 1u, i, prim, lo, hi, false);
             return;
         }
-        const unsigned side = ti == s.main ? sah_side(s.frame, task.decision, lo, hi)
-                                           : sah_side(sah_frame(task.cbox, task.bin_count),
-                                                      task.decision, lo, hi);
+        const unsigned side =
+            ti == s.main ? sah_side(s.frame, task.decision, lo, hi)
+                         : sah_side(sah_frame(task.cbox, task.bin_count), task.decision, lo, hi);
         if (ti != s.main) {
-            const unsigned at = task.begin + side * task.left_count +
-                                sah_atomic_add(&task.sent[side], 1u);
+            const unsigned at =
+                task.begin + side * task.left_count + sah_atomic_add(&task.sent[side], 1u);
             sah_place(p, task, side, at, prim, lo, hi, false);
             return;
         }
@@ -854,20 +853,20 @@ LUCENT_HD inline void sah_partition(const GpuSahBuildParams& p, unsigned block, 
 // ---- 5: small tasks, a warp each ------------------------------------------------------------
 
 struct SahSmallShared {
-    unsigned have;                       // a task was taken
-    GpuSahSmallTask task;                // the small task (its node is the subtree's root)
+    unsigned have;                          // a task was taken
+    GpuSahSmallTask task;                   // the small task (its node is the subtree's root)
     GpuSahSmallTask stack[kSahSmallStack];  // pending nodes, begin relative to the task's
     unsigned stack_size;
-    GpuSahSmallTask node;                // the node being built, begin relative
+    GpuSahSmallTask node;  // the node being built, begin relative
     unsigned active;
     int box[6], cbox[6];
     SahFrame frame;
     SahBest best[3];
     SahDecision decision;
     unsigned child_node, fill[2];
-    unsigned prim[kSahSmallMax];         // the task's triangles, by local index
+    unsigned prim[kSahSmallMax];  // the task's triangles, by local index
     float3 lo[kSahSmallMax], hi[kSahSmallMax];
-    unsigned short ids[kSahSmallMax];    // local indices in leaf order
+    unsigned short ids[kSahSmallMax];  // local indices in leaf order
     unsigned short ids_next[kSahSmallMax];
     unsigned bins[kSahTaskBinWords];
 };
@@ -899,7 +898,8 @@ LUCENT_HD inline void sah_small_node(const GpuSahBuildParams& p, unsigned thread
     });
     const unsigned nb = s.frame.bins;
     if (nb > 0) {
-        sah_step(threads, [&](unsigned t) { sah_clear_bins(s.bins, 3 * nb * kSahBinWords, t, threads); });
+        sah_step(threads,
+                 [&](unsigned t) { sah_clear_bins(s.bins, 3 * nb * kSahBinWords, t, threads); });
         sah_step(threads, [&](unsigned t) {
             for (unsigned j = t; j < n; j += threads) {
                 const unsigned k = s.ids[begin + j];
@@ -936,8 +936,8 @@ LUCENT_HD inline void sah_small_node(const GpuSahBuildParams& p, unsigned thread
         const GpuSahSmallTask child[2] = {{c0, begin, left, s.node.depth + 1},
                                           {c0 + 1, begin + left, n - left, s.node.depth + 1}};
         for (int side = 0; side < 2; ++side)
-            p.node_range[child[side].node] = make_uint2(s.task.begin + child[side].begin,
-                                                        child[side].count);
+            p.node_range[child[side].node] =
+                make_uint2(s.task.begin + child[side].begin, child[side].count);
         // The larger child waits, the smaller is built next: the stack stays short.
         const int first = child[0].count >= child[1].count ? 0 : 1;
         for (int q = 0; q < 2; ++q) {
@@ -1146,7 +1146,16 @@ LUCENT_HD inline void sah_triangles(const GpuSahBuildParams& p, unsigned at) {
 #if !LUCENT_GPU_CODE
 /// The kernels in launch order, for the GPU launcher and the CPU emulation alike.
 enum class GpuSahPass {
-    kReset, kInit, kBin, kSplit, kPartition, kSmall, kCount, kEmit, kTriangles, kPassCount
+    kReset,
+    kInit,
+    kBin,
+    kSplit,
+    kPartition,
+    kSmall,
+    kCount,
+    kEmit,
+    kTriangles,
+    kPassCount
 };
 
 /// Blocks and threads of each pass.
@@ -1159,16 +1168,21 @@ inline GpuSahShape gpu_sah_shape(GpuSahPass pass, unsigned n, unsigned small_lim
         return GpuSahShape{unsigned((items + threads - 1) / threads), threads};
     };
     switch (pass) {
-        case GpuSahPass::kReset: return GpuSahShape{1, kSahWarp};
-        case GpuSahPass::kSplit: return GpuSahShape{gpu_sah_task_capacity(n, small_limit), kSahWarp};
+        case GpuSahPass::kReset:
+            return GpuSahShape{1, kSahWarp};
+        case GpuSahPass::kSplit:
+            return GpuSahShape{gpu_sah_task_capacity(n, small_limit), kSahWarp};
         case GpuSahPass::kSmall: {
             const unsigned tasks = gpu_sah_small_capacity(n);
             return GpuSahShape{tasks < kSahSmallBlocks ? tasks : kSahSmallBlocks, kSahWarp};
         }
         case GpuSahPass::kCount:
-        case GpuSahPass::kEmit: return over(2 * size_t(n) - 1, 128);
-        case GpuSahPass::kTriangles: return over(n, 128);
-        default: return over(n, kSahBlock);  // init, bin, partition: a thread per place
+        case GpuSahPass::kEmit:
+            return over(2 * size_t(n) - 1, 128);
+        case GpuSahPass::kTriangles:
+            return over(n, 128);
+        default:
+            return over(n, kSahBlock);  // init, bin, partition: a thread per place
     }
 }
 
@@ -1257,7 +1271,8 @@ inline void gpu_sah_run_on_cpu(GpuSahBuildParams& p, GpuSahPass pass, unsigned l
             case GpuSahPass::kTriangles:
                 for (unsigned t = 0; t < shape.threads; ++t) sah_triangles(p, first + t);
                 break;
-            case GpuSahPass::kPassCount: break;
+            case GpuSahPass::kPassCount:
+                break;
         }
     }
 }
@@ -1267,23 +1282,22 @@ inline void gpu_sah_run_on_cpu(GpuSahBuildParams& p, GpuSahPass pass, unsigned l
 
 #if LUCENT_GPU_CODE
 // The entry points the host launches (extern "C": unmangled names for cuModuleGetFunction).
-#define LUCENT_SAH_THREAD_KERNEL(name, body, threads)                              \
-    extern "C" __global__ void __launch_bounds__(threads)                          \
-        name(lucent::gpu::GpuSahBuildParams p) {                                   \
-        lucent::gpu::body(p, blockIdx.x * blockDim.x + threadIdx.x);               \
+#define LUCENT_SAH_THREAD_KERNEL(name, body, threads)                                              \
+    extern "C" __global__ void __launch_bounds__(threads) name(lucent::gpu::GpuSahBuildParams p) { \
+        lucent::gpu::body(p, blockIdx.x* blockDim.x + threadIdx.x);                                \
     }
-#define LUCENT_SAH_BLOCK_KERNEL(name, body, shared, threads)                       \
-    extern "C" __global__ void __launch_bounds__(threads)                          \
-        name(lucent::gpu::GpuSahBuildParams p) {                                   \
-        __shared__ lucent::gpu::shared s;                                          \
-        lucent::gpu::body(p, blockIdx.x, blockDim.x, s);                           \
+#define LUCENT_SAH_BLOCK_KERNEL(name, body, shared, threads)                                       \
+    extern "C" __global__ void __launch_bounds__(threads) name(lucent::gpu::GpuSahBuildParams p) { \
+        __shared__ lucent::gpu::shared s;                                                          \
+        lucent::gpu::body(p, blockIdx.x, blockDim.x, s);                                           \
     }
 LUCENT_SAH_THREAD_KERNEL(lucent_sah_reset, sah_reset, 32)
 LUCENT_SAH_BLOCK_KERNEL(lucent_sah_init, sah_init, SahInitShared, 256)
 LUCENT_SAH_BLOCK_KERNEL(lucent_sah_bin, sah_bin, SahBinShared, 256)
 LUCENT_SAH_BLOCK_KERNEL(lucent_sah_split, sah_split, SahSplitShared, 32)
 LUCENT_SAH_BLOCK_KERNEL(lucent_sah_partition, sah_partition, SahPartitionShared, 256)
-extern "C" __global__ void __launch_bounds__(32) lucent_sah_small(lucent::gpu::GpuSahBuildParams p) {
+extern "C" __global__ void __launch_bounds__(32)
+    lucent_sah_small(lucent::gpu::GpuSahBuildParams p) {
     __shared__ lucent::gpu::SahSmallShared s;
     lucent::gpu::sah_small(p, blockDim.x, s);
 }
