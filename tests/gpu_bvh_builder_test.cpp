@@ -158,24 +158,26 @@ struct EmulatedSahBuild {
     double sah_cost = 0;
     unsigned depth = 0;
     unsigned fault = 0;
+    unsigned big_levels = 0;   // levels with big tasks
+    unsigned small_tasks = 0;  // subtrees built by one warp each
 };
 
 Mesh chain_mesh(int count);
 
 EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
                                        std::span<const uint3> indices,
-                                       const cuda::GpuBvhBuildOptions& options = {}) {
+                                       const cuda::GpuBvhBuildOptions& options = {},
+                                       unsigned small_limit = gpu::kSahSmallDefault) {
     const unsigned n = unsigned(indices.empty() ? positions.size() / 3 : indices.size());
     const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
+    const gpu::GpuSahScratch scratch = gpu::gpu_sah_scratch(n, small_limit);
     std::vector<float4> prim_lo(n), prim_hi(n), node_lo(nodes), node_hi(nodes);
-    std::vector<unsigned> prim_task(n), order(n), node_parent(nodes), node_inner(nodes),
-        node_arrivals(nodes), counters(gpu::kSahCounterCount);
+    std::vector<unsigned> order(n), node_parent(nodes), node_inner(nodes), node_arrivals(nodes),
+        counters(gpu::kSahCounterCount);
     std::vector<uint2> node_range(nodes);
-    std::vector<gpu::GpuSahTask> tasks[2] = {std::vector<gpu::GpuSahTask>(n / 2 + 1),
-                                             std::vector<gpu::GpuSahTask>(n / 2 + 1)};
-    const size_t pool_words = gpu::gpu_sah_pool_words(n);
-    std::vector<unsigned> pool[2] = {std::vector<unsigned>(pool_words),
-                                     std::vector<unsigned>(pool_words)};
+    std::vector<unsigned> work[2], place_task[2], bins[2];
+    std::vector<gpu::GpuSahTask> tasks[2];
+    std::vector<gpu::GpuSahSmallTask> small(scratch.small_capacity);
     EmulatedSahBuild out;
     out.bvh.nodes.resize(gpu::kGpuNodeFloat4s * out_nodes);
     out.bvh.triangles.resize(gpu::kGpuTriangleFloat4s * size_t(n));
@@ -190,19 +192,28 @@ EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
     p.max_leaf_size = unsigned(options.max_leaf_size);
     p.traversal_cost = options.traversal_cost;
     p.intersection_cost = options.intersection_cost;
-    p.pool_words = unsigned(pool_words);
-    p.prim_lo = prim_lo.data(), p.prim_hi = prim_hi.data();
-    p.prim_task = prim_task.data(), p.order = order.data();
-    for (int k = 0; k < 2; ++k) p.tasks[k] = tasks[k].data(), p.pool[k] = pool[k].data();
+    p.small_limit = small_limit;
+    p.task_capacity = unsigned(scratch.task_capacity);
+    p.small_capacity = unsigned(scratch.small_capacity);
+    p.prim_lo = prim_lo.data(), p.prim_hi = prim_hi.data(), p.order = order.data();
+    for (int k = 0; k < 2; ++k) {
+        work[k].resize(n), place_task[k].resize(n), bins[k].resize(scratch.bin_words);
+        tasks[k].resize(scratch.task_capacity);
+        p.work[k] = work[k].data(), p.place_task[k] = place_task[k].data();
+        p.tasks[k] = tasks[k].data(), p.bins[k] = bins[k].data();
+    }
+    p.small = small.data();
     p.node_lo = node_lo.data(), p.node_hi = node_hi.data(), p.node_range = node_range.data();
     p.node_parent = node_parent.data(), p.node_inner = node_inner.data();
     p.node_arrivals = node_arrivals.data(), p.counters = counters.data();
     p.out_nodes = out.bvh.nodes.data(), p.out_triangles = out.bvh.triangles.data();
     p.out_triangle_ids = out.bvh.triangle_ids.data(), p.out_parents = out.bvh.parents.data();
     gpu::gpu_sah_build_passes(
-        n,
-        [&](gpu::GpuSahPass pass, unsigned threads, unsigned level) {
-            gpu::gpu_sah_run_on_cpu(p, pass, threads, level);
+        n, small_limit,
+        [&](gpu::GpuSahPass pass, unsigned level) {
+            if (pass == gpu::GpuSahPass::kBin && counters[gpu::kSahTaskCount + (level & 1u)] > 0)
+                out.big_levels = level + 1;
+            gpu::gpu_sah_run_on_cpu(p, pass, level);
         },
         [&](unsigned parity) { return counters[gpu::kSahTaskCount + parity]; });
     out.bvh.nodes.resize(gpu::kGpuNodeFloat4s * counters[gpu::kSahInner]);
@@ -210,6 +221,7 @@ EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
     out.sah_cost = std::bit_cast<float>(counters[gpu::kSahCost]);
     out.depth = counters[gpu::kSahDepth];
     out.fault = counters[gpu::kSahFault];
+    out.small_tasks = counters[gpu::kSahSmallCount];
     return out;
 }
 
@@ -258,23 +270,26 @@ EmulatedSahBuild emulate_gpu_sah_build(std::span<const float3> positions,
 // The emulation runs without a GPU: these hold in every build with the CUDA backend.
 TEST(GpuSahBuildEmulation, MakesTheHostTree) {
     const Mesh mesh = test_mesh(7, 1500);
-    for (int leaf : {1, 4, 8}) {
-        SCOPED_TRACE("leaf size " + std::to_string(leaf));
-        cuda::GpuBvhBuildOptions options;
-        options.max_leaf_size = leaf;
-        const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices, options);
-        const GpuTriangleBvh host =
-            cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
-        EXPECT_EQ(gpu.fault, 0u);
-        // The same splits: the same nodes, depth and cost (summed in another order).
-        EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
-        EXPECT_EQ(gpu.depth, host.stats.depth);
-        EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
-        expect_complete(gpu.bvh, mesh);
-        if (HasFatalFailure()) return;
-        EXPECT_TRUE(boxes_bound_children(gpu.bvh));
-        expect_brute_force_hits(gpu.bvh, mesh, 11, 3000);
-    }
+    for (int leaf : {1, 4, 8})
+        for (unsigned limit : {gpu::kSahSmallMin, gpu::kSahSmallDefault}) {
+            SCOPED_TRACE("leaf size " + std::to_string(leaf) + ", small tasks of up to " +
+                         std::to_string(limit));
+            cuda::GpuBvhBuildOptions options;
+            options.max_leaf_size = leaf;
+            const EmulatedSahBuild gpu =
+                emulate_gpu_sah_build(mesh.positions, mesh.indices, options, limit);
+            const GpuTriangleBvh host =
+                cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
+            EXPECT_EQ(gpu.fault, 0u);
+            // The same splits: the same nodes, depth and cost (summed in another order).
+            EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
+            EXPECT_EQ(gpu.depth, host.stats.depth);
+            EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+            expect_complete(gpu.bvh, mesh);
+            if (HasFatalFailure()) return;
+            EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+            expect_brute_force_hits(gpu.bvh, mesh, 11, 3000);
+        }
 }
 
 TEST(GpuSahBuildEmulation, SmallUnindexedAndDegenerateMeshes) {
@@ -312,17 +327,32 @@ TEST(GpuSahBuildEmulation, ChainStaysWithinTheStack) {
     expect_complete(gpu.bvh, mesh);
 }
 
-TEST(GpuSahBuildEmulation, SponzaIsTheHostTree) {
-    const std::string file = std::string(LUCENT_SCENES_DIR) + "/sponza.obj";
-    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
-    const scene::ObjMesh mesh = scene::load_obj_mesh(file);
-    const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices);
-    const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
-    EXPECT_EQ(gpu.fault, 0u);
-    EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
-    EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
-    ASSERT_TRUE(is_tree(gpu.bvh));
-    EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+// Every small-task limit makes the same tree: from 28 (mostly big tasks, levels of blocks
+// staging bins and places in shared memory) to 256 (mostly warps building subtrees).
+TEST(GpuSahBuildEmulation, ScenesAreTheHostTreeForEverySmallTaskLimit) {
+    for (const char* name : {"sponza", "sibenik", "bunny", "dragon"}) {
+        const std::string file = std::string(LUCENT_SCENES_DIR) + "/" + name + ".obj";
+        if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
+        const scene::ObjMesh mesh = scene::load_obj_mesh(file);
+        const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+        for (unsigned limit : {gpu::kSahSmallMin, gpu::kSahSmallDefault, gpu::kSahSmallMax}) {
+            SCOPED_TRACE(std::string(name) + ", small tasks of up to " + std::to_string(limit));
+            const EmulatedSahBuild gpu =
+                emulate_gpu_sah_build(mesh.positions, mesh.indices, {}, limit);
+            EXPECT_EQ(gpu.fault, 0u);
+            EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
+            EXPECT_EQ(gpu.depth, host.stats.depth);
+            EXPECT_NEAR(gpu.sah_cost, host.stats.sah_cost, 1e-4 * host.stats.sah_cost);
+            EXPECT_GT(gpu.small_tasks, mesh.indices.size() / (2 * limit));
+            // The levels launched before the first read of the task count cover most of the
+            // big levels (within the 4 launched between reads).
+            EXPECT_GE(gpu::gpu_sah_unread_levels(unsigned(mesh.indices.size()), limit) + 4,
+                      gpu.big_levels);
+        }
+        const EmulatedSahBuild gpu = emulate_gpu_sah_build(mesh.positions, mesh.indices);
+        ASSERT_TRUE(is_tree(gpu.bvh));
+        EXPECT_TRUE(boxes_bound_children(gpu.bvh));
+    }
 }
 
 TEST_F(GpuBvhBuilderTest, LayoutFindsWhatBruteForceFinds) {

@@ -267,6 +267,11 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         ga.vertices.clear();
         ga.indices.clear();
         ga.tri_instance.clear();
+        ga.indices.reserve(total);
+        ga.tri_instance.reserve(total);
+        // Without a host build, the bounds come from this pass (the triangles' vertices, while
+        // they are in cache): the GPU build needs nothing else of the host.
+        Aabb bounds = empty_box();
         for (unsigned k = 0; k < node.instances.size(); ++k) {
             const CompiledInstance& inst = m_scene->instances[node.instances[k]];
             const GeometryTriangles* tris = triangles_of(inst);
@@ -275,15 +280,15 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
             ga.vertices.insert(ga.vertices.end(), v, v + tris->vertices()->count());
             for (unsigned p = 0; p < inst.primitive_count; ++p) {
                 uint3 t = triangle_of(inst, p);
+                if (!host_triangles)
+                    for (unsigned i : {t.x, t.y, t.z}) grow(bounds, v[i]);
                 ga.indices.push_back(uint3{t.x + base, t.y + base, t.z + base});
                 ga.tri_instance.push_back(k);
             }
         }
         if (!host_triangles) {
             ga.triangles = accel::TriangleAccel();
-            ga.bounds = empty_box();
-            for (const uint3 t : ga.indices)
-                for (unsigned v : {t.x, t.y, t.z}) grow(ga.bounds, ga.vertices[v]);
+            ga.bounds = bounds;
         } else {
             accel::BuildOptions options;
             options.spatial_splits = !any_hit;

@@ -1,10 +1,13 @@
 #include "cuda/accel/gpu_bvh_builder.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <string>
+#include <type_traits>
 
 #include "cuda/device/lucent_gpu/bvh_build.cuh"
 #include "cuda/device/lucent_gpu/bvh_refit.cuh"
@@ -31,8 +34,62 @@ T* device_ptr(const DeviceBuffer& b) {
     return const_cast<T*>(b.as<T>());
 }
 
+/// LUCENT_GPU_ACCEL_TIMES=1: the builder prints where a build's time goes (module, uploads,
+/// launches, the GPU's own time), to stderr.
+bool print_times() {
+    static const bool on = [] {
+        const char* v = std::getenv("LUCENT_GPU_ACCEL_TIMES");
+        return v && *v && std::strcmp(v, "0") != 0;
+    }();
+    return on;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 unsigned blocks_for(size_t count, unsigned block) {
     return unsigned((count + block - 1) / block);
+}
+
+/// Room for the layout of a tree over n >= 1 triangles (n - 1 inner nodes at most).
+void reserve_layout(GpuTriangleBvhDevice& out, unsigned n) {
+    const size_t out_nodes = n > 1 ? n - 1 : 1;
+    reserve(out.nodes, sizeof(float4) * gpu::kGpuNodeFloat4s * out_nodes);
+    reserve(out.triangles, sizeof(float4) * gpu::kGpuTriangleFloat4s * n);
+    reserve(out.triangle_ids, 4 * size_t(n));
+    reserve(out.parents, 4 * out_nodes);
+}
+
+/// The inputs and outputs both algorithms' parameters have (gpu::GpuBuildParams,
+/// gpu::GpuSahBuildParams).
+template <class Params>
+void set_common_params(Params& p, const DeviceTriangles& tris, const GpuBvhBuildOptions& options,
+                       const GpuTriangleBvhDevice& out) {
+    p.positions = reinterpret_cast<const float3*>(static_cast<uintptr_t>(tris.positions));
+    p.indices = reinterpret_cast<const uint3*>(static_cast<uintptr_t>(tris.indices));
+    p.vertex_count = tris.vertex_count;
+    p.triangle_count = tris.triangle_count;
+    p.max_leaf_size = unsigned(options.max_leaf_size);
+    p.traversal_cost = options.traversal_cost;
+    p.intersection_cost = options.intersection_cost;
+    p.out_nodes = device_ptr<float4>(out.nodes);
+    p.out_triangles = device_ptr<float4>(out.triangles);
+    p.out_triangle_ids = device_ptr<unsigned>(out.triangle_ids);
+    p.out_parents = device_ptr<unsigned>(out.parents);
+}
+
+/// Triangles a small task of the binned-SAH build may hold (LUCENT_GPU_SAH_SMALL, for
+/// experiments; gpu::kSahSmallDefault otherwise).
+unsigned sah_small_limit() {
+    const char* v = std::getenv("LUCENT_GPU_SAH_SMALL");
+    if (!v || !*v) return gpu::kSahSmallDefault;
+    char* end = nullptr;
+    const unsigned long limit = std::strtoul(v, &end, 10);
+    if (*end || limit < gpu::kSahSmallMin || limit > gpu::kSahSmallMax)
+        throw Error(std::string("LUCENT_GPU_SAH_SMALL=") + v + ": expected " +
+                    std::to_string(gpu::kSahSmallMin) + ".." + std::to_string(gpu::kSahSmallMax));
+    return unsigned(limit);
 }
 
 }  // namespace
@@ -42,14 +99,15 @@ struct GpuBvhBuilder::Impl {
     CUfunction reset = nullptr, bounds = nullptr, morton = nullptr, leaves = nullptr,
                hploc = nullptr, emit = nullptr, histogram = nullptr, scan = nullptr,
                scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr;
-    CUfunction sah[8] = {};  // by GpuSahPass
+    CUfunction sah[int(gpu::GpuSahPass::kPassCount)] = {};
     CUevent start = nullptr, stop = nullptr;
+    CUevent phase[2] = {};  // LUCENT_GPU_ACCEL_TIMES: after the big levels, after the small tasks
     // Scratch, grown to the largest mesh seen.
     DeviceBuffer keys, keys_alt, order, order_alt, split_slots, clusters, node_lo, node_hi,
         node_children, node_inner, node_parent, histogram_buffer, counters, arrivals;
     DeviceBuffer host_positions, host_indices;  // uploads of the span overloads
     // Scratch of the binned-SAH build.
-    DeviceBuffer prim_lo, prim_hi, prim_task, tasks[2], pool[2], node_range, sah_counters;
+    DeviceBuffer sah_scratch;  // one allocation, carved into the arrays (sah_scratch_layout)
 
     void launch(CUfunction f, unsigned grid, unsigned block, void** args, const char* what) {
         if (grid == 0) return;
@@ -90,6 +148,7 @@ DeviceTriangles upload_triangles(std::span<const float3> positions, std::span<co
 }
 
 GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
+    const auto t0 = std::chrono::steady_clock::now();
     CompileRequest req = embedded_request(
         "lucent_bvh_build.cu",
         "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n"
@@ -101,7 +160,12 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     add_options_from_env(req, "LUCENT_GPU_BUILD_NVRTC_OPTIONS");
     const CompileResult compiled = compile_cubin(req);
     const DriverApi& d = api();
+    const double compile_ms = ms_since(t0);
     check(d.cuModuleLoadData(&m->module, compiled.cubin.data()), "cuModuleLoadData (BVH builder)");
+    if (print_times())
+        std::fprintf(stderr, "lucent: GPU BVH builder: module %.3f ms (%s), loaded in %.3f ms\n",
+                     compile_ms, compiled.from_cache ? "kernel cache" : "NVRTC",
+                     ms_since(t0) - compile_ms);
     auto fn = [&](const char* name) {
         CUfunction f = nullptr;
         check(d.cuModuleGetFunction(&f, m->module, name), name);
@@ -118,18 +182,22 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     m->scatter = fn("lucent_radix_scatter");
     m->refit_triangles = fn("lucent_refit_triangles");
     m->refit_nodes = fn("lucent_refit_nodes");
-    const char* sah_names[8] = {"lucent_sah_reset",     "lucent_sah_init",  "lucent_sah_bin",
-                                "lucent_sah_split",     "lucent_sah_partition",
-                                "lucent_sah_count",     "lucent_sah_emit",  "lucent_sah_triangles"};
-    for (int k = 0; k < 8; ++k) m->sah[k] = fn(sah_names[k]);
+    const char* sah_names[] = {"lucent_sah_reset", "lucent_sah_init",      "lucent_sah_bin",
+                               "lucent_sah_split", "lucent_sah_partition", "lucent_sah_small",
+                               "lucent_sah_count", "lucent_sah_emit",      "lucent_sah_triangles"};
+    static_assert(std::size(sah_names) == size_t(gpu::GpuSahPass::kPassCount));
+    for (size_t k = 0; k < std::size(sah_names); ++k) m->sah[k] = fn(sah_names[k]);
     check(d.cuEventCreate(&m->start, CU_EVENT_DEFAULT), "cuEventCreate");
     check(d.cuEventCreate(&m->stop, CU_EVENT_DEFAULT), "cuEventCreate");
+    for (CUevent& e : m->phase) check(d.cuEventCreate(&e, CU_EVENT_DEFAULT), "cuEventCreate");
 }
 
 GpuBvhBuilder::~GpuBvhBuilder() {
     if (const DriverApi* d = driver()) {  // errors while tearing down are not actionable
         if (m->start) d->cuEventDestroy(m->start);
         if (m->stop) d->cuEventDestroy(m->stop);
+        for (CUevent e : m->phase)
+            if (e) d->cuEventDestroy(e);
         if (m->module) d->cuModuleUnload(m->module);
     }
 }
@@ -190,19 +258,10 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
     reserve(s.node_parent, 4 * nodes);
     reserve(s.histogram_buffer, 4 * 256 * size_t(blocks_for(n, gpu::kSortTile)));
     reserve(s.counters, 4 * gpu::kCounterCount);
-    reserve(out.nodes, sizeof(float4) * gpu::kGpuNodeFloat4s * out_nodes);
-    reserve(out.triangles, sizeof(float4) * gpu::kGpuTriangleFloat4s * n);
-    reserve(out.triangle_ids, 4 * size_t(n));
-    reserve(out.parents, 4 * out_nodes);
+    reserve_layout(out, n);
 
     gpu::GpuBuildParams p{};
-    p.positions = reinterpret_cast<const float3*>(static_cast<uintptr_t>(tris.positions));
-    p.indices = reinterpret_cast<const uint3*>(static_cast<uintptr_t>(tris.indices));
-    p.vertex_count = tris.vertex_count;
-    p.triangle_count = n;
-    p.max_leaf_size = unsigned(options.max_leaf_size);
-    p.traversal_cost = options.traversal_cost;
-    p.intersection_cost = options.intersection_cost;
+    set_common_params(p, tris, options, out);
     p.keys = device_ptr<unsigned>(s.keys);
     p.order = device_ptr<unsigned>(s.order);
     p.split_slots = device_ptr<unsigned>(s.split_slots);
@@ -213,10 +272,6 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
     p.node_inner = device_ptr<unsigned>(s.node_inner);
     p.node_parent = device_ptr<unsigned>(s.node_parent);
     p.counters = device_ptr<unsigned>(s.counters);
-    p.out_nodes = device_ptr<float4>(out.nodes);
-    p.out_triangles = device_ptr<float4>(out.triangles);
-    p.out_triangle_ids = device_ptr<unsigned>(out.triangle_ids);
-    p.out_parents = device_ptr<unsigned>(out.parents);
 
     void* args[] = {&p};
     check(api().cuEventRecord(s.start, nullptr), "cuEventRecord");
@@ -271,86 +326,94 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
                                            const GpuBvhBuildOptions& options) {
     const unsigned n = tris.triangle_count;
     const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
-    const size_t pool_words = gpu::gpu_sah_pool_words(n);
-    if (pool_words > 0xffffffffu)
-        throw Error("GPU BVH builder: " + std::to_string(n) +
-                    " triangles are too many for the binned-SAH build; use H-PLOC");
-    reserve(prim_lo, sizeof(float4) * n);
-    reserve(prim_hi, sizeof(float4) * n);
-    reserve(prim_task, 4 * size_t(n));
-    reserve(order, 4 * size_t(n));
-    for (int k = 0; k < 2; ++k) {
-        reserve(tasks[k], sizeof(gpu::GpuSahTask) * (n / 2 + 1));
-        reserve(pool[k], 4 * pool_words);
-    }
-    reserve(node_lo, sizeof(float4) * nodes);
-    reserve(node_hi, sizeof(float4) * nodes);
-    reserve(node_range, sizeof(uint2) * nodes);
-    reserve(node_parent, 4 * nodes);
-    reserve(node_inner, 4 * nodes);
-    reserve(arrivals, 4 * nodes);
-    reserve(sah_counters, 4 * gpu::kSahCounterCount);
-    reserve(out.nodes, sizeof(float4) * gpu::kGpuNodeFloat4s * out_nodes);
-    reserve(out.triangles, sizeof(float4) * gpu::kGpuTriangleFloat4s * n);
-    reserve(out.triangle_ids, 4 * size_t(n));
-    reserve(out.parents, 4 * out_nodes);
+    const auto reserved = std::chrono::steady_clock::now();
+    const unsigned small_limit = sah_small_limit();
+    const gpu::GpuSahScratch scratch = gpu::gpu_sah_scratch(n, small_limit);
+    reserve_layout(out, n);
 
     gpu::GpuSahBuildParams p{};
-    p.positions = reinterpret_cast<const float3*>(static_cast<uintptr_t>(tris.positions));
-    p.indices = reinterpret_cast<const uint3*>(static_cast<uintptr_t>(tris.indices));
-    p.vertex_count = tris.vertex_count;
-    p.triangle_count = n;
-    p.max_leaf_size = unsigned(options.max_leaf_size);
-    p.traversal_cost = options.traversal_cost;
-    p.intersection_cost = options.intersection_cost;
-    p.pool_words = unsigned(pool_words);
-    p.prim_lo = device_ptr<float4>(prim_lo);
-    p.prim_hi = device_ptr<float4>(prim_hi);
-    p.prim_task = device_ptr<unsigned>(prim_task);
-    p.order = device_ptr<unsigned>(order);
-    for (int k = 0; k < 2; ++k) {
-        p.tasks[k] = device_ptr<gpu::GpuSahTask>(tasks[k]);
-        p.pool[k] = device_ptr<unsigned>(pool[k]);
-    }
-    p.node_lo = device_ptr<float4>(node_lo);
-    p.node_hi = device_ptr<float4>(node_hi);
-    p.node_range = device_ptr<uint2>(node_range);
-    p.node_parent = device_ptr<unsigned>(node_parent);
-    p.node_inner = device_ptr<unsigned>(node_inner);
-    p.node_arrivals = device_ptr<unsigned>(arrivals);
-    p.counters = device_ptr<unsigned>(sah_counters);
-    p.out_nodes = device_ptr<float4>(out.nodes);
-    p.out_triangles = device_ptr<float4>(out.triangles);
-    p.out_triangle_ids = device_ptr<unsigned>(out.triangle_ids);
-    p.out_parents = device_ptr<unsigned>(out.parents);
+    set_common_params(p, tris, options, out);
+    p.small_limit = small_limit;
+    p.task_capacity = unsigned(scratch.task_capacity);
+    p.small_capacity = unsigned(scratch.small_capacity);
+    // The scratch arrays, carved out of one allocation (a first build would otherwise pay
+    // for twenty allocations): placed from `base`, returning the bytes they take.
+    const auto carve = [&](CUdeviceptr base) {
+        size_t at = 0;
+        const auto take = [&](auto*& array, size_t count) {
+            using T = std::remove_reference_t<decltype(*array)>;
+            array = reinterpret_cast<T*>(base + at);
+            at += (sizeof(T) * count + 255) & ~size_t(255);
+        };
+        take(p.prim_lo, n);
+        take(p.prim_hi, n);
+        take(p.order, n);
+        for (int k = 0; k < 2; ++k) {
+            take(p.work[k], n);
+            take(p.place_task[k], n);
+            take(p.tasks[k], scratch.task_capacity);
+            take(p.bins[k], scratch.bin_words);
+        }
+        take(p.small, scratch.small_capacity);
+        take(p.node_lo, nodes);
+        take(p.node_hi, nodes);
+        take(p.node_range, nodes);
+        take(p.node_parent, nodes);
+        take(p.node_inner, nodes);
+        take(p.node_arrivals, nodes);
+        take(p.counters, gpu::kSahCounterCount);
+        return at;
+    };
+    reserve(sah_scratch, carve(0));
+    carve(sah_scratch.ptr());
+    if (print_times())
+        std::fprintf(stderr, "lucent: GPU BVH build: device memory (scratch, layout) %.3f ms\n",
+                     ms_since(reserved));
+    const CUdeviceptr counters_ptr = reinterpret_cast<uintptr_t>(p.counters);
 
-    static const char* const kPassNames[8] = {
-        "BVH build (SAH): reset",     "BVH build (SAH): boxes",  "BVH build (SAH): bins",
-        "BVH build (SAH): split",     "BVH build (SAH): partition",
-        "BVH build (SAH): counts",    "BVH build (SAH): layout", "BVH build (SAH): triangles"};
+    static const char* const kPassNames[] = {
+        "BVH build (SAH): reset",  "BVH build (SAH): boxes",     "BVH build (SAH): bins",
+        "BVH build (SAH): split",  "BVH build (SAH): partition", "BVH build (SAH): small tasks",
+        "BVH build (SAH): counts", "BVH build (SAH): layout",    "BVH build (SAH): triangles"};
+    const auto t0 = std::chrono::steady_clock::now();
+    unsigned levels = 0;
     check(api().cuEventRecord(start, nullptr), "cuEventRecord");
     gpu::gpu_sah_build_passes(
-        n,
-        [&](gpu::GpuSahPass pass, unsigned threads, unsigned level) {
+        n, small_limit,
+        [&](gpu::GpuSahPass pass, unsigned level) {
+            if (print_times() && pass == gpu::GpuSahPass::kSmall)
+                check(api().cuEventRecord(phase[0], nullptr), "cuEventRecord");
+            if (print_times() && pass == gpu::GpuSahPass::kCount)
+                check(api().cuEventRecord(phase[1], nullptr), "cuEventRecord");
+            if (pass == gpu::GpuSahPass::kBin) levels = level + 1;
             p.level = level;
             void* args[] = {&p};
-            const unsigned block = pass == gpu::GpuSahPass::kReset ? 32u : 128u;
-            launch(sah[int(pass)], blocks_for(threads, block), block, args,
-                   kPassNames[int(pass)]);
+            const gpu::GpuSahShape shape = gpu::gpu_sah_shape(pass, n, small_limit);
+            launch(sah[int(pass)], shape.blocks, shape.threads, args, kPassNames[int(pass)]);
         },
         [&](unsigned parity) {
             unsigned count = 0;
-            check(api().cuMemcpyDtoH(&count, sah_counters.ptr() + 4 * (gpu::kSahTaskCount + parity),
-                                     4),
+            check(api().cuMemcpyDtoH(&count, counters_ptr + 4 * (gpu::kSahTaskCount + parity), 4),
                   "GPU BVH build: task count");
             return count;
         });
     GpuBvhStats stats;
     stats.builder = "binned SAH (GPU)";
     stats.build_ms = elapsed_ms();
+    if (print_times()) {
+        float big = 0, small_ms = 0;
+        check(api().cuEventElapsedTime(&big, start, phase[0]), "cuEventElapsedTime");
+        check(api().cuEventElapsedTime(&small_ms, phase[0], phase[1]), "cuEventElapsedTime");
+        std::fprintf(stderr,
+                     "lucent: GPU BVH build (binned SAH) of %u triangles: %.3f ms on the host; "
+                     "GPU %.3f ms: boxes and %u levels of big tasks %.3f ms, small tasks (up to "
+                     "%u triangles) %.3f ms, layout %.3f ms\n",
+                     n, ms_since(t0), stats.build_ms, levels, big, small_limit, small_ms,
+                     stats.build_ms - big - small_ms);
+    }
 
     unsigned counters[gpu::kSahCounterCount];
-    sah_counters.download(counters, sizeof counters);
+    check(api().cuMemcpyDtoH(counters, counters_ptr, sizeof counters), "GPU BVH build: counters");
     if (counters[gpu::kSahBadIndex] != gpu::kSahInvalid)
         throw Error("GPU BVH builder: triangle " + std::to_string(counters[gpu::kSahBadIndex]) +
                     " has a vertex index out of range (" + std::to_string(tris.vertex_count) +
@@ -380,7 +443,12 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
 
 GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<const uint3> indices,
                                  GpuTriangleBvhDevice& out, const GpuBvhBuildOptions& options) {
-    return build(m->upload(positions, indices), out, options);
+    const auto t0 = std::chrono::steady_clock::now();
+    const DeviceTriangles tris = m->upload(positions, indices);
+    if (print_times())
+        std::fprintf(stderr, "lucent: GPU BVH build: upload of %u triangles %.3f ms\n",
+                     tris.triangle_count, ms_since(t0));
+    return build(tris, out, options);
 }
 
 double GpuBvhBuilder::refit(const DeviceTriangles& tris, GpuTriangleBvhDevice& bvh) {

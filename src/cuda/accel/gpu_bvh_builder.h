@@ -1,7 +1,7 @@
 // Builds the GPU triangle BVH layout (triangle_bvh.cuh) on the GPU itself, for geometry
 // that changes every frame, and a GPU refit of any layout (bvh_refit.cuh). Two algorithms
 // (GpuBvhBuildOptions::gpu_algorithm): binned SAH (bvh_sah_build.cuh, the default), the
-// host's algorithm and tree, 5.5 ms for Sponza; H-PLOC (bvh_build.cuh), trees tracing at
+// host's algorithm and tree, 1.1 ms for Sponza; H-PLOC (bvh_build.cuh), trees tracing at
 // 0.85-1.05x the SAH tree's speed, built in 0.3 ms for Sponza and 2 ms for a million
 // triangles (H200, docs/performance.md).
 #pragma once

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <set>
@@ -161,9 +163,15 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_buffers.clear();
     // The order matters: records are laid out as programs are added.
     FlatScene flat;
+    const auto start = std::chrono::steady_clock::now();
     add_programs(scene, flat);
     flatten_instances(scene, flat);
     flatten_nodes(scene, flat);
+    if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+        std::fprintf(
+            stderr, "lucent: GPU scene: layouts %.3f ms of %.3f ms flattening\n", m_accel_ms,
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count());
     upload(scene, flat);
     set_params(scene);
     drop_unused(flat);
@@ -286,7 +294,7 @@ gpu::GpuGeometryAccel GpuScene::flatten_geometry_accel(const core::CompiledScene
         // rebuilt only when they change.
         GeometryMirror& mirror = m_geometry[&ga];
         flat.used_geometry.insert(&ga);
-        update_triangle_bvh(n, mirror);
+        update_triangle_bvh(n, mirrored_triangles(scene, n), mirror);
         a.triangles = mirror.bvh.view();
         a.bvh = {~0u, 0};
         if (mirror.empty) a.triangles_only = 0, a.prim_total = 0;  // nothing to hit
@@ -410,26 +418,69 @@ void GpuScene::fetch(const Buffer& buffer) {
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);
 }
 
+/// The triangles of a GeometryGroup of one instance as its buffers hold them, already on the
+/// device (flatten_instances mirrored them): a GPU build then reads them there instead of
+/// uploading the host's gathered copy, which is the same bytes (float3 vertices, uint3
+/// indices, from their starts).
+std::optional<DeviceTriangles> GpuScene::mirrored_triangles(const core::CompiledScene& scene,
+                                                            const core::CompiledNode& node) {
+    if (node.instances.size() != 1) return std::nullopt;
+    const core::CompiledInstance& inst = scene.instances[node.instances[0]];
+    const GeometryTriangles* tris = triangles_of(inst);
+    if (!tris || !tris->indices()) return std::nullopt;
+    const Buffer& vertices = *tris->vertices();
+    const Buffer& indices = *tris->indices();
+    const core::GeometryAccel& ga = *node.geometry;
+    if (inst.vertices != vertices.raw() || inst.indices != indices.raw() ||
+        vertices.element().size != sizeof(float3) || indices.element().size != sizeof(uint3) ||
+        vertices.count() != ga.vertices.size() || indices.count() != ga.indices.size() ||
+        inst.primitive_count != ga.indices.size())
+        return std::nullopt;
+    DeviceTriangles d;
+    d.positions = device_pointer(tris->vertices());
+    d.vertex_count = unsigned(vertices.count());
+    d.indices = device_pointer(tris->indices());
+    d.triangle_count = unsigned(indices.count());
+    return d;
+}
+
 /// Rebuilds (or refits) the GPU layout of a GeometryGroup's triangles when they changed:
 /// on the GPU for Builder::kAuto (binned SAH) and kGpuHploc, on the host for kBinnedSah.
-void GpuScene::update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror) {
+/// `on_device`: the same triangles already in device memory, if they are (no upload).
+void GpuScene::update_triangle_bvh(const core::CompiledNode& node,
+                                   std::optional<DeviceTriangles> on_device,
+                                   GeometryMirror& mirror) {
     const core::GeometryAccel& ga = *node.geometry;
     if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
         return;
     const auto start = std::chrono::steady_clock::now();
     const Acceleration& accel = acceleration_of(node);
     if (accel.builder() == Builder::kGpuHploc || accel.builder() == Builder::kAuto) {
-        if (!m_bvh_builder) m_bvh_builder = std::make_unique<GpuBvhBuilder>(m_sm);
+        if (!m_bvh_builder) {
+            m_bvh_builder = m_builder_on_the_way.valid() ? m_builder_on_the_way.get()
+                                                         : std::make_unique<GpuBvhBuilder>(m_sm);
+            if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+                std::fprintf(stderr, "lucent: GPU BVH builder ready after %.3f ms\n",
+                             std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - start)
+                                 .count());
+        }
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
                            mirror.bvh.triangle_count == ga.indices.size();
         if (refit) {
-            m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
+            if (on_device)
+                m_bvh_builder->refit(*on_device, mirror.bvh);
+            else
+                m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
         } else {
             try {
                 GpuBvhBuildOptions options;
                 if (accel.builder() == Builder::kGpuHploc)
                     options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
-                m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh, options);
+                if (on_device)
+                    m_bvh_builder->build(*on_device, mirror.bvh, options);
+                else
+                    m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh, options);
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
                 // bounds its depth (refits keep that tree's topology).

@@ -2,7 +2,9 @@
 // mirror of every Buffer the programs use. Uploads only what changed since the last launch.
 #pragma once
 
+#include <future>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -17,8 +19,11 @@ namespace lucent::cuda {
 
 class GpuScene {
   public:
-    /// For the device of the current context, of compute capability `sm` (x10).
-    explicit GpuScene(int sm) : m_sm(sm) {}
+    /// For the device of the current context, of compute capability `sm` (x10). `builder`, if
+    /// valid, is the GPU BVH builder being made on another thread (the first GPU build takes
+    /// it; otherwise that build makes one).
+    explicit GpuScene(int sm, std::future<std::unique_ptr<GpuBvhBuilder>> builder = {})
+        : m_sm(sm), m_builder_on_the_way(std::move(builder)) {}
 
     /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
     /// buffers whose host contents changed.
@@ -77,11 +82,15 @@ class GpuScene {
     void write_record(unsigned offset, const core::CompiledProgram& program);
     void fetch_mirror(BufferMirror& mirror);
     void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
-    void update_triangle_bvh(const core::CompiledNode& node, GeometryMirror& mirror);
+    void update_triangle_bvh(const core::CompiledNode& node,
+                             std::optional<DeviceTriangles> on_device, GeometryMirror& mirror);
+    std::optional<DeviceTriangles> mirrored_triangles(const core::CompiledScene& scene,
+                                                      const core::CompiledNode& node);
 
     int m_sm;
     double m_accel_ms = 0;
     std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a GPU build (Builder::kAuto, kGpuHploc) needs it
+    std::future<std::unique_ptr<GpuBvhBuilder>> m_builder_on_the_way;
     ProgramTable m_programs;
     std::vector<unsigned char> m_records;
     std::unordered_map<const void*, gpu::ProgramRef> m_callable_slots;  // by host record
