@@ -9,10 +9,10 @@
 #include <string>
 #include <type_traits>
 
+#include "cuda/backend/driver_api.h"
 #include "cuda/device/lucent_gpu/bvh_build.cuh"
 #include "cuda/device/lucent_gpu/bvh_refit.cuh"
 #include "cuda/device/lucent_gpu/bvh_sah_build.cuh"
-#include "cuda/backend/driver_api.h"
 #include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/error.h"
 
@@ -147,8 +147,7 @@ DeviceTriangles upload_triangles(std::span<const float3> positions, std::span<co
     return tris;
 }
 
-GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
-    const auto t0 = std::chrono::steady_clock::now();
+CompileRequest bvh_builder_request(int sm) {
     CompileRequest req = embedded_request(
         "lucent_bvh_build.cu",
         "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n"
@@ -158,7 +157,12 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
         req.options.push_back("-DLUCENT_BUILD_DEBUG=1");  // the kernels print what they do
     // Experiments: e.g. "-DLUCENT_PLOC_RADIUS=8 -DLUCENT_MORTON_CUBE=1".
     add_options_from_env(req, "LUCENT_GPU_BUILD_NVRTC_OPTIONS");
-    const CompileResult compiled = compile_cubin(req);
+    return req;
+}
+
+GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const CompileResult compiled = compile_cubin(bvh_builder_request(sm));
     const DriverApi& d = api();
     const double compile_ms = ms_since(t0);
     check(d.cuModuleLoadData(&m->module, compiled.cubin.data()), "cuModuleLoadData (BVH builder)");
@@ -423,9 +427,8 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
                             std::to_string(gpu::kGpuStackSize) + ") for " + std::to_string(n) +
                             " triangles; build this mesh with the host SAH builder");
     if (counters[gpu::kSahFault] != gpu::kSahFaultNone)
-        throw Error("GPU BVH builder: internal error " +
-                    std::to_string(counters[gpu::kSahFault]) + " (GpuSahFault) for " +
-                    std::to_string(n) + " triangles");
+        throw Error("GPU BVH builder: internal error " + std::to_string(counters[gpu::kSahFault]) +
+                    " (GpuSahFault) for " + std::to_string(n) + " triangles");
     stats.depth = counters[gpu::kSahDepth];
     stats.node_count = counters[gpu::kSahInner];
     if (stats.node_count > out_nodes || stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)

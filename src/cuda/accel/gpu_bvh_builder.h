@@ -12,6 +12,7 @@
 #include <span>
 
 #include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/error.h"
 
 namespace lucent::cuda {
@@ -36,6 +37,10 @@ class GpuBvhTooDeep : public Error {
   public:
     using Error::Error;
 };
+
+/// The NVRTC request of the build kernels' module for `sm` (compute capability x 10): what
+/// GpuBvhBuilder compiles, also compiled without a GPU by gpu_bvh_builder_test.
+CompileRequest bvh_builder_request(int sm);
 
 /// One builder per CUDA context (it holds that context's module and scratch memory); use it
 /// with that context current. Not thread-safe.
