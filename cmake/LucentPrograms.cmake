@@ -34,6 +34,7 @@ function(lucent_add_programs target)
   endif()
 
   get_target_property(type ${target} TYPE)
+  set(outputs "")
   set(out_dir "${CMAKE_CURRENT_BINARY_DIR}/lucent_modules/${target}")
   file(MAKE_DIRECTORY "${out_dir}")
   set(include_dirs "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
@@ -59,5 +60,20 @@ function(lucent_add_programs target)
     else()
       target_sources(${target} PRIVATE "${output}")
     endif()
+    list(APPEND outputs "${output}")
   endforeach()
+  if(type STREQUAL "STATIC_LIBRARY")
+    # The programs that link <target> compile these files, in whatever directory they are
+    # made; the rule that generates them is only in this one. So they are generated before
+    # <target> is built, which every program linking it waits for (without this, a program
+    # of another directory built first finds no rule to make them).
+    set(generate "${target}_lucent_modules")
+    set(n 1)
+    while(TARGET "${generate}")
+      math(EXPR n "${n} + 1")
+      set(generate "${target}_lucent_modules_${n}")
+    endwhile()
+    add_custom_target(${generate} DEPENDS ${outputs})
+    add_dependencies(${target} ${generate})
+  endif()
 endfunction()
