@@ -92,6 +92,20 @@ unsigned sah_small_limit() {
     return unsigned(limit);
 }
 
+/// What both algorithms' builds end with, once their node count is checked: the leaves (a
+/// binary tree has one more than inner nodes), the SAH cost the kernels left as float bits,
+/// and the layout's sizes.
+GpuBvhStats finish_build(GpuBvhStats stats, unsigned sah_bits, unsigned triangles,
+                         GpuTriangleBvhDevice& out) {
+    stats.leaf_count = stats.node_count + 1;
+    float sah;
+    std::memcpy(&sah, &sah_bits, sizeof sah);
+    stats.sah_cost = sah;
+    out.node_count = stats.node_count;
+    out.triangle_count = triangles;
+    return stats;
+}
+
 }  // namespace
 
 struct GpuBvhBuilder::Impl {
@@ -317,13 +331,7 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
     if (stats.node_count > out_nodes)
         throw Error("GPU BVH builder: internal error, " + std::to_string(stats.node_count) +
                     " inner nodes emitted for " + std::to_string(n) + " triangles");
-    stats.leaf_count = stats.node_count + 1;
-    float sah;
-    std::memcpy(&sah, &counters[gpu::kCounterSah], sizeof sah);
-    stats.sah_cost = sah;
-    out.node_count = stats.node_count;
-    out.triangle_count = n;
-    return stats;
+    return finish_build(stats, counters[gpu::kCounterSah], n, out);
 }
 
 GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTriangleBvhDevice& out,
@@ -435,13 +443,7 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
         throw Error("GPU BVH builder: internal error, " + std::to_string(stats.node_count) +
                     " inner nodes, depth " + std::to_string(stats.depth) + " for " +
                     std::to_string(n) + " triangles");
-    stats.leaf_count = stats.node_count + 1;
-    float sah;
-    std::memcpy(&sah, &counters[gpu::kSahCost], sizeof sah);
-    stats.sah_cost = sah;
-    out.node_count = stats.node_count;
-    out.triangle_count = n;
-    return stats;
+    return finish_build(stats, counters[gpu::kSahCost], n, out);
 }
 
 GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<const uint3> indices,
