@@ -51,6 +51,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export LUCENT_SCENE_RAYS=${LUCENT_SCENE_RAYS:-40}
 gl='^(ViewTest|CliBenchPresent|Display)'
 ctest --test-dir "$build" --output-on-failure -j2 -E "^fuzz\.|accel_isa_symbols|$gl"
+# One at a time: two `xvfb-run -a` starting together race for a display and for their
+# temporary directories ("problem while cleaning up temporary directory", exit 5 instead of
+# the program's own), which the sanitized binaries' slow start-up makes likely.
 ASAN_OPTIONS=${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0} \
-  ctest --test-dir "$build" --output-on-failure -j2 -R "$gl"
+  ctest --test-dir "$build" --output-on-failure -j1 -R "$gl"
 stage tests
