@@ -130,11 +130,19 @@ class CudaBackend final : public core::Backend {
         if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
             if (!m_scene)
                 m_scene = std::make_unique<GpuScene>(m_sm, std::move(m_bvh_builder_on_the_way));
+            const auto start = std::chrono::steady_clock::now();
             m_scene->update(scene);
             report.accel_ms += m_scene->accel_ms();  // the GPU layouts (GPU or host builds)
             m_last_scene = &scene;
             m_last_generation = scene.generation;
+            const auto updated = std::chrono::steady_clock::now();
             prepare_kernel(scene, report);
+            if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+                std::fprintf(stderr, "lucent: GPU scene update %.3f ms, kernels %.3f ms\n",
+                             std::chrono::duration<double, std::milli>(updated - start).count(),
+                             std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - updated)
+                                 .count());
         } else {
             m_scene->sync_buffers();
         }

@@ -73,8 +73,14 @@ CUdeviceptr GpuScene::device_pointer(const std::shared_ptr<const Buffer>& shared
     m.buffer = shared;
     size_t bytes = buffer->count() * buffer->element().size;
     if (m.version != buffer->version() || m.memory.size() != bytes) {
+        const auto start = std::chrono::steady_clock::now();
         m.memory.upload(buffer->raw(), bytes);
         m.version = buffer->version();
+        m_mirror_uploads.count += 1;
+        m_mirror_uploads.bytes += bytes;
+        m_mirror_uploads.ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
     }
     return m.memory.ptr();
 }
@@ -163,18 +169,33 @@ void GpuScene::update(const core::CompiledScene& scene) {
     m_buffers.clear();
     // The order matters: records are laid out as programs are added.
     FlatScene flat;
-    const auto start = std::chrono::steady_clock::now();
+    // LUCENT_GPU_ACCEL_TIMES=1 prints where the update's time goes, step by step.
+    const bool print_times = std::getenv("LUCENT_GPU_ACCEL_TIMES") != nullptr;
+    auto last = std::chrono::steady_clock::now();
+    auto lap = [&] {
+        const auto now = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - last).count();
+        last = now;
+        return ms;
+    };
+    m_mirror_uploads = {};
     add_programs(scene, flat);
+    const double programs_ms = lap();
     flatten_instances(scene, flat);
+    const double instances_ms = lap();
     flatten_nodes(scene, flat);
-    if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
-        std::fprintf(
-            stderr, "lucent: GPU scene: layouts %.3f ms of %.3f ms flattening\n", m_accel_ms,
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count());
+    const double nodes_ms = lap();
     upload(scene, flat);
     set_params(scene);
     drop_unused(flat);
+    const double upload_ms = lap();
+    if (print_times)
+        std::fprintf(stderr,
+                     "lucent: GPU scene: programs %.3f ms, instances %.3f ms, nodes %.3f ms "
+                     "(layouts %.3f ms), flat arrays %.3f ms; buffer mirrors: %u uploaded "
+                     "(%.1f MB) in %.3f ms\n",
+                     programs_ms, instances_ms, nodes_ms, m_accel_ms, upload_ms,
+                     m_mirror_uploads.count, m_mirror_uploads.bytes / 1e6, m_mirror_uploads.ms);
 }
 
 void GpuScene::add_programs(const core::CompiledScene& scene, FlatScene& flat) {

@@ -89,6 +89,10 @@ class GpuScene {
 
     int m_sm;
     double m_accel_ms = 0;
+    struct {
+        unsigned count = 0;
+        double bytes = 0, ms = 0;
+    } m_mirror_uploads;  // the last update()'s buffer uploads (LUCENT_GPU_ACCEL_TIMES)
     std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a GPU build (Builder::kAuto, kGpuHploc) needs it
     std::future<std::unique_ptr<GpuBvhBuilder>> m_builder_on_the_way;
     ProgramTable m_programs;
