@@ -3,7 +3,7 @@
 # root after scripts/gpu-bundle.sh built .gpu-bundle/ on the development machine.
 # Writes logs and images to $OUT (default gpu-out/). Usage: scripts/gpu-check.sh [STEP...]
 # with steps: render examples samples tests igi pathtracer fog tea sanitizer sanitize bench builder present sweep
-# profile hotspots multi python (several GPUs: MULTI_SUITES picks the suites run through --devices)
+# profile hotspots multi python startup (several GPUs: MULTI_SUITES picks the suites run through --devices)
 # (default: render tests sanitizer bench). LUCENT_GPU_CHECK_CACHE names a kernel cache folder
 # to keep between runs (your own, e.g. under the tree's ignored build folders); by default
 # each run compiles into a fresh private one.
@@ -328,6 +328,21 @@ builder)
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj --subdivide 2 --repeat 9
     echo "== bench build --backend cuda: dragon cut twice (1.6M triangles)"
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/dragon.obj --subdivide 2 --repeat 9
+    ;;
+startup)
+    # What a user waits for before the first frame: the direct sample on Sponza at 4K,
+    # `compile + accel` and the first launch's GPU scene update itemized
+    # (LUCENT_GPU_ACCEL_TIMES: programs, instances, nodes, layouts, buffer mirrors uploaded
+    # or cleared, the kernels' preparation); the first run compiles its kernels cold.
+    for round in cold warm warm warm; do
+        [ "$round" = cold ] && cold_cache
+        echo "== direct, sponza.obj, 3840x2160, $round kernel cache"
+        LUCENT_GPU_ACCEL_TIMES=1 $R $B/bin/lucent render --sample direct --backend cuda \
+            --scene /work/shared/scenes/sponza.obj --size 3840x2160 --repeat 5 --json \
+            --out "$work/startup.exr" 2> "$work/startup.log" |
+            python3 -c 'import json, sys; print("\n".join("%s %.3f ms [%s]" % (s["name"], s["ms"], s.get("note", "")) for s in json.load(sys.stdin)["stages"]))'
+        grep "lucent:" "$work/startup.log"
+    done
     ;;
 python)
     # The Python module linked for this machine's python3 (another version than the build

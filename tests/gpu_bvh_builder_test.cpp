@@ -20,6 +20,7 @@
 #include "cuda/accel/gpu_triangle_bvh.h"
 #include "cuda/backend/driver_api.h"
 #include "cuda/device/lucent_gpu/bvh_sah_build.cuh"
+#include "cuda/device/lucent_gpu/triangle_gather.cuh"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"
@@ -358,6 +359,89 @@ TEST(GpuSahBuildEmulation, ScenesAreTheHostTreeForEverySmallTaskLimit) {
     }
 }
 
+/// Three instances' triangles (indexed, unindexed, indexed) and the mesh the host's gather
+/// (core/triangle_gather.cpp) makes of them: vertices concatenated, indices rebased.
+struct GatherCase {
+    std::vector<float3> positions[3];
+    std::vector<uint3> indices[3];
+    std::vector<float3> want_positions;
+    std::vector<uint3> want_indices;
+    GatherCase() {
+        const Mesh a = test_mesh(5, 40), c = test_mesh(9, 7);
+        positions[0] = a.positions, indices[0] = a.indices;
+        for (int i = 0; i < 12; ++i) positions[1].push_back(make_float3(float(i), 1.0f, 2.0f));
+        positions[2] = c.positions, indices[2] = c.indices;
+        for (int k = 0; k < 3; ++k) {
+            const auto base = unsigned(want_positions.size());
+            want_positions.insert(want_positions.end(), positions[k].begin(), positions[k].end());
+            const size_t triangles =
+                indices[k].empty() ? positions[k].size() / 3 : indices[k].size();
+            for (unsigned t = 0; t < triangles; ++t) {
+                const uint3 v =
+                    indices[k].empty() ? make_uint3(3 * t, 3 * t + 1, 3 * t + 2) : indices[k][t];
+                want_indices.push_back(make_uint3(v.x + base, v.y + base, v.z + base));
+            }
+        }
+    }
+};
+
+bool same(float3 a, float3 b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+bool same(uint3 a, uint3 b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
+TEST(GpuTriangleGatherEmulation, MakesTheHostsMesh) {
+    const GatherCase g;
+    std::vector<gpu::GpuTrianglePiece> pieces;
+    unsigned vertices = 0, triangles = 0;
+    for (int k = 0; k < 3; ++k) {
+        const auto n =
+            unsigned(g.indices[k].empty() ? g.positions[k].size() / 3 : g.indices[k].size());
+        pieces.push_back({g.positions[k].data(),
+                          g.indices[k].empty() ? nullptr : g.indices[k].data(), vertices,
+                          unsigned(g.positions[k].size()), triangles, n});
+        vertices += unsigned(g.positions[k].size());
+        triangles += n;
+    }
+    std::vector<float3> positions(vertices);
+    std::vector<uint3> indices(triangles);
+    const gpu::GpuGatherParams p{pieces.data(), 3, vertices, triangles, positions.data(),
+                                 indices.data()};
+    for (unsigned i = 0; i < std::max(vertices, triangles); ++i) gpu::gather_element(p, i);
+    ASSERT_EQ(positions.size(), g.want_positions.size());
+    ASSERT_EQ(indices.size(), g.want_indices.size());
+    for (size_t i = 0; i < positions.size(); ++i)
+        EXPECT_TRUE(same(positions[i], g.want_positions[i])) << "vertex " << i;
+    for (size_t i = 0; i < indices.size(); ++i)
+        EXPECT_TRUE(same(indices[i], g.want_indices[i])) << "triangle " << i;
+}
+
+TEST_F(GpuBvhBuilderTest, GatherMakesTheHostsMesh) {
+    const GatherCase g;
+    cuda::DeviceBuffer positions[3], indices[3];
+    std::vector<cuda::DeviceTriangles> pieces;
+    for (int k = 0; k < 3; ++k)
+        pieces.push_back(
+            cuda::upload_triangles(g.positions[k], g.indices[k], positions[k], indices[k]));
+    const cuda::DeviceTriangles mesh = builder->gather(pieces);
+    ASSERT_EQ(mesh.vertex_count, g.want_positions.size());
+    ASSERT_EQ(mesh.triangle_count, g.want_indices.size());
+    std::vector<float3> got_positions(mesh.vertex_count);
+    std::vector<uint3> got_indices(mesh.triangle_count);
+    cuda::check(api->cuMemcpyDtoH(got_positions.data(), mesh.positions,
+                                  got_positions.size() * sizeof(float3)),
+                "download");
+    cuda::check(
+        api->cuMemcpyDtoH(got_indices.data(), mesh.indices, got_indices.size() * sizeof(uint3)),
+        "download");
+    for (size_t i = 0; i < got_positions.size(); ++i)
+        EXPECT_TRUE(same(got_positions[i], g.want_positions[i])) << "vertex " << i;
+    for (size_t i = 0; i < got_indices.size(); ++i)
+        EXPECT_TRUE(same(got_indices[i], g.want_indices[i])) << "triangle " << i;
+}
+
 TEST_F(GpuBvhBuilderTest, LayoutFindsWhatBruteForceFinds) {
     const Mesh mesh = test_mesh(7, 1500);
     for (auto algorithm : kAlgorithms)
@@ -543,13 +627,13 @@ TEST(GpuBvhBuilderJit, TheBuildKernelsCompileForSm90) {
     EXPECT_EQ(compiled.log.find("warning"), std::string::npos) << compiled.log;
     // The cubin's symbol table names its kernels (extern "C": unmangled).
     for (const char* kernel :
-         {"lucent_build_reset",     "lucent_build_bounds", "lucent_build_morton",
-          "lucent_build_leaves",    "lucent_build_hploc",  "lucent_build_emit",
-          "lucent_radix_histogram", "lucent_radix_scan",   "lucent_radix_scatter",
-          "lucent_refit_triangles", "lucent_refit_nodes",  "lucent_sah_reset",
-          "lucent_sah_init",        "lucent_sah_bin",      "lucent_sah_split",
-          "lucent_sah_partition",   "lucent_sah_small",    "lucent_sah_count",
-          "lucent_sah_emit",        "lucent_sah_triangles"})
+         {"lucent_build_reset",     "lucent_build_bounds",  "lucent_build_morton",
+          "lucent_build_leaves",    "lucent_build_hploc",   "lucent_build_emit",
+          "lucent_radix_histogram", "lucent_radix_scan",    "lucent_radix_scatter",
+          "lucent_refit_triangles", "lucent_refit_nodes",   "lucent_sah_reset",
+          "lucent_sah_init",        "lucent_sah_bin",       "lucent_sah_split",
+          "lucent_sah_partition",   "lucent_sah_small",     "lucent_sah_count",
+          "lucent_sah_emit",        "lucent_sah_triangles", "lucent_gather_triangles"})
         EXPECT_NE(compiled.cubin.find(std::string(kernel) + '\0'), std::string::npos) << kernel;
 }
 

@@ -285,6 +285,30 @@ TEST(MultiDevice, SlotsDealTilesInTurn) {
     EXPECT_EQ(device_slot_of(uint3{5, 5, 5}, uint3{64, 64, 64}, 1), 0u);
 }
 
+TEST(BufferContents, AreZeroedUntilSomethingWritesThem) {
+    // Buffer::zeroed() lets a GPU clear its copy instead of uploading the host's bytes: it
+    // must be false as soon as anything may have written them, a launch on the CPU too.
+    Scene s(options_for({kCpu}));
+    auto sum = s.ctx.create_buffer<float>(BufferType::kInputOutput, 4, 3);
+    auto unbound = s.ctx.create_buffer<float>(BufferType::kInputOutput, 4, 3);
+    EXPECT_TRUE(sum->zeroed());
+    sum->upload(std::vector<float>(12, 1.0f));
+    EXPECT_FALSE(sum->zeroed());
+    sum->resize(4, 3);
+    EXPECT_TRUE(sum->zeroed()) << "resize zeroes the contents";
+    s.ctx["sum"] = sum;
+    s.ctx["round"] = 1u;
+    s.ctx.set_ray_generation_program(0, program(s.ctx, LUCENT_PROGRAM(md_accumulate)));
+    s.ctx.launch(0, 4, 3);
+    EXPECT_FALSE(sum->zeroed()) << "the launch wrote it";
+    EXPECT_EQ(read_buffer<float>(*sum)[1], 10.0f);  // 0 * 0.5 + 1 * 7 + 1 * 3 + 0
+    EXPECT_TRUE(unbound->zeroed()) << "no launch views it";
+    sum->resize(4, 3);
+    (void)sum->map<float>();
+    sum->unmap();
+    EXPECT_FALSE(sum->zeroed()) << "mapped: the host may have written it";
+}
+
 TEST(DeviceList, ParsesNumbersCpuAndAll) {
     EXPECT_EQ(parse_device_list("0,1"), (std::vector<DeviceSpec>{gpu(0), gpu(1)}));
     EXPECT_EQ(parse_device_list(" CPU , 0 "), (std::vector<DeviceSpec>{kCpu, gpu(0)}));

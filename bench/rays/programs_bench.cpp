@@ -56,13 +56,12 @@ Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std:
 ProgramsResult run_programs(const ProgramsInput& in) {
     const scene::ObjMesh& mesh = *in.mesh;
     const RaySet& primary = *in.primary;
-    // The register-capped variants of the GPU kernels compiled with them, not in the
-    // background, so that every ray set is timed with all of its shapes tried (unless the
-    // caller chose otherwise).
-    setenv("LUCENT_GPU_REGISTER_VARIANTS", "sync", 0);
     ContextOptions options;
     options.backend = in.backend;
     options.threads = in.threads;
+    // The register-capped variants of the GPU kernels compiled with them, not in the
+    // background, so that every ray set is timed with all of its shapes tried.
+    options.register_variants = RegisterVariants::kWithKernel;
     Context ctx(options);
     ctx.add_module("lucent_bench_rays");
     ctx.set_ray_type<programs::RayHit>(programs::kBenchRay, "bench");

@@ -36,6 +36,7 @@ class Buffer : public ContextObject {
         check_element(type_info_of<T>());
         sync_from_device();
         m_mapped = true;
+        m_zeroed = false;
         return reinterpret_cast<T*>(bytes());
     }
     template <class T>
@@ -71,11 +72,24 @@ class Buffer : public ContextObject {
     bool launch_index_local() const { return m_launch_index_local; }
 
     /// The host copy, as it is (backends use these; applications use map/data).
-    void* raw() { return bytes(); }
+    void* raw() {
+        m_zeroed = false;
+        return bytes();
+    }
     const void* raw() const { return bytes(); }
     uint64_t version() const { return m_version; }
+    /// Nothing has written the contents since the last resize, so they are all zeros: a
+    /// backend may clear its device copy instead of copying the host's bytes (a launch's
+    /// output images are often hundreds of MB).
+    bool zeroed() const { return m_zeroed; }
+    /// Something other than map() or upload() may have written the host copy: a launch that
+    /// views the buffer writably, or a device copy fetched into it.
+    void mark_written() const { m_zeroed = false; }
     /// A GPU launch wrote the buffer: the host copy is refreshed on the next map or data.
-    void mark_device_newer() const { m_device_newer = true; }
+    void mark_device_newer() const {
+        m_device_newer = true;
+        m_zeroed = false;
+    }
     /// Brings the host copy up to date now if a launch wrote the buffer on a device.
     void sync_from_device() const;
 
@@ -93,6 +107,7 @@ class Buffer : public ContextObject {
     std::vector<Block> m_blocks;  // 16-byte aligned backing store
     bool m_mapped = false;
     mutable bool m_device_newer = false;
+    mutable bool m_zeroed = true;  // see zeroed()
     bool m_launch_index_local = false;
     uint64_t m_version = 1;
 };

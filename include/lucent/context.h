@@ -44,6 +44,16 @@ std::vector<DeviceSpec> parse_device_list(const std::string& text);
 /// "cpu" or "cuda:1".
 std::string device_spec_name(const DeviceSpec& device);
 
+/// CUDA: what the backend does for a kernel of more than 64 registers a thread. Capped at 64,
+/// more warps fit on a multiprocessor but values spill; which is faster depends on the
+/// program (docs/performance.md), so a capped variant is one more launch shape the tuning
+/// times (docs/programming-model.md, "Launch shapes").
+enum class RegisterVariants {
+    kBackground,  // compiled on other threads after the first launch, timed once it is ready
+    kWithKernel,  // compiled with the kernel, before the first launch: reproducible timings
+    kOff,         // none: every kernel runs as compiled
+};
+
 struct ContextOptions {
     BackendKind backend = BackendKind::kAuto;
     unsigned threads = 0;  // CPU backend workers; 0 = one per core
@@ -59,6 +69,9 @@ struct ContextOptions {
     /// Multi-device launches: launch-grid rows per piece taken from the queue (1D launches:
     /// 64 x this many indices); 0 = sized by each device's measured speed. For tests.
     unsigned piece_rows = 0;
+    /// CUDA: the register-capped variants of large kernels (the environment variable
+    /// LUCENT_GPU_REGISTER_VARIANTS=background|sync|off overrides it, for experiments).
+    RegisterVariants register_variants = RegisterVariants::kBackground;
     /// Called on the launching thread as bands of rows of a launch finish, where the
     /// device's copy of the buffers is host memory (the CPU backend, one device); an
     /// interactive viewer shows them while a slow frame renders. Empty: launches run whole.

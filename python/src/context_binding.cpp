@@ -44,9 +44,19 @@ std::vector<DeviceSpec> device_list(const py::object& devices) {
     return parse_device_list(list);
 }
 
+RegisterVariants register_variants(const std::string& name) {
+    if (name == "background") return RegisterVariants::kBackground;
+    if (name == "with_kernel") return RegisterVariants::kWithKernel;
+    if (name == "off") return RegisterVariants::kOff;
+    throw py::value_error("Context: register_variants: expected 'background', 'with_kernel' or "
+                          "'off'; got '" + name + "'");
+}
+
 ContextOptions context_options(const std::string& backend, unsigned threads, int jit_check_sm,
-                               const py::object& devices, const py::object& ranks) {
+                               const py::object& devices, const py::object& ranks,
+                               const std::string& variants) {
     ContextOptions options;
+    options.register_variants = register_variants(variants);
     options.ranks = ranks_argument(ranks, "Context: ranks");
     options.backend = backend_kind(backend, "Context: backend");
     options.threads = threads;
@@ -122,21 +132,26 @@ void bind_context(py::module_& m) {
     py::class_<Context, std::shared_ptr<Context>> ctx(
         m, "Context", "Owns the entry points, ray types and objects of a scene, and launches.");
     ctx.def(py::init([](const std::string& backend, unsigned threads, int jit_check_sm,
-                        const py::object& devices, const py::object& ranks) {
+                        const py::object& devices, const py::object& ranks,
+                        const std::string& variants) {
                 ContextOptions options =
-                    context_options(backend, threads, jit_check_sm, devices, ranks);
+                    context_options(backend, threads, jit_check_sm, devices, ranks, variants);
                 py::gil_scoped_release release;  // a CUDA context takes a while to start
                 return std::make_shared<Context>(std::move(options));
             }),
             py::arg("backend") = "auto", py::arg("threads") = 0u, py::arg("jit_check_sm") = 0,
             py::arg("devices") = py::none(), py::arg("ranks") = py::none(),
+            py::arg("register_variants") = "background",
             "backend: 'auto', 'cpu' or 'cuda'; threads: CPU workers (0: one per core); "
             "jit_check_sm: with the CPU backend, also compile the GPU megakernel for this "
             "compute capability (90: sm_90) at each compile, without a GPU; devices: '0,1', "
             "'cpu,0', 'all' or a list, to spread launches over several devices; ranks: a "
             "lucent.Ranks (lucent.Ranks.world() under mpirun) to spread them over the "
             "processes of an MPI job, each on its own devices (every rank runs the same "
-            "script; docs/distributed.md).")
+            "script; docs/distributed.md); register_variants: CUDA, for kernels of more than "
+            "64 registers a thread, a variant capped at 64 that the launch-shape tuning "
+            "times beside the others: 'background' (compiled after the first launch), "
+            "'with_kernel' (compiled before it: reproducible timings) or 'off'.")
         .def_property_readonly("backend", &Context::backend_name)
         .def_property_readonly("backend_notice", &Context::backend_notice)
         .def_property_readonly("device_count", &Context::device_count)

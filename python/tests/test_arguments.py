@@ -67,6 +67,14 @@ def test_bad_backend():
         lucent.render("whitted", backend="vulkan")
 
 
+def test_register_variants():
+    for variants in ("background", "with_kernel", "off"):
+        lucent.Context(backend="cpu", register_variants=variants)
+    with pytest.raises(ValueError, match="register_variants: expected 'background', "
+                                         "'with_kernel' or 'off'; got 'sync'"):
+        lucent.Context(backend="cpu", register_variants="sync")
+
+
 @pytest.mark.parametrize("origins, directions, error, words", [
     (O.astype(np.int64), D, TypeError, ["intersect", "origins", "(R, 3) float32", "int64"]),
     (O, D.astype(np.float16), TypeError, ["directions", "float16"]),

@@ -16,11 +16,13 @@ namespace lucent::core {
 namespace {
 
 /// One device of a device list.
-std::unique_ptr<Backend> make_device_backend(const DeviceSpec& device, unsigned threads) {
-    if (device.kind == DeviceSpec::Kind::kCpu) return make_cpu_backend(threads);
+std::unique_ptr<Backend> make_device_backend(const DeviceSpec& device,
+                                             const ContextOptions& options) {
+    if (device.kind == DeviceSpec::Kind::kCpu) return make_cpu_backend(options.threads);
 #if LUCENT_HAVE_CUDA
     std::string why;
-    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why)) return backend;
+    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why, options.register_variants))
+        return backend;
     throw Error("Context: device " + device_spec_name(device) + " cannot run here: " + why +
                 "; list the GPUs `nvidia-smi -L` shows, or cpu");
 #else
@@ -45,7 +47,7 @@ std::unique_ptr<Backend> make_local_backend(const ContextOptions& options, std::
         std::vector<std::unique_ptr<Backend>> devices;
         std::vector<std::string> names;
         for (const DeviceSpec& device : options.devices) {
-            devices.push_back(make_device_backend(device, options.threads));
+            devices.push_back(make_device_backend(device, options));
             names.push_back(device_spec_name(device));
         }
         const unsigned count = unsigned(devices.size());
@@ -55,7 +57,8 @@ std::unique_ptr<Backend> make_local_backend(const ContextOptions& options, std::
     if (options.backend != BackendKind::kCpu) {
 #if LUCENT_HAVE_CUDA
         std::string why;
-        if (auto backend = cuda::make_cuda_backend(0, &why)) return backend;
+        if (auto backend = cuda::make_cuda_backend(0, &why, options.register_variants))
+            return backend;
         if (options.backend == BackendKind::kCuda)
             throw Error("Context: the CUDA backend cannot run here: " + why +
                         "; use --backend cpu or --backend auto");

@@ -8,6 +8,7 @@
 #include "core/program_exception.h"
 #include "lucent/device/curve_intersect.h"
 #include "core/scene_compiler.h"
+#include "core/triangle_gather.h"
 
 namespace lucent::core {
 
@@ -264,32 +265,17 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         total += m_scene->instances[i].bvh_references();
     }
     if (ga.triangles_only) {
-        ga.vertices.clear();
-        ga.indices.clear();
-        ga.tri_instance.clear();
-        ga.indices.reserve(total);
-        ga.tri_instance.reserve(total);
-        // Without a host build, the bounds come from this pass (the triangles' vertices, while
-        // they are in cache): the GPU build needs nothing else of the host.
-        Aabb bounds = empty_box();
-        for (unsigned k = 0; k < node.instances.size(); ++k) {
-            const CompiledInstance& inst = m_scene->instances[node.instances[k]];
-            const GeometryTriangles* tris = triangles_of(inst);
-            uint32_t base = uint32_t(ga.vertices.size());
-            const float3* v = inst.vertices;
-            ga.vertices.insert(ga.vertices.end(), v, v + tris->vertices()->count());
-            for (unsigned p = 0; p < inst.primitive_count; ++p) {
-                uint3 t = triangle_of(inst, p);
-                if (!host_triangles)
-                    for (unsigned i : {t.x, t.y, t.z}) grow(bounds, v[i]);
-                ga.indices.push_back(uint3{t.x + base, t.y + base, t.z + base});
-                ga.tri_instance.push_back(k);
-            }
-        }
+        ga.triangle_count = total;
         if (!host_triangles) {
+            // The GPU gathers the triangles itself (GpuScene); the scene above needs only
+            // their bounds.
+            ga.vertices.clear();
+            ga.indices.clear();
+            ga.tri_instance.clear();
             ga.triangles = accel::TriangleAccel();
-            ga.bounds = bounds;
+            ga.bounds = triangle_bounds(*m_scene, node);
         } else {
+            gather_triangles(*m_scene, node, ga.vertices, ga.indices, &ga.tri_instance);
             accel::BuildOptions options;
             options.spatial_splits = !any_hit;
             if (refit)
@@ -300,6 +286,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
         }
         ga.host_triangles = host_triangles;
     } else {
+        ga.triangle_count = 0;
         std::vector<Aabb> boxes;
         boxes.reserve(total);
         Aabb all = empty_box();

@@ -48,6 +48,7 @@ void Buffer::resize(unsigned width, unsigned height, unsigned depth) {
                     "D buffer; leave the unused dimensions at 1");
     m_size = uint3{width, height, depth};
     m_device_newer = false;
+    m_zeroed = true;
     size_t bytes = count() * m_element->size;
     m_blocks.assign((bytes + 15) / 16, Block{});
     ++m_version;

@@ -99,6 +99,9 @@ struct GeometryAccel {
     bool triangles_only = false;
     accel::TriangleAccel triangles;      // triangles_only: all instances' triangles together
     bool host_triangles = false;         // `triangles` is built (kGpuHploc on a GPU needs none)
+    unsigned triangle_count = 0;         // triangles_only: of every instance together
+    // host_triangles: the instances' triangles gathered (core/triangle_gather.h); without a
+    // host build they are left empty, and a GPU build gathers them on the device.
     std::vector<float3> vertices;        // the concatenated vertices
     std::vector<uint3> indices;          // concatenated, rebased indices
     std::vector<uint32_t> tri_instance;  // triangle → position in CompiledNode::instances

@@ -8,6 +8,7 @@
 #include "backends/backend_factory.h"
 #include "core/backend.h"
 #include "core/context_state.h"
+#include "core/launch_buffers.h"
 #include "core/module_registry.h"
 #include "core/runtime_module.h"
 #include "core/scene_compiler.h"
@@ -518,7 +519,19 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     }
     auto t1 = Clock::now();
     const double jit_before = report.jit_ms;  // --jit-check's compile, before t1
-    m_impl->backend->launch(scene, spec, report);
+    {
+        // Whatever the launch did, buffers it views writably may hold what it wrote.
+        struct MarkWritten {
+            const core::CompiledScene& scene;
+            unsigned entry;
+            ~MarkWritten() {
+                core::for_each_program(scene, entry, [](const core::CompiledProgram& p) {
+                    for (const auto& b : p.writable_buffers) b->mark_written();
+                });
+            }
+        } mark_written{scene, entry};
+        m_impl->backend->launch(scene, spec, report);
+    }
     // A kernel compile inside the backend's launch is reported apart.
     report.launch_ms = ms_since(t1) - (report.jit_ms - jit_before);
     m_impl->last = std::move(report);

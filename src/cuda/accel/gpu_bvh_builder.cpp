@@ -8,11 +8,13 @@
 #include <iterator>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "cuda/backend/driver_api.h"
 #include "cuda/device/lucent_gpu/bvh_build.cuh"
 #include "cuda/device/lucent_gpu/bvh_refit.cuh"
 #include "cuda/device/lucent_gpu/bvh_sah_build.cuh"
+#include "cuda/device/lucent_gpu/triangle_gather.cuh"
 #include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/error.h"
 
@@ -112,7 +114,8 @@ struct GpuBvhBuilder::Impl {
     CUmodule module = nullptr;
     CUfunction reset = nullptr, bounds = nullptr, morton = nullptr, leaves = nullptr,
                hploc = nullptr, emit = nullptr, histogram = nullptr, scan = nullptr,
-               scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr;
+               scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr,
+               gather = nullptr;
     CUfunction sah[int(gpu::GpuSahPass::kPassCount)] = {};
     CUevent start = nullptr, stop = nullptr;
     CUevent phase[2] = {};  // LUCENT_GPU_ACCEL_TIMES: after the big levels, after the small tasks
@@ -120,6 +123,7 @@ struct GpuBvhBuilder::Impl {
     DeviceBuffer keys, keys_alt, order, order_alt, split_slots, clusters, node_lo, node_hi,
         node_children, node_inner, node_parent, histogram_buffer, counters, arrivals;
     DeviceBuffer host_positions, host_indices;  // uploads of the span overloads
+    DeviceBuffer gathered_positions, gathered_indices, gather_pieces;  // gather()
     // Scratch of the binned-SAH build.
     DeviceBuffer sah_scratch;  // one allocation, carved into the arrays (sah_scratch_layout)
 
@@ -165,7 +169,7 @@ CompileRequest bvh_builder_request(int sm) {
     CompileRequest req = embedded_request(
         "lucent_bvh_build.cu",
         "#include \"lucent_gpu/bvh_build.cuh\"\n#include \"lucent_gpu/bvh_refit.cuh\"\n"
-        "#include \"lucent_gpu/bvh_sah_build.cuh\"\n",
+        "#include \"lucent_gpu/bvh_sah_build.cuh\"\n#include \"lucent_gpu/triangle_gather.cuh\"\n",
         {"--std=c++17"}, sm);
     if (const char* debug = std::getenv("LUCENT_GPU_BUILD_DEBUG"); debug && *debug)
         req.options.push_back("-DLUCENT_BUILD_DEBUG=1");  // the kernels print what they do
@@ -200,6 +204,7 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
     m->scatter = fn("lucent_radix_scatter");
     m->refit_triangles = fn("lucent_refit_triangles");
     m->refit_nodes = fn("lucent_refit_nodes");
+    m->gather = fn("lucent_gather_triangles");
     const char* sah_names[] = {"lucent_sah_reset", "lucent_sah_init",      "lucent_sah_bin",
                                "lucent_sah_split", "lucent_sah_partition", "lucent_sah_small",
                                "lucent_sah_count", "lucent_sah_emit",      "lucent_sah_triangles"};
@@ -454,6 +459,48 @@ GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<co
         std::fprintf(stderr, "lucent: GPU BVH build: upload of %u triangles %.3f ms\n",
                      tris.triangle_count, ms_since(t0));
     return build(tris, out, options);
+}
+
+DeviceTriangles GpuBvhBuilder::gather(std::span<const DeviceTriangles> pieces) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<gpu::GpuTrianglePiece> table;
+    table.reserve(pieces.size());
+    size_t vertices = 0, triangles = 0;
+    for (const DeviceTriangles& piece : pieces) {
+        table.push_back({reinterpret_cast<const float3*>(static_cast<uintptr_t>(piece.positions)),
+                         reinterpret_cast<const uint3*>(static_cast<uintptr_t>(piece.indices)),
+                         unsigned(vertices), piece.vertex_count, unsigned(triangles),
+                         piece.triangle_count});
+        vertices += piece.vertex_count;
+        triangles += piece.triangle_count;
+    }
+    if (vertices > 0xffffffffu || triangles > 0xffffffffu)
+        throw Error("GPU BVH builder: " + std::to_string(triangles) + " triangles over " +
+                    std::to_string(vertices) +
+                    " vertices in one GeometryGroup; split it into groups of fewer than 2^32");
+    Impl& s = *m;
+    reserve(s.gathered_positions, sizeof(float3) * std::max<size_t>(vertices, 1));
+    reserve(s.gathered_indices, sizeof(uint3) * std::max<size_t>(triangles, 1));
+    s.gather_pieces.upload(table.data(), table.size() * sizeof(gpu::GpuTrianglePiece));
+    gpu::GpuGatherParams p{};
+    p.pieces = s.gather_pieces.as<gpu::GpuTrianglePiece>();
+    p.piece_count = unsigned(table.size());
+    p.vertex_total = unsigned(vertices);
+    p.triangle_total = unsigned(triangles);
+    p.positions = device_ptr<float3>(s.gathered_positions);
+    p.indices = device_ptr<uint3>(s.gathered_indices);
+    void* args[] = {&p};
+    s.launch(s.gather, blocks_for(std::max(vertices, triangles), 256), 256, args,
+             "gather the instances' triangles");
+    if (print_times())
+        std::fprintf(stderr, "lucent: GPU BVH build: %zu instances' triangles gathered, %.3f ms\n",
+                     pieces.size(), ms_since(t0));
+    DeviceTriangles mesh;
+    mesh.positions = s.gathered_positions.ptr();
+    mesh.vertex_count = unsigned(vertices);
+    mesh.indices = s.gathered_indices.ptr();
+    mesh.triangle_count = unsigned(triangles);
+    return mesh;
 }
 
 double GpuBvhBuilder::refit(const DeviceTriangles& tris, GpuTriangleBvhDevice& bvh) {

@@ -62,6 +62,11 @@ class GpuBvhBuilder {
     GpuBvhStats build(std::span<const float3> positions, std::span<const uint3> indices,
                       GpuTriangleBvhDevice& out, const GpuBvhBuildOptions& options = {});
 
+    /// Gathers triangles of several instances (`pieces`, in device memory) into one mesh:
+    /// vertices concatenated, indices rebased onto them (lucent_gather_triangles). The mesh
+    /// is the builder's scratch, valid until the next gather.
+    DeviceTriangles gather(std::span<const DeviceTriangles> pieces);
+
     /// Moves `bvh`'s triangles to new vertex positions (the same triangles, in the same
     /// order, as it was built from) and recomputes its boxes; returns the GPU time in ms.
     double refit(const DeviceTriangles& triangles, GpuTriangleBvhDevice& bvh);

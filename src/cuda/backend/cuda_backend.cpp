@@ -59,7 +59,8 @@ class CudaBackend final : public core::Backend {
     };
 
   public:
-    CudaBackend(const DriverApi& d, int ordinal) : m_driver(d), m_ordinal(ordinal) {
+    CudaBackend(const DriverApi& d, int ordinal, RegisterVariants register_variants)
+        : m_driver(d), m_ordinal(ordinal), m_register_variants(register_variants) {
         check(d.cuDeviceGet(&m_device, ordinal), "cuDeviceGet");
         char name[256] = {};
         d.cuDeviceGetName(name, sizeof name, m_device);
@@ -309,6 +310,7 @@ class CudaBackend final : public core::Backend {
         auto* host = static_cast<unsigned char*>(const_cast<void*>(buffer.raw()));
         check(m_driver.cuMemcpyDtoH(host + offset, mirror_of(buffer) + offset, bytes),
               "download a piece of a buffer");
+        buffer.mark_written();
     }
 
     void copy_range_to(core::Backend& target, const Buffer& buffer, size_t offset,
@@ -403,13 +405,17 @@ class CudaBackend final : public core::Backend {
     }
 
     /// Compiles the register-capped variant of every kernel that uses more registers than
-    /// the cap allows, on other threads while launches run (LUCENT_GPU_REGISTER_VARIANTS:
-    /// "sync" compiles them here, "off" not at all); adopt_capped_variants adds them to the
-    /// kernels' shapes. Not with a fixed carveout or a block count in LUCENT_NVRTC_OPTIONS
-    /// (experiments that choose the shape themselves).
+    /// the cap allows, on other threads while launches run (ContextOptions::register_variants,
+    /// or LUCENT_GPU_REGISTER_VARIANTS: "sync" compiles them here, "off" not at all);
+    /// adopt_capped_variants adds them to the kernels' shapes. Not with a fixed carveout or
+    /// a block count in LUCENT_NVRTC_OPTIONS (experiments that choose the shape themselves).
     void start_capped_variants(const Megakernel& kernel) {
         const char* mode_env = std::getenv("LUCENT_GPU_REGISTER_VARIANTS");
-        const std::string mode = mode_env ? mode_env : "background";
+        const std::string mode = mode_env && *mode_env ? mode_env
+                                 : m_register_variants == RegisterVariants::kOff ? "off"
+                                 : m_register_variants == RegisterVariants::kWithKernel
+                                     ? "sync"
+                                     : "background";
         const char* options = std::getenv("LUCENT_NVRTC_OPTIONS");
         if (mode == "off" || m_fixed_shape ||
             (options && std::strstr(options, "LUCENT_GPU_MIN_BLOCKS")))
@@ -559,6 +565,7 @@ class CudaBackend final : public core::Backend {
     KernelCode* m_code = nullptr;                 // its variant in this launch's shape
     int m_grid = 1;                               // and that shape's grid
     std::future<std::vector<CompileResult>> m_capped;  // capped variants being compiled
+    RegisterVariants m_register_variants;
     std::vector<size_t> m_capped_kernels;              // the kernels they are of
     // The GPU BVH builder being made on another thread, until a GpuScene takes it.
     std::future<std::unique_ptr<GpuBvhBuilder>> m_bvh_builder_on_the_way;
@@ -686,7 +693,8 @@ std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
 
 }  // namespace
 
-std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why) {
+std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why,
+                                                 RegisterVariants register_variants) {
     const DriverApi* d = driver(why);
     if (!d) return nullptr;
     std::string nvrtc_why;
@@ -702,7 +710,7 @@ std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why) 
                    std::to_string(count) + ")";
         return nullptr;
     }
-    return std::make_unique<CudaBackend>(*d, ordinal);
+    return std::make_unique<CudaBackend>(*d, ordinal, register_variants);
 }
 
 int gpu_count() {

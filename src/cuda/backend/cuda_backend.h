@@ -5,12 +5,15 @@
 #include <string>
 
 #include "core/backend.h"
+#include "lucent/context.h"
 
 namespace lucent::cuda {
 
 /// The CUDA backend on GPU `ordinal`, or null (with the reason in `why`) when no driver,
 /// such GPU or NVRTC answers.
-std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why);
+std::unique_ptr<core::Backend> make_cuda_backend(
+    int ordinal, std::string* why,
+    RegisterVariants register_variants = RegisterVariants::kBackground);
 
 /// GPUs the driver reports (0 without a driver).
 int gpu_count();

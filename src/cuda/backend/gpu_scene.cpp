@@ -8,6 +8,7 @@
 #include <functional>
 #include <set>
 
+#include "core/triangle_gather.h"
 #include "cuda/jit/megakernel_compiler.h"
 #include "lucent/error.h"
 
@@ -74,10 +75,18 @@ CUdeviceptr GpuScene::device_pointer(const std::shared_ptr<const Buffer>& shared
     size_t bytes = buffer->count() * buffer->element().size;
     if (m.version != buffer->version() || m.memory.size() != bytes) {
         const auto start = std::chrono::steady_clock::now();
-        m.memory.upload(buffer->raw(), bytes);
+        if (buffer->zeroed()) {
+            // Zeros (a new output image, an accumulator): cleared on the device rather than
+            // copied from pageable host memory.
+            m.memory.alloc(bytes);
+            m.memory.fill(0);
+            m_mirror_uploads.cleared += 1;
+        } else {
+            m.memory.upload(buffer->raw(), bytes);
+            m_mirror_uploads.count += 1;
+            m_mirror_uploads.bytes += bytes;
+        }
         m.version = buffer->version();
-        m_mirror_uploads.count += 1;
-        m_mirror_uploads.bytes += bytes;
         m_mirror_uploads.ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
@@ -193,9 +202,10 @@ void GpuScene::update(const core::CompiledScene& scene) {
         std::fprintf(stderr,
                      "lucent: GPU scene: programs %.3f ms, instances %.3f ms, nodes %.3f ms "
                      "(layouts %.3f ms), flat arrays %.3f ms; buffer mirrors: %u uploaded "
-                     "(%.1f MB) in %.3f ms\n",
+                     "(%.1f MB) and %u cleared in %.3f ms\n",
                      programs_ms, instances_ms, nodes_ms, m_accel_ms, upload_ms,
-                     m_mirror_uploads.count, m_mirror_uploads.bytes / 1e6, m_mirror_uploads.ms);
+                     m_mirror_uploads.count, m_mirror_uploads.bytes / 1e6,
+                     m_mirror_uploads.cleared, m_mirror_uploads.ms);
 }
 
 void GpuScene::add_programs(const core::CompiledScene& scene, FlatScene& flat) {
@@ -315,7 +325,7 @@ gpu::GpuGeometryAccel GpuScene::flatten_geometry_accel(const core::CompiledScene
         // rebuilt only when they change.
         GeometryMirror& mirror = m_geometry[&ga];
         flat.used_geometry.insert(&ga);
-        update_triangle_bvh(n, mirrored_triangles(scene, n), mirror);
+        update_triangle_bvh(scene, n, mirrored_triangles(scene, n), mirror);
         a.triangles = mirror.bvh.view();
         a.bvh = {~0u, 0};
         if (mirror.empty) a.triangles_only = 0, a.prim_total = 0;  // nothing to hit
@@ -410,6 +420,7 @@ void GpuScene::mark_outputs_device_newer() {
 void GpuScene::fetch_mirror(BufferMirror& mirror) {
     const Buffer& b = *mirror.buffer;
     mirror.memory.download(const_cast<void*>(b.raw()), b.count() * b.element().size);
+    b.mark_written();
     mirror.device_newer = false;
 }
 
@@ -439,42 +450,60 @@ void GpuScene::fetch(const Buffer& buffer) {
     if (found != m_buffers.end() && found->second.device_newer) fetch_mirror(found->second);
 }
 
-/// The triangles of a GeometryGroup of one instance as its buffers hold them, already on the
-/// device (flatten_instances mirrored them): a GPU build then reads them there instead of
-/// uploading the host's gathered copy, which is the same bytes (float3 vertices, uint3
-/// indices, from their starts).
-std::optional<DeviceTriangles> GpuScene::mirrored_triangles(const core::CompiledScene& scene,
-                                                            const core::CompiledNode& node) {
-    if (node.instances.size() != 1) return std::nullopt;
-    const core::CompiledInstance& inst = scene.instances[node.instances[0]];
-    const GeometryTriangles* tris = triangles_of(inst);
-    if (!tris || !tris->indices()) return std::nullopt;
-    const Buffer& vertices = *tris->vertices();
-    const Buffer& indices = *tris->indices();
-    const core::GeometryAccel& ga = *node.geometry;
-    if (inst.vertices != vertices.raw() || inst.indices != indices.raw() ||
-        vertices.element().size != sizeof(float3) || indices.element().size != sizeof(uint3) ||
-        vertices.count() != ga.vertices.size() || indices.count() != ga.indices.size() ||
-        inst.primitive_count != ga.indices.size())
-        return std::nullopt;
-    DeviceTriangles d;
-    d.positions = device_pointer(tris->vertices());
-    d.vertex_count = unsigned(vertices.count());
-    d.indices = device_pointer(tris->indices());
-    d.triangle_count = unsigned(indices.count());
-    return d;
+/// The triangles of each instance of a triangles-only group as its buffers hold them, already
+/// on the device (flatten_instances mirrored them): a GPU build reads them there (gathered
+/// into one mesh on the GPU when there are several), instead of the host gathering and
+/// uploading the same bytes. None when an instance's triangles are not its buffers' plain
+/// contents (float3 vertices, uint3 indices, from their starts): the host gathers those.
+std::optional<std::vector<DeviceTriangles>> GpuScene::mirrored_triangles(
+    const core::CompiledScene& scene, const core::CompiledNode& node) {
+    std::vector<DeviceTriangles> pieces;
+    pieces.reserve(node.instances.size());
+    for (unsigned i : node.instances) {
+        const core::CompiledInstance& inst = scene.instances[i];
+        const GeometryTriangles* tris = triangles_of(inst);
+        if (!tris || !tris->vertices()) return std::nullopt;
+        const Buffer& vertices = *tris->vertices();
+        const Buffer* indices = tris->indices().get();
+        const unsigned triangles = indices ? unsigned(indices->count())
+                                           : unsigned(vertices.count() / 3);
+        if (inst.vertices != vertices.raw() || vertices.element().size != sizeof(float3) ||
+            inst.primitive_count != triangles ||
+            (indices && (inst.indices != indices->raw() ||
+                         indices->element().size != sizeof(uint3))))
+            return std::nullopt;
+        DeviceTriangles d;
+        d.positions = device_pointer(tris->vertices());
+        d.vertex_count = unsigned(vertices.count());
+        d.indices = indices ? device_pointer(tris->indices()) : 0;
+        d.triangle_count = triangles;
+        pieces.push_back(d);
+    }
+    return pieces;
 }
 
 /// Rebuilds (or refits) the GPU layout of a GeometryGroup's triangles when they changed:
 /// on the GPU for Builder::kAuto (binned SAH) and kGpuHploc, on the host for kBinnedSah.
-/// `on_device`: the same triangles already in device memory, if they are (no upload).
-void GpuScene::update_triangle_bvh(const core::CompiledNode& node,
-                                   std::optional<DeviceTriangles> on_device,
+/// `on_device`: the instances' triangles already in device memory, if they are (no upload).
+void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
+                                   const core::CompiledNode& node,
+                                   const std::optional<std::vector<DeviceTriangles>>& on_device,
                                    GeometryMirror& mirror) {
     const core::GeometryAccel& ga = *node.geometry;
     if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
         return;
     const auto start = std::chrono::steady_clock::now();
+    // The triangles as one mesh on the host: the compile's when it gathered them (a host
+    // build), else gathered here (triangles the device cannot read in place, the host
+    // build after a GPU tree too deep).
+    std::vector<float3> gathered_vertices;
+    std::vector<uint3> gathered_indices;
+    auto host_mesh = [&]() -> std::pair<std::span<const float3>, std::span<const uint3>> {
+        if (ga.host_triangles) return {ga.vertices, ga.indices};
+        if (gathered_indices.empty() && ga.triangle_count > 0)
+            core::gather_triangles(scene, node, gathered_vertices, gathered_indices);
+        return {gathered_vertices, gathered_indices};
+    };
     const Acceleration& accel = acceleration_of(node);
     if (accel.builder() == Builder::kGpuHploc || accel.builder() == Builder::kAuto) {
         if (!m_bvh_builder) {
@@ -486,33 +515,40 @@ void GpuScene::update_triangle_bvh(const core::CompiledNode& node,
                                  std::chrono::steady_clock::now() - start)
                                  .count());
         }
+        std::optional<DeviceTriangles> mesh;
+        if (on_device && on_device->size() == 1)
+            mesh = on_device->front();
+        else if (on_device)
+            mesh = m_bvh_builder->gather(*on_device);
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
-                           mirror.bvh.triangle_count == ga.indices.size();
+                           mirror.bvh.triangle_count == ga.triangle_count;
         if (refit) {
-            if (on_device)
-                m_bvh_builder->refit(*on_device, mirror.bvh);
+            if (mesh)
+                m_bvh_builder->refit(*mesh, mirror.bvh);
             else
-                m_bvh_builder->refit(ga.vertices, ga.indices, mirror.bvh);
+                m_bvh_builder->refit(host_mesh().first, host_mesh().second, mirror.bvh);
         } else {
             try {
                 GpuBvhBuildOptions options;
                 if (accel.builder() == Builder::kGpuHploc)
                     options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
-                if (on_device)
-                    m_bvh_builder->build(*on_device, mirror.bvh, options);
+                if (mesh)
+                    m_bvh_builder->build(*mesh, mirror.bvh, options);
                 else
-                    m_bvh_builder->build(ga.vertices, ga.indices, mirror.bvh, options);
+                    m_bvh_builder->build(host_mesh().first, host_mesh().second, mirror.bvh,
+                                         options);
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
                 // bounds its depth (refits keep that tree's topology).
-                upload_gpu_triangle_bvh(build_gpu_triangle_bvh(ga.vertices, ga.indices),
-                                        mirror.bvh);
+                const auto [vertices, indices] = host_mesh();
+                upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices), mirror.bvh);
             }
         }
     } else {
-        upload_gpu_triangle_bvh(build_gpu_triangle_bvh(ga.vertices, ga.indices), mirror.bvh);
+        const auto [vertices, indices] = host_mesh();
+        upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices), mirror.bvh);
     }
-    mirror.empty = ga.indices.empty();
+    mirror.empty = ga.triangle_count == 0;
     mirror.structure = ga.structure_signature;
     mirror.content = ga.content_signature;
     m_accel_ms +=

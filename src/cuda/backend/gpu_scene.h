@@ -82,15 +82,16 @@ class GpuScene {
     void write_record(unsigned offset, const core::CompiledProgram& program);
     void fetch_mirror(BufferMirror& mirror);
     void patch_record(unsigned char* bytes, const core::CompiledProgram& program);
-    void update_triangle_bvh(const core::CompiledNode& node,
-                             std::optional<DeviceTriangles> on_device, GeometryMirror& mirror);
-    std::optional<DeviceTriangles> mirrored_triangles(const core::CompiledScene& scene,
-                                                      const core::CompiledNode& node);
+    void update_triangle_bvh(const core::CompiledScene& scene, const core::CompiledNode& node,
+                             const std::optional<std::vector<DeviceTriangles>>& on_device,
+                             GeometryMirror& mirror);
+    std::optional<std::vector<DeviceTriangles>> mirrored_triangles(
+        const core::CompiledScene& scene, const core::CompiledNode& node);
 
     int m_sm;
     double m_accel_ms = 0;
     struct {
-        unsigned count = 0;
+        unsigned count = 0, cleared = 0;
         double bytes = 0, ms = 0;
     } m_mirror_uploads;  // the last update()'s buffer uploads (LUCENT_GPU_ACCEL_TIMES)
     std::unique_ptr<GpuBvhBuilder> m_bvh_builder;  // made when a GPU build (Builder::kAuto, kGpuHploc) needs it
