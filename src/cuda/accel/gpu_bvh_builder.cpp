@@ -123,7 +123,8 @@ struct GpuBvhBuilder::Impl {
     DeviceBuffer keys, keys_alt, order, order_alt, split_slots, clusters, node_lo, node_hi,
         node_children, node_inner, node_parent, histogram_buffer, counters, arrivals;
     DeviceBuffer host_positions, host_indices;  // uploads of the span overloads
-    DeviceBuffer gathered_positions, gathered_indices, gather_pieces;  // gather()
+    // gather(): the piece table, then the mesh's positions and indices (one allocation).
+    DeviceBuffer gather_scratch;
     // Scratch of the binned-SAH build.
     DeviceBuffer sah_scratch;  // one allocation, carved into the arrays (sah_scratch_layout)
 
@@ -462,6 +463,7 @@ GpuBvhStats GpuBvhBuilder::build(std::span<const float3> positions, std::span<co
 }
 
 DeviceTriangles GpuBvhBuilder::gather(std::span<const DeviceTriangles> pieces) {
+    if (pieces.empty()) return {};
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<gpu::GpuTrianglePiece> table;
     table.reserve(pieces.size());
@@ -479,16 +481,21 @@ DeviceTriangles GpuBvhBuilder::gather(std::span<const DeviceTriangles> pieces) {
                     std::to_string(vertices) +
                     " vertices in one GeometryGroup; split it into groups of fewer than 2^32");
     Impl& s = *m;
-    reserve(s.gathered_positions, sizeof(float3) * std::max<size_t>(vertices, 1));
-    reserve(s.gathered_indices, sizeof(uint3) * std::max<size_t>(triangles, 1));
-    s.gather_pieces.upload(table.data(), table.size() * sizeof(gpu::GpuTrianglePiece));
+    const auto aligned = [](size_t bytes) { return (bytes + 255) & ~size_t(255); };
+    const size_t table_bytes = aligned(table.size() * sizeof(gpu::GpuTrianglePiece));
+    const size_t positions_bytes = aligned(vertices * sizeof(float3));
+    reserve(s.gather_scratch, table_bytes + positions_bytes + triangles * sizeof(uint3));
+    const CUdeviceptr base = s.gather_scratch.ptr();
+    check(api().cuMemcpyHtoD(base, table.data(), table.size() * sizeof(gpu::GpuTrianglePiece)),
+          "GPU BVH builder: the gather's piece table");
     gpu::GpuGatherParams p{};
-    p.pieces = s.gather_pieces.as<gpu::GpuTrianglePiece>();
+    p.pieces = reinterpret_cast<const gpu::GpuTrianglePiece*>(static_cast<uintptr_t>(base));
     p.piece_count = unsigned(table.size());
     p.vertex_total = unsigned(vertices);
     p.triangle_total = unsigned(triangles);
-    p.positions = device_ptr<float3>(s.gathered_positions);
-    p.indices = device_ptr<uint3>(s.gathered_indices);
+    p.positions = reinterpret_cast<float3*>(static_cast<uintptr_t>(base + table_bytes));
+    p.indices =
+        reinterpret_cast<uint3*>(static_cast<uintptr_t>(base + table_bytes + positions_bytes));
     void* args[] = {&p};
     s.launch(s.gather, blocks_for(std::max(vertices, triangles), 256), 256, args,
              "gather the instances' triangles");
@@ -496,9 +503,9 @@ DeviceTriangles GpuBvhBuilder::gather(std::span<const DeviceTriangles> pieces) {
         std::fprintf(stderr, "lucent: GPU BVH build: %zu instances' triangles gathered, %.3f ms\n",
                      pieces.size(), ms_since(t0));
     DeviceTriangles mesh;
-    mesh.positions = s.gathered_positions.ptr();
+    mesh.positions = base + table_bytes;
     mesh.vertex_count = unsigned(vertices);
-    mesh.indices = s.gathered_indices.ptr();
+    mesh.indices = base + table_bytes + positions_bytes;
     mesh.triangle_count = unsigned(triangles);
     return mesh;
 }
