@@ -43,10 +43,6 @@ bool is_empty(const Aabb& b) {
     return b.lo.x > b.hi.x;
 }
 
-uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
-    return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
-}
-
 /// The box of a moving triangle or sphere over its whole time range: the union of its keys'
 /// boxes holds it, since each point moves linearly between keys (OptiX's motion AABBs are
 /// per key; one box over all of them trades some culling for one BVH of the usual kind).
@@ -61,7 +57,7 @@ Aabb motion_primitive_box(const CompiledInstance& inst, const float* motion, uns
             return runtime::motion_point(motion, m, inst.motion_points, i, key, frac);
         };
         if (inst.triangles()) {
-            const uint3 t = triangle_of(inst, prim);
+            const uint3 t = inst.triangle(prim);
             grow(box, point(t.x));
             grow(box, point(t.y));
             grow(box, point(t.z));
@@ -77,7 +73,7 @@ Aabb primitive_box(const CompiledInstance& inst, const float* motion, unsigned p
     if (runtime::moving(inst.motion)) return motion_primitive_box(inst, motion, prim);
     Aabb box = empty_box();
     if (inst.triangles()) {
-        uint3 t = triangle_of(inst, prim);
+        uint3 t = inst.triangle(prim);
         grow(box, inst.vertices[t.x]);
         grow(box, inst.vertices[t.y]);
         grow(box, inst.vertices[t.z]);
@@ -180,11 +176,6 @@ Aabb motion_transform_bounds(const runtime::MotionRange& m, const float* motion,
     }
     return box;
 }
-
-const GeometryTriangles* triangles_of(const CompiledInstance& inst) {
-    return inst.triangles() ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
-                          : nullptr;
-}
 }  // namespace
 
 void SceneCompiler::build_geometry_accel(CompiledNode& node) {
@@ -208,7 +199,7 @@ void SceneCompiler::build_geometry_accel(CompiledNode& node) {
                 m_rebuild_inputs.push_back(b.get());
             }
         }
-        if (const GeometryTriangles* tris = triangles_of(inst)) {
+        if (const GeometryTriangles* tris = inst.triangle_geometry()) {
             structure.add(tris->indices().get())
                 .add(tris->indices() ? tris->indices()->version() : 0);
             content.add(tris->vertices().get()).add(tris->vertices()->version());

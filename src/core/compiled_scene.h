@@ -84,6 +84,15 @@ struct CompiledInstance {
     runtime::MotionRange motion{};
     unsigned motion_points = 0;
     bool triangles() const { return type == PrimitiveType::kTriangles; }
+    /// Built-in triangles: the vertex indices of triangle `prim`.
+    uint3 triangle(unsigned prim) const {
+        return indices ? indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
+    }
+    /// Built-in triangles: their geometry (null for other primitives).
+    const GeometryTriangles* triangle_geometry() const {
+        return triangles() ? static_cast<const GeometryTriangles*>(source->geometry().get())
+                           : nullptr;
+    }
     /// The primitives of the group's BVH this instance adds: one per primitive, but
     /// curve_references(type) per curve segment, each boxing part of it.
     unsigned bvh_references() const {
@@ -135,6 +144,9 @@ struct CompiledEntry {
     CompiledProgram ray_generation;
     CompiledProgram exception;
     std::vector<const Buffer*> output_buffers;  // Output buffers the ray-generation record views
+    /// Every buffer a launch of this entry may write (any program it can run views it
+    /// writably): Context::launch marks them written (Buffer::zeroed).
+    std::vector<const Buffer*> written_buffers;
 };
 
 /// Whether `code` is among the enabled ones (kAllExceptions enables every code, and

@@ -8,7 +8,6 @@
 #include "backends/backend_factory.h"
 #include "core/backend.h"
 #include "core/context_state.h"
-#include "core/launch_buffers.h"
 #include "core/module_registry.h"
 #include "core/runtime_module.h"
 #include "core/scene_compiler.h"
@@ -522,14 +521,11 @@ void Context::launch(unsigned entry, unsigned width, unsigned height, unsigned d
     {
         // Whatever the launch did, buffers it views writably may hold what it wrote.
         struct MarkWritten {
-            const core::CompiledScene& scene;
-            unsigned entry;
+            const std::vector<const Buffer*>& buffers;
             ~MarkWritten() {
-                core::for_each_program(scene, entry, [](const core::CompiledProgram& p) {
-                    for (const auto& b : p.writable_buffers) b->mark_written();
-                });
+                for (const Buffer* b : buffers) b->mark_written();
             }
-        } mark_written{scene, entry};
+        } mark_written{scene.entries[entry].written_buffers};
         m_impl->backend->launch(scene, spec, report);
     }
     // A kernel compile inside the backend's launch is reported apart.

@@ -2,9 +2,11 @@
 #include "core/scene_compiler.h"
 
 #include "core/builtin_geometry.h"
+#include "core/launch_buffers.h"
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 namespace lucent::core {
 
@@ -85,6 +87,13 @@ std::unique_ptr<CompiledScene> SceneCompiler::compile() {
     compile_graph();
     build_accelerations();
     for (const Buffer* b : m_rebuild_inputs) m_scene->rebuild_inputs.emplace_back(b, b->version());
+    for (unsigned e = 0; e < m_scene->entries.size(); ++e) {
+        std::set<const Buffer*> written;
+        for_each_program(*m_scene, e, [&](const CompiledProgram& p) {
+            for (const auto& b : p.writable_buffers) written.insert(b.get());
+        });
+        m_scene->entries[e].written_buffers.assign(written.begin(), written.end());
+    }
     return std::move(m_scene);
 }
 

@@ -4,22 +4,13 @@
 
 namespace lucent::core {
 
-namespace {
-uint3 triangle_of(const CompiledInstance& inst, unsigned prim) {
-    return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
-}
-const GeometryTriangles& triangles_of(const CompiledInstance& inst) {
-    return static_cast<const GeometryTriangles&>(*inst.source->geometry());
-}
-}  // namespace
-
 void gather_triangles(const CompiledScene& scene, const CompiledNode& node,
                       std::vector<float3>& vertices, std::vector<uint3>& indices,
                       std::vector<uint32_t>* tri_instance) {
     size_t vertex_total = 0, triangle_total = 0;
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = scene.instances[i];
-        vertex_total += triangles_of(inst).vertices()->count();
+        vertex_total += inst.triangle_geometry()->vertices()->count();
         triangle_total += inst.primitive_count;
     }
     vertices.clear();
@@ -34,9 +25,9 @@ void gather_triangles(const CompiledScene& scene, const CompiledNode& node,
         const CompiledInstance& inst = scene.instances[node.instances[k]];
         const auto base = uint32_t(vertices.size());
         vertices.insert(vertices.end(), inst.vertices,
-                        inst.vertices + triangles_of(inst).vertices()->count());
+                        inst.vertices + inst.triangle_geometry()->vertices()->count());
         for (unsigned p = 0; p < inst.primitive_count; ++p) {
-            const uint3 t = triangle_of(inst, p);
+            const uint3 t = inst.triangle(p);
             indices.push_back(uint3{t.x + base, t.y + base, t.z + base});
         }
         if (tri_instance) tri_instance->insert(tri_instance->end(), inst.primitive_count, k);
@@ -53,7 +44,7 @@ Aabb triangle_bounds(const CompiledScene& scene, const CompiledNode& node) {
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = scene.instances[i];
         const float3* v = inst.vertices;
-        const size_t vertex_count = triangles_of(inst).vertices()->count();
+        const size_t vertex_count = inst.triangle_geometry()->vertices()->count();
         if (inst.primitive_count == 0) continue;
         if (vertex_count <= 3 * size_t(inst.primitive_count)) {
             // Every vertex of the buffer, in order, rather than through the indices (Sponza's
@@ -64,7 +55,7 @@ Aabb triangle_bounds(const CompiledScene& scene, const CompiledNode& node) {
         } else {
             // A buffer shared by instances that each use a part of it.
             for (unsigned p = 0; p < inst.primitive_count; ++p) {
-                const uint3 t = triangle_of(inst, p);
+                const uint3 t = inst.triangle(p);
                 grow(v[t.x]), grow(v[t.y]), grow(v[t.z]);
             }
         }

@@ -54,7 +54,7 @@ struct CpuPolicy {
         return inst.material_indices ? inst.material_indices[prim] : 0u;
     }
     void triangle(const Instance& inst, unsigned prim, float3& p0, float3& p1, float3& p2) const {
-        const uint3 t = triangle_of(inst, prim);
+        const uint3 t = inst.triangle(prim);
         if (runtime::moving(inst.motion)) {  // at the time of the trace being shaded
             moving_triangle(inst, t, frame_time(), p0, p1, p2);
             return;
@@ -117,9 +117,6 @@ struct CpuPolicy {
         p1 = runtime::motion_point(motion, inst.motion, inst.motion_points, t.y, key, frac);
         p2 = runtime::motion_point(motion, inst.motion, inst.motion_points, t.z, key, frac);
         return present;
-    }
-    static uint3 triangle_of(const Instance& inst, unsigned prim) {
-        return inst.indices ? inst.indices[prim] : uint3{3 * prim, 3 * prim + 1, 3 * prim + 2};
     }
 };
 

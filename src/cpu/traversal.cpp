@@ -122,7 +122,7 @@ class Traverser {
             unsigned local = ref - ga.prim_first[k];
             const CompiledInstance& inst = m_scene.instances[n.instances[k]];
             if (inst.triangles()) {
-                uint3 tri = CpuPolicy::triangle_of(inst, local);
+                uint3 tri = inst.triangle(local);
                 float3 p0 = inst.vertices[tri.x], p1 = inst.vertices[tri.y],
                        p2 = inst.vertices[tri.z];
                 if (runtime::moving(inst.motion) &&

@@ -29,11 +29,6 @@ static_assert(unsigned(PrimitiveType::kCustom) == gpu::kGpuCustom &&
                   unsigned(PrimitiveType::kCurves) == gpu::kGpuCurves,
               "GpuInstance::type holds lucent::PrimitiveType's values");
 
-const GeometryTriangles* triangles_of(const core::CompiledInstance& inst) {
-    return inst.triangles() ? static_cast<const GeometryTriangles*>(inst.source->geometry().get())
-                          : nullptr;
-}
-
 const Acceleration& acceleration_of(const core::CompiledNode& node) {
     return *static_cast<const GeometryGroup*>(node.source)->acceleration();
 }
@@ -236,7 +231,7 @@ void GpuScene::flatten_instances(const core::CompiledScene& scene, FlatScene& fl
         g.user_id = inst.user_id;
         g.intersection = add_program(inst.intersection);
         g.attribute = add_program(inst.attribute);
-        if (const GeometryTriangles* tris = triangles_of(inst)) {
+        if (const GeometryTriangles* tris = inst.triangle_geometry()) {
             g.vertices = reinterpret_cast<const float3*>(device_pointer(tris->vertices()));
             g.indices = reinterpret_cast<const uint3*>(device_pointer(tris->indices()));
             g.material_indices =
@@ -461,7 +456,7 @@ std::optional<std::vector<DeviceTriangles>> GpuScene::mirrored_triangles(
     pieces.reserve(node.instances.size());
     for (unsigned i : node.instances) {
         const core::CompiledInstance& inst = scene.instances[i];
-        const GeometryTriangles* tris = triangles_of(inst);
+        const GeometryTriangles* tris = inst.triangle_geometry();
         if (!tris || !tris->vertices()) return std::nullopt;
         const Buffer& vertices = *tris->vertices();
         const Buffer* indices = tris->indices().get();
@@ -522,21 +517,22 @@ void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
             mesh = m_bvh_builder->gather(*on_device);
         const bool refit = mirror.structure == ga.structure_signature && accel.refit() &&
                            mirror.bvh.triangle_count == ga.triangle_count;
-        if (refit) {
-            if (mesh)
-                m_bvh_builder->refit(*mesh, mirror.bvh);
-            else
-                m_bvh_builder->refit(host_mesh().first, host_mesh().second, mirror.bvh);
+        if (refit && mesh) {
+            m_bvh_builder->refit(*mesh, mirror.bvh);
+        } else if (refit) {
+            const auto [vertices, indices] = host_mesh();
+            m_bvh_builder->refit(vertices, indices, mirror.bvh);
         } else {
             try {
                 GpuBvhBuildOptions options;
                 if (accel.builder() == Builder::kGpuHploc)
                     options.gpu_algorithm = GpuBuildAlgorithm::kHploc;
-                if (mesh)
+                if (mesh) {
                     m_bvh_builder->build(*mesh, mirror.bvh, options);
-                else
-                    m_bvh_builder->build(host_mesh().first, host_mesh().second, mirror.bvh,
-                                         options);
+                } else {
+                    const auto [vertices, indices] = host_mesh();
+                    m_bvh_builder->build(vertices, indices, mirror.bvh, options);
+                }
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
                 // bounds its depth (refits keep that tree's topology).

@@ -466,9 +466,7 @@ __device__ void write_leaf_triangles(const GpuBuildParams& p, unsigned node, uns
             const bool ok = triangle_in_range(p, v);
             const float3 a = ok ? p.positions[v.x] : make_float3(0, 0, 0);
             const float3 b = ok ? p.positions[v.y] : a, c = ok ? p.positions[v.z] : a;
-            p.out_triangles[3 * at + 0] = make_float4(a.x, a.y, a.z, 0.0f);
-            p.out_triangles[3 * at + 1] = make_float4(b.x, b.y, b.z, 0.0f);
-            p.out_triangles[3 * at + 2] = make_float4(c.x, c.y, c.z, 0.0f);
+            gpu_store_triangle(p.out_triangles, at, a, b, c);
             p.out_triangle_ids[at] = t;
             ++at;
         } else {

@@ -36,10 +36,7 @@ __device__ inline void kernel_refit_triangles(GpuRefitParams p) {
     const unsigned t = p.triangle_ids[i];
     const uint3 v = p.indices ? p.indices[t] : make_uint3(3 * t, 3 * t + 1, 3 * t + 2);
     if (v.x >= p.vertex_count || v.y >= p.vertex_count || v.z >= p.vertex_count) return;
-    const float3 a = p.positions[v.x], b = p.positions[v.y], c = p.positions[v.z];
-    p.triangles[3 * i + 0] = make_float4(a.x, a.y, a.z, 0.0f);
-    p.triangles[3 * i + 1] = make_float4(b.x, b.y, b.z, 0.0f);
-    p.triangles[3 * i + 2] = make_float4(c.x, c.y, c.z, 0.0f);
+    gpu_store_triangle(p.triangles, i, p.positions[v.x], p.positions[v.y], p.positions[v.z]);
 }
 
 __device__ inline void set_slot_box(float4* node, unsigned slot, float3 lo, float3 hi) {

@@ -45,22 +45,25 @@ LUCENT_HD inline unsigned sah_atomic_add(unsigned* a, unsigned v) {
     return std::atomic_ref<unsigned>(*a).fetch_add(v);
 #endif
 }
-LUCENT_HD inline void sah_atomic_min(int* a, int v) {
+/// Atomic min and max of an int or an unsigned (CUDA's atomicMin / atomicMax overloads).
+template <class T>
+LUCENT_HD inline void sah_atomic_min(T* a, T v) {
 #if LUCENT_GPU_CODE
     atomicMin(a, v);
 #else
-    std::atomic_ref<int> r(*a);
-    int old = r.load();
+    std::atomic_ref<T> r(*a);
+    T old = r.load();
     while (v < old && !r.compare_exchange_weak(old, v)) {
     }
 #endif
 }
-LUCENT_HD inline void sah_atomic_max(int* a, int v) {
+template <class T>
+LUCENT_HD inline void sah_atomic_max(T* a, T v) {
 #if LUCENT_GPU_CODE
     atomicMax(a, v);
 #else
-    std::atomic_ref<int> r(*a);
-    int old = r.load();
+    std::atomic_ref<T> r(*a);
+    T old = r.load();
     while (v > old && !r.compare_exchange_weak(old, v)) {
     }
 #endif
@@ -71,26 +74,6 @@ LUCENT_HD inline void sah_atomic_first(unsigned* a, unsigned v) {  // keeps the 
 #else
     unsigned expected = 0;
     std::atomic_ref<unsigned>(*a).compare_exchange_strong(expected, v);
-#endif
-}
-LUCENT_HD inline void sah_atomic_min_u(unsigned* a, unsigned v) {
-#if LUCENT_GPU_CODE
-    atomicMin(a, v);
-#else
-    std::atomic_ref<unsigned> r(*a);
-    unsigned old = r.load();
-    while (v < old && !r.compare_exchange_weak(old, v)) {
-    }
-#endif
-}
-LUCENT_HD inline void sah_atomic_max_u(unsigned* a, unsigned v) {
-#if LUCENT_GPU_CODE
-    atomicMax(a, v);
-#else
-    std::atomic_ref<unsigned> r(*a);
-    unsigned old = r.load();
-    while (v > old && !r.compare_exchange_weak(old, v)) {
-    }
 #endif
 }
 /// Makes this thread's stores visible before its next atomic (the bottom-up pass).

@@ -108,7 +108,7 @@ LUCENT_HD inline void sah_emit(const GpuSahBuildParams& p, unsigned x) {
 #else
     out[3] = make_float4(std::bit_cast<float>(ref0), std::bit_cast<float>(ref1), 0.0f, 0.0f);
 #endif
-    sah_atomic_max_u(&p.counters[kSahDepth], depth);
+    sah_atomic_max(&p.counters[kSahDepth], depth);
     if (index == 0) {
         p.out_parents[0] = kSahInvalid;
         const float a = sah_half_area(sah_xyz(p.node_lo[x]), sah_xyz(p.node_hi[x]));
@@ -125,9 +125,7 @@ LUCENT_HD inline void sah_triangles(const GpuSahBuildParams& p, unsigned at) {
     const bool ok = v.x < p.vertex_count && v.y < p.vertex_count && v.z < p.vertex_count;
     const float3 a = ok ? p.positions[v.x] : make_float3(0.0f, 0.0f, 0.0f);
     const float3 b = ok ? p.positions[v.y] : a, c = ok ? p.positions[v.z] : a;
-    p.out_triangles[3 * at + 0] = make_float4(a.x, a.y, a.z, 0.0f);
-    p.out_triangles[3 * at + 1] = make_float4(b.x, b.y, b.z, 0.0f);
-    p.out_triangles[3 * at + 2] = make_float4(c.x, c.y, c.z, 0.0f);
+    gpu_store_triangle(p.out_triangles, at, a, b, c);
     p.out_triangle_ids[at] = t;
 }
 

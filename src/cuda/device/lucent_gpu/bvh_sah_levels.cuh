@@ -55,7 +55,7 @@ LUCENT_HD inline void sah_init(const GpuSahBuildParams& p, unsigned block, unsig
             lo = fminf(a, fminf(b, c));
             hi = fmaxf(a, fmaxf(b, c));
         } else {
-            sah_atomic_min_u(&p.counters[kSahBadIndex], i);
+            sah_atomic_min(&p.counters[kSahBadIndex], i);
         }
         p.prim_lo[i] = make_float4(lo.x, lo.y, lo.z, 0.0f);
         p.prim_hi[i] = make_float4(hi.x, hi.y, hi.z, 0.0f);

@@ -126,6 +126,14 @@ LUCENT_HD inline int gpu_active_lanes() {
 #endif
 }
 
+/// Writes leaf-order triangle i (three float4 at tris + 3i) from its vertices: what both
+/// GPU builders and the refit store.
+LUCENT_HD inline void gpu_store_triangle(float4* tris, unsigned i, float3 a, float3 b, float3 c) {
+    tris[3 * i + 0] = make_float4(a.x, a.y, a.z, 0.0f);
+    tris[3 * i + 1] = make_float4(b.x, b.y, b.z, 0.0f);
+    tris[3 * i + 2] = make_float4(c.x, c.y, c.z, 0.0f);
+}
+
 /// The watertight test of leaf-order triangle i (three float4 at tris + 3i) within
 /// (tmin, tmax): the CPU's test, so the GPU finds the CPU's hits.
 LUCENT_HD inline bool gpu_intersect_triangle(const float4* tris, unsigned i,
