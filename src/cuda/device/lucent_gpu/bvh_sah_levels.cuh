@@ -206,7 +206,7 @@ LUCENT_HD inline void sah_split(const GpuSahBuildParams& p, unsigned block, unsi
             for (unsigned w = t; w < 3 * nb * kSahBinWords; w += threads) s.bins[w] = global[w];
         });
         sah_step(threads, [&](unsigned t) {
-            if (t < 3) s.best[t] = sah_sweep_axis(s.bins + t * nb * kSahBinWords, nb);
+            sah_sweep_axes(s.bins, nb, s.best, t, threads);
         });
     }
     sah_step(threads, [&](unsigned t) {

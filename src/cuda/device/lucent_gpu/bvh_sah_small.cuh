@@ -63,7 +63,7 @@ LUCENT_HD inline void sah_small_node(const GpuSahBuildParams& p, unsigned thread
             }
         });
         sah_step(threads, [&](unsigned t) {
-            if (t < 3) s.best[t] = sah_sweep_axis(s.bins + t * nb * kSahBinWords, nb);
+            sah_sweep_axes(s.bins, nb, s.best, t, threads);
         });
     }
     sah_step(threads, [&](unsigned t) {
