@@ -307,12 +307,10 @@ hotspots)
     ;;
 bench)
     for s in sponza sibenik bunny dragon cornell/CornellBox-Original; do
-        # The bare kernels and the engine path (--programs: issue 25's table).
-        echo "== bench rays --backend cuda --programs $s"
+        echo "== bench rays --backend cuda $s"
+        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
         $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9 \
-            --programs
-        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9 \
-            --programs --json > "$out/rays-cuda-$(basename $s .obj).json"
+            --json > "$out/rays-cuda-$(basename $s .obj).json"
     done
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj
     ;;
@@ -325,14 +323,6 @@ builder)
     for s in sponza sibenik dragon bunny; do
         echo "== bench build --backend cuda $s"
         $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
-    done
-    # The experiment: the levels of big tasks in one cooperative launch (the same tree; the
-    # builder tests compare it with the host's). A hang would be a grid barrier's fault.
-    echo "== LUCENT_GPU_SAH_LEVELS=persistent: builder tests and bench build"
-    LUCENT_GPU_SAH_LEVELS=persistent timeout 300 $R $B/bin/gpu_bvh_builder_test 2>&1 | tail -3
-    for s in sponza dragon; do
-        LUCENT_GPU_SAH_LEVELS=persistent LUCENT_GPU_ACCEL_TIMES=1 timeout 60 \
-            $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
     done
     echo "== bench build --backend cuda: sponza cut twice (1.06M triangles)"
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj --subdivide 2 --repeat 9

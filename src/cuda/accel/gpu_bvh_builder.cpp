@@ -50,20 +50,6 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Blocks of `threads` of `f` that fit on the current device at once (a cooperative
-/// launch's most), or 0 where it cannot launch cooperatively.
-unsigned persistent_blocks(CUfunction f, unsigned threads) {
-    const DriverApi& d = api();
-    CUdevice device = 0;
-    int cooperative = 0, sms = 0, per_sm = 0;
-    check(d.cuCtxGetDevice(&device), "cuCtxGetDevice");
-    d.cuDeviceGetAttribute(&cooperative, CU_DEVICE_ATTRIBUTE_COOPERATIVE_LAUNCH, device);
-    d.cuDeviceGetAttribute(&sms, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, device);
-    check(d.cuOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, f, int(threads), 0),
-          "cuOccupancyMaxActiveBlocksPerMultiprocessor");
-    return cooperative ? unsigned(sms * per_sm) : 0u;
-}
-
 unsigned blocks_for(size_t count, unsigned block) {
     return unsigned((count + block - 1) / block);
 }
@@ -131,10 +117,6 @@ struct GpuBvhBuilder::Impl {
                scatter = nullptr, refit_triangles = nullptr, refit_nodes = nullptr,
                gather = nullptr;
     CUfunction sah[int(gpu::GpuSahPass::kPassCount)] = {};
-    // LUCENT_GPU_SAH_LEVELS=persistent: the levels of big tasks in one cooperative launch of
-    // this many blocks (all resident at once); 0: as three launches a level.
-    CUfunction sah_levels = nullptr;
-    unsigned sah_levels_blocks = 0;
     CUevent start = nullptr, stop = nullptr;
     CUevent phase[2] = {};  // LUCENT_GPU_ACCEL_TIMES: after the big levels, after the small tasks
     // Scratch, grown to the largest mesh seen.
@@ -229,9 +211,6 @@ GpuBvhBuilder::GpuBvhBuilder(int sm) : m(std::make_unique<Impl>()) {
                                "lucent_sah_count", "lucent_sah_emit",      "lucent_sah_triangles"};
     static_assert(std::size(sah_names) == size_t(gpu::GpuSahPass::kPassCount));
     for (size_t k = 0; k < std::size(sah_names); ++k) m->sah[k] = fn(sah_names[k]);
-    m->sah_levels = fn("lucent_sah_levels");
-    if (const char* v = std::getenv("LUCENT_GPU_SAH_LEVELS"); v && std::strcmp(v, "persistent") == 0)
-        m->sah_levels_blocks = persistent_blocks(m->sah_levels, gpu::kSahBlock);
     check(d.cuEventCreate(&m->start, CU_EVENT_DEFAULT), "cuEventCreate");
     check(d.cuEventCreate(&m->stop, CU_EVENT_DEFAULT), "cuEventCreate");
     for (CUevent& e : m->phase) check(d.cuEventCreate(&e, CU_EVENT_DEFAULT), "cuEventCreate");
@@ -417,34 +396,25 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
     const auto t0 = std::chrono::steady_clock::now();
     unsigned levels = 0;
     check(api().cuEventRecord(start, nullptr), "cuEventRecord");
-    const auto run = [&](gpu::GpuSahPass pass, unsigned level) {
-        if (print_times() && pass == gpu::GpuSahPass::kSmall)
-            check(api().cuEventRecord(phase[0], nullptr), "cuEventRecord");
-        if (print_times() && pass == gpu::GpuSahPass::kCount)
-            check(api().cuEventRecord(phase[1], nullptr), "cuEventRecord");
-        if (pass == gpu::GpuSahPass::kBin) levels = level + 1;
-        p.level = level;
-        void* args[] = {&p};
-        const gpu::GpuSahShape shape = gpu::gpu_sah_shape(pass, n, small_limit);
-        launch(sah[int(pass)], shape.blocks, shape.threads, args, kPassNames[int(pass)]);
-    };
-    if (sah_levels_blocks > 0) {
-        gpu::gpu_sah_build_passes_with(n, small_limit, run, [&] {
-            const unsigned blocks = std::min(sah_levels_blocks, blocks_for(n, gpu::kSahBlock));
-            p.level = 0;
+    gpu::gpu_sah_build_passes(
+        n, small_limit,
+        [&](gpu::GpuSahPass pass, unsigned level) {
+            if (print_times() && pass == gpu::GpuSahPass::kSmall)
+                check(api().cuEventRecord(phase[0], nullptr), "cuEventRecord");
+            if (print_times() && pass == gpu::GpuSahPass::kCount)
+                check(api().cuEventRecord(phase[1], nullptr), "cuEventRecord");
+            if (pass == gpu::GpuSahPass::kBin) levels = level + 1;
+            p.level = level;
             void* args[] = {&p};
-            check(api().cuLaunchCooperativeKernel(sah_levels, blocks, 1, 1, gpu::kSahBlock, 1, 1,
-                                                  0, nullptr, args),
-                  "BVH build (SAH): the levels, one cooperative launch");
-        });
-    } else {
-        gpu::gpu_sah_build_passes(n, small_limit, run, [&](unsigned parity) {
+            const gpu::GpuSahShape shape = gpu::gpu_sah_shape(pass, n, small_limit);
+            launch(sah[int(pass)], shape.blocks, shape.threads, args, kPassNames[int(pass)]);
+        },
+        [&](unsigned parity) {
             unsigned count = 0;
             check(api().cuMemcpyDtoH(&count, counters_ptr + 4 * (gpu::kSahTaskCount + parity), 4),
                   "GPU BVH build: task count");
             return count;
         });
-    }
     GpuBvhStats stats;
     stats.builder = "binned SAH (GPU)";
     stats.build_ms = elapsed_ms();
@@ -454,12 +424,9 @@ GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTrian
         check(api().cuEventElapsedTime(&small_ms, phase[0], phase[1]), "cuEventElapsedTime");
         std::fprintf(stderr,
                      "lucent: GPU BVH build (binned SAH) of %u triangles: %.3f ms on the host; "
-                     "GPU %.3f ms: boxes and %s levels of big tasks %.3f ms, small tasks (up to "
+                     "GPU %.3f ms: boxes and %u levels of big tasks %.3f ms, small tasks (up to "
                      "%u triangles) %.3f ms, layout %.3f ms\n",
-                     n, ms_since(t0), stats.build_ms,
-                     sah_levels_blocks ? "one cooperative launch of the"
-                                       : std::to_string(levels).c_str(),
-                     big, small_limit, small_ms,
+                     n, ms_since(t0), stats.build_ms, levels, big, small_limit, small_ms,
                      stats.build_ms - big - small_ms);
     }
 

@@ -27,9 +27,6 @@
 //     its parent, as the host's layout) and writes its 64-byte node; lucent_sah_triangles
 //     copies the triangles into leaf order.
 //
-// LUCENT_GPU_SAH_LEVELS=persistent (an experiment, not yet timed): passes 2-4 of every
-// level in one cooperative launch, lucent_sah_levels, with grid barriers between them.
-//
 // Every kernel body is a plain function built for the host too: a per-thread pass is a
 // function of (params, thread); a per-block pass a function of (params, block, shared
 // memory) written as steps (sah_step) with a barrier after each. Tests run the whole build on
@@ -106,25 +103,14 @@ inline unsigned gpu_sah_unread_levels(unsigned n, unsigned small_limit) {
     return balanced + balanced / 2 + 2;
 }
 
-/// Runs the passes of a build over n >= 1 triangles: run(pass, level) launches one, and
-/// levels() runs the levels of big tasks, when there are any.
-template <class Run, class Levels>
-void gpu_sah_build_passes_with(unsigned n, unsigned small_limit, Run&& run, Levels&& levels) {
-    run(GpuSahPass::kReset, 0u);
-    run(GpuSahPass::kInit, 0u);
-    if (n > small_limit) levels();
-    run(GpuSahPass::kSmall, 0u);
-    run(GpuSahPass::kCount, 0u);
-    run(GpuSahPass::kEmit, 0u);
-    run(GpuSahPass::kTriangles, 0u);
-}
-
-/// The passes with the levels of big tasks run as three passes each: tasks_of(parity)
-/// reads how many big tasks the level about to run has (after the first
+/// Runs the passes of a build over n >= 1 triangles: run(pass, level) launches one,
+/// tasks_of(parity) reads how many big tasks the level about to run has (after the first
 /// gpu_sah_unread_levels levels, every 4 levels).
 template <class Run, class TasksOf>
 void gpu_sah_build_passes(unsigned n, unsigned small_limit, Run&& run, TasksOf&& tasks_of) {
-    gpu_sah_build_passes_with(n, small_limit, run, [&] {
+    run(GpuSahPass::kReset, 0u);
+    run(GpuSahPass::kInit, 0u);
+    if (n > small_limit) {
         const unsigned unread = gpu_sah_unread_levels(n, small_limit);
         for (unsigned level = 0; level < kSahLevels; ++level) {
             if (level >= unread && (level - unread) % 4 == 0 && tasks_of(level & 1u) == 0) break;
@@ -132,7 +118,11 @@ void gpu_sah_build_passes(unsigned n, unsigned small_limit, Run&& run, TasksOf&&
             run(GpuSahPass::kSplit, level);
             run(GpuSahPass::kPartition, level);
         }
-    });
+    }
+    run(GpuSahPass::kSmall, 0u);
+    run(GpuSahPass::kCount, 0u);
+    run(GpuSahPass::kEmit, 0u);
+    run(GpuSahPass::kTriangles, 0u);
 }
 
 /// Words of scratch a build of n triangles needs beyond its nodes (for the launcher and the
@@ -218,74 +208,6 @@ extern "C" __global__ void __launch_bounds__(32)
     lucent_sah_small(lucent::gpu::GpuSahBuildParams p) {
     __shared__ lucent::gpu::SahSmallShared s;
     lucent::gpu::sah_small(p, blockDim.x, s);
-}
-
-namespace lucent::gpu {
-/// A barrier of every block of a cooperative launch (all of them resident at once, which
-/// cuLaunchCooperativeKernel guarantees): thread 0 of each block arrives on a counter, and
-/// the last to arrive opens the next generation. The fences order every block's writes
-/// before the barrier with every block's reads after it.
-__device__ inline void sah_grid_barrier(const GpuSahBuildParams& p) {
-    __syncthreads();
-    if (threadIdx.x == 0) {
-        volatile unsigned* generation = p.counters + kSahBarrierGeneration;
-        const unsigned passed = *generation;
-        __threadfence();
-        if (atomicAdd(p.counters + kSahBarrierArrived, 1u) == gridDim.x - 1) {
-            atomicExch(p.counters + kSahBarrierArrived, 0u);
-            __threadfence();
-            atomicAdd(p.counters + kSahBarrierGeneration, 1u);
-        } else {
-            while (*generation == passed) {
-#if __CUDA_ARCH__ >= 700
-                __nanosleep(20);
-#endif
-            }
-        }
-        __threadfence();
-    }
-    __syncthreads();
-}
-}  // namespace lucent::gpu
-
-/// The levels of big tasks in one cooperative launch, a grid barrier between passes instead
-/// of a launch each (LUCENT_GPU_SAH_LEVELS=persistent, an experiment): each block runs the
-/// bin and partition passes' blocks in turn, and each of its warps the split pass's tasks;
-/// the loop ends at the first level without tasks, read on the GPU (no host read).
-extern "C" __global__ void __launch_bounds__(lucent::gpu::kSahBlock)
-    lucent_sah_levels(lucent::gpu::GpuSahBuildParams p) {
-    using namespace lucent::gpu;
-    constexpr unsigned kWarpsPerBlock = kSahBlock / kSahWarp;
-    __shared__ union {
-        SahBinShared bin;
-        SahSplitShared split[kWarpsPerBlock];
-        SahPartitionShared partition;
-    } s;
-    const unsigned place_blocks = (p.triangle_count + kSahBlock - 1) / kSahBlock;
-    const unsigned warp = threadIdx.x / kSahWarp;
-    for (unsigned level = 0; level < kSahLevels; ++level) {
-        p.level = level;
-        // Made by the level above's split, before the barrier; fixed during this level.
-        const unsigned tasks =
-            *static_cast<volatile unsigned*>(p.counters + kSahTaskCount + (level & 1u));
-        if (tasks == 0) break;
-        for (unsigned b = blockIdx.x; b < place_blocks; b += gridDim.x) {
-            sah_bin(p, b, kSahBlock, s.bin);
-            __syncthreads();
-        }
-        sah_grid_barrier(p);
-        for (unsigned t = blockIdx.x * kWarpsPerBlock + warp; t < tasks;
-             t += gridDim.x * kWarpsPerBlock) {
-            sah_split(p, t, kSahWarp, s.split[warp]);
-            __syncwarp();
-        }
-        sah_grid_barrier(p);
-        for (unsigned b = blockIdx.x; b < place_blocks; b += gridDim.x) {
-            sah_partition(p, b, kSahBlock, s.partition);
-            __syncthreads();
-        }
-        sah_grid_barrier(p);
-    }
 }
 LUCENT_SAH_THREAD_KERNEL(lucent_sah_count, sah_count, 128)
 LUCENT_SAH_THREAD_KERNEL(lucent_sah_emit, sah_emit, 128)

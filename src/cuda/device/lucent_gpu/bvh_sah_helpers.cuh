@@ -398,19 +398,13 @@ LUCENT_HD inline void sah_write_node_box(const GpuSahBuildParams& p, unsigned no
 /// One step of a block's work: f(thread) on every thread of the block, then a barrier. On
 /// the CPU the threads run one after another: what a thread keeps from one step to the next
 /// lives in the block's shared struct, indexed by thread, and a block's control flow reads
-/// only shared values (the same for every thread). A pass of one warp a block (split, small
-/// tasks) may also run as one of several warps of a larger block, each on its own work
-/// (lucent_sah_levels): then its threads are the warp's lanes and its barrier the warp's.
+/// only shared values (the same for every thread).
 template <class F>
 LUCENT_HD inline void sah_step(unsigned threads, F&& f) {
 #if LUCENT_GPU_CODE
-    if (threads == kSahWarp && blockDim.x > kSahWarp) {  // one warp's work in a larger block
-        f(threadIdx.x % kSahWarp);
-        __syncwarp();
-    } else {
-        f(threadIdx.x);
-        __syncthreads();
-    }
+    (void)threads;
+    f(threadIdx.x);
+    __syncthreads();
 #else
     for (unsigned t = 0; t < threads; ++t) f(t);
 #endif

@@ -41,9 +41,7 @@ enum GpuSahCounter : int {
     kSahCost = 7,        // SAH cost of the tree (as the host's Bvh::sah_cost), float bits
     kSahInner = 8,       // inner nodes emitted
     kSahFault = 9,       // 0, or the first GpuSahFault
-    kSahBarrierArrived = 10,     // lucent_sah_levels' grid barrier: blocks arrived
-    kSahBarrierGeneration = 11,  // and barriers passed
-    kSahCounterCount = 12
+    kSahCounterCount = 10
 };
 
 enum GpuSahFault : unsigned {
