@@ -307,10 +307,12 @@ hotspots)
     ;;
 bench)
     for s in sponza sibenik bunny dragon cornell/CornellBox-Original; do
-        echo "== bench rays --backend cuda $s"
-        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9
+        # The bare kernels and the engine path (--programs: issue 25's table).
+        echo "== bench rays --backend cuda --programs $s"
         $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9 \
-            --json > "$out/rays-cuda-$(basename $s .obj).json"
+            --programs
+        $R $B/bin/lucent bench rays --backend cuda --scene /work/shared/scenes/$s.obj --repeat 9 \
+            --programs --json > "$out/rays-cuda-$(basename $s .obj).json"
     done
     $R $B/bin/lucent bench build --backend cuda --scene /work/shared/scenes/sponza.obj
     ;;
