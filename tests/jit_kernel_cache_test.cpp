@@ -38,9 +38,11 @@ class KernelCache : public ::testing::Test {
     }
     /// The kernels' folder under the cache.
     fs::path kernels() const { return dir / "kernels"; }
+    /// The one CUBIN entry (beside it, `.calls` keeps its call graph).
     fs::path only_entry() const {
         std::vector<fs::path> files;
-        for (auto& e : fs::directory_iterator(kernels())) files.push_back(e.path());
+        for (auto& e : fs::directory_iterator(kernels()))
+            if (e.path().extension() == ".cubin") files.push_back(e.path());
         EXPECT_EQ(files.size(), 1u);
         return files.empty() ? fs::path() : files[0];
     }
@@ -55,6 +57,34 @@ TEST_F(KernelCache, SecondCompileIsAHitWithTheSameBinary) {
     auto warm = lucent::cuda::compile_cubin(request);
     EXPECT_TRUE(warm.from_cache);
     EXPECT_EQ(warm.cubin, cold.cubin);
+}
+
+TEST_F(KernelCache, TheCallGraphIsKeptBesideTheBinary) {
+    // f and g call each other; scale calls f: the graph ptx_calls.h reads from the PTX, and
+    // the same graph from the cache's `.calls` entry on a hit.
+    request.source =
+        "__device__ __noinline__ int g(int x);\n"
+        "__device__ __noinline__ int f(int x) { return x > 0 ? g(x - 1) * 2 : 1; }\n"
+        "__device__ __noinline__ int g(int x) { return x > 0 ? f(x - 1) + 1 : 0; }\n"
+        "extern \"C\" __global__ void scale(int* x) { x[threadIdx.x] = f(x[threadIdx.x]); }\n";
+    auto cold = lucent::cuda::compile_cubin(request);
+    ASSERT_TRUE(cold.call_graph_known);
+    const lucent::cuda::PtxCallGraph expected{
+        {"scale", {"_Z1fi"}}, {"_Z1fi", {"_Z1gi"}}, {"_Z1gi", {"_Z1fi"}}};
+    EXPECT_EQ(cold.call_graph, expected);
+    EXPECT_EQ(lucent::cuda::recursive_functions(cold.call_graph),
+              (std::vector<std::string>{"_Z1fi", "_Z1gi"}));
+    auto warm = lucent::cuda::compile_cubin(request);
+    ASSERT_TRUE(warm.from_cache);
+    ASSERT_TRUE(warm.call_graph_known);
+    EXPECT_EQ(warm.call_graph, expected);
+    // Without its `.calls` entry (cached before call graphs were kept) the graph is unknown.
+    fs::path calls = only_entry();
+    calls.replace_extension(".calls");
+    ASSERT_TRUE(fs::remove(calls));
+    auto older = lucent::cuda::compile_cubin(request);
+    EXPECT_TRUE(older.from_cache);
+    EXPECT_FALSE(older.call_graph_known);
 }
 
 TEST_F(KernelCache, CorruptEntryIsRebuiltNotLoaded) {

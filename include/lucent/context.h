@@ -122,6 +122,10 @@ struct LaunchReport {
     /// CUDA: this launch ran the kernel's variant compiled for at most 64 registers a thread
     /// (compiled in the background after the first launch; one more shape the tuning times).
     bool registers_capped = false;
+    /// CUDA: this launch ran the kernel's variant with trace() inlined into its
+    /// ray-generation program (compiled in the background where no program that a trace
+    /// runs traces again; one more shape the tuning times).
+    bool trace_inlined = false;
     /// Multi-device launches: what each device ran, in ContextOptions::devices order.
     struct DeviceShare {
         std::string device;      // "cuda:0"

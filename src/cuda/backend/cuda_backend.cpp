@@ -39,6 +39,10 @@ constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
 // for the path tracer on Sponza; so it is one more shape for the tuning to time, not a rule.
 constexpr int kCappedBlocksPerSm = 8;
 constexpr int kCappedRegisters = 65536 / (kCappedBlocksPerSm * 128);
+const std::string kCappedOption = "-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(kCappedBlocksPerSm);
+// The inline-trace variant (megakernel_compiler.h, can_inline_trace): trace() inlined into
+// the ray-generation program where no program a trace runs traces again.
+const std::string kInlineTraceOption = "-DLUCENT_GPU_INLINE_TRACE=1";
 
 constexpr size_t kExceptionBytes = sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots;
 
@@ -50,9 +54,11 @@ class CudaBackend final : public core::Backend {
         CUfunction function = nullptr;
         CUdeviceptr params = 0;  // the module's launch parameters
         int carveout = -1;       // the carveout last set on the function
+        bool registers_capped = false, trace_inlined = false;  // the variant's options
     };
-    /// A ray-generation program's kernel: its variants (0: as compiled; 1: registers capped,
-    /// once compiled) and the launch shapes of all of them (launch_shapes.h).
+    /// A ray-generation program's kernel: its variants (0: as compiled; then, once compiled,
+    /// registers capped, trace inlined, or both) and the launch shapes of all of them
+    /// (launch_shapes.h).
     struct RayGenerationKernel {
         std::vector<KernelCode> codes;
         std::vector<LaunchShape> shapes{LaunchShape{}};  // shape 0: occupancy first
@@ -163,7 +169,7 @@ class CudaBackend final : public core::Backend {
         // The kernel of the entry's ray-generation program (the context refuses a launch of
         // an entry without one), and its launch shape: fixed by LUCENT_GPU_CARVEOUT, else
         // tuned per entry and size.
-        adopt_capped_variants();
+        adopt_variants();
         m_kernel = &m_kernels.at(size_t(p.ray_generation.id));
         m_tuning_key = {spec.entry, p.launch_count};
         m_shape_trial = false;
@@ -279,7 +285,9 @@ class CudaBackend final : public core::Backend {
         m_driver.cuEventElapsedTime(&kernel_ms, m_start, m_stop);
         report.kernel_ms = kernel_ms;
         report.launch_shape_trial = m_shape_trial;
-        report.registers_capped = m_kernel->shapes[size_t(m_shape)].variant > 0;
+        const KernelCode& ran = m_kernel->codes.at(size_t(m_kernel->shapes[size_t(m_shape)].variant));
+        report.registers_capped = ran.registers_capped;
+        report.trace_inlined = ran.trace_inlined;
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
@@ -387,7 +395,7 @@ class CudaBackend final : public core::Backend {
         size_t stack = 1024 + size_t(shape.max_depth) * (2 * shape.attribute_bytes + 1536);
         check(m_driver.cuCtxSetLimit(CU_LIMIT_STACK_SIZE, stack), "set the stack size");
         m_source = std::move(text);
-        start_capped_variants(kernel);
+        start_variants(kernel);
     }
 
     /// A compiled kernel loaded as its own module.
@@ -404,12 +412,14 @@ class CudaBackend final : public core::Backend {
         return code;
     }
 
-    /// Compiles the register-capped variant of every kernel that uses more registers than
-    /// the cap allows, on other threads while launches run (ContextOptions::register_variants,
-    /// or LUCENT_GPU_REGISTER_VARIANTS: "sync" compiles them here, "off" not at all);
-    /// adopt_capped_variants adds them to the kernels' shapes. Not with a fixed carveout or
-    /// a block count in LUCENT_NVRTC_OPTIONS (experiments that choose the shape themselves).
-    void start_capped_variants(const Megakernel& kernel) {
+    /// Compiles the variants of each kernel, on other threads while launches run
+    /// (ContextOptions::register_variants, or LUCENT_GPU_REGISTER_VARIANTS: "sync" compiles
+    /// them here, "off" not at all): registers capped where the kernel uses more than the
+    /// cap allows, trace() inlined where its trace_ray is not recursive, and both where both
+    /// hold. adopt_variants adds them to the kernels' shapes. Not with a fixed carveout, or
+    /// a block count or the inlining in LUCENT_NVRTC_OPTIONS (experiments that choose the
+    /// shape or the code themselves).
+    void start_variants(const Megakernel& kernel) {
         const char* mode_env = std::getenv("LUCENT_GPU_REGISTER_VARIANTS");
         const std::string mode = mode_env && *mode_env ? mode_env
                                  : m_register_variants == RegisterVariants::kOff ? "off"
@@ -418,47 +428,67 @@ class CudaBackend final : public core::Backend {
                                      : "background";
         const char* options = std::getenv("LUCENT_NVRTC_OPTIONS");
         if (mode == "off" || m_fixed_shape ||
-            (options && std::strstr(options, "LUCENT_GPU_MIN_BLOCKS")))
+            (options && (std::strstr(options, "LUCENT_GPU_MIN_BLOCKS") ||
+                         std::strstr(options, "LUCENT_GPU_INLINE_TRACE"))))
             return;
-        m_capped_kernels.clear();
+        m_variants.clear();
+        std::vector<CompileRequest> requests;
         for (size_t i = 0; i < m_kernels.size(); ++i) {
             int registers = 0;
             m_driver.cuFuncGetAttribute(&registers, CU_FUNC_ATTRIBUTE_NUM_REGS,
                                         m_kernels[i].codes[0].function);
-            if (registers > kCappedRegisters) m_capped_kernels.push_back(i);
+            const bool cap = registers > kCappedRegisters;
+            const bool inline_trace = can_inline_trace(kernel.binaries.at(i));
+            auto add = [&](bool capped, bool inlined) {
+                std::vector<std::string> extra;
+                if (capped) extra.push_back(kCappedOption);
+                if (inlined) extra.push_back(kInlineTraceOption);
+                requests.push_back(std::move(unit_requests(kernel, m_sm, {i}, extra).at(0)));
+                m_variants.push_back({i, capped, inlined});
+            };
+            if (cap) add(true, false);
+            if (inline_trace) add(false, true);
+            if (cap && inline_trace) add(true, true);
         }
-        if (m_capped_kernels.empty()) return;
-        std::vector<CompileRequest> requests =
-            unit_requests(kernel, m_sm, m_capped_kernels,
-                          {"-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(kCappedBlocksPerSm)});
+        if (m_variants.empty()) return;
         if (mode == "sync") {
-            adopt_capped(compile_units(requests));
+            std::vector<CompileResult> binaries;
+            try {
+                binaries = compile_units(requests);
+            } catch (const std::exception&) {
+                m_variants.clear();  // as in the background: the kernels as compiled run
+                return;
+            }
+            adopt(binaries);
             return;
         }
-        m_capped = std::async(std::launch::async,
-                              [requests = std::move(requests)] { return compile_units(requests); });
+        m_variants_compiling = std::async(
+            std::launch::async, [requests = std::move(requests)] { return compile_units(requests); });
     }
 
-    /// At a launch's start: the capped variants, once compiled, become shapes of their
-    /// kernels. A variant that failed to compile is left out (the kernels as compiled run).
-    void adopt_capped_variants() {
-        if (!m_capped.valid() ||
-            m_capped.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    /// At a launch's start: the variants, once compiled, become shapes of their kernels. If
+    /// one failed to compile, none is added (the kernels as compiled run).
+    void adopt_variants() {
+        if (!m_variants_compiling.valid() ||
+            m_variants_compiling.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
             return;
         std::vector<CompileResult> binaries;
         try {
-            binaries = m_capped.get();
+            binaries = m_variants_compiling.get();
         } catch (const std::exception&) {
+            m_variants.clear();
             return;
         }
-        adopt_capped(binaries);
+        adopt(binaries);
     }
 
-    void adopt_capped(const std::vector<CompileResult>& binaries) {
-        for (size_t j = 0; j < binaries.size() && j < m_capped_kernels.size(); ++j) {
-            const size_t i = m_capped_kernels[j];
-            RayGenerationKernel& k = m_kernels[i];
-            KernelCode code = load_code(binaries[j].cubin, i);
+    void adopt(const std::vector<CompileResult>& binaries) {
+        for (size_t j = 0; j < binaries.size() && j < m_variants.size(); ++j) {
+            const Variant& v = m_variants[j];
+            RayGenerationKernel& k = m_kernels[v.kernel];
+            KernelCode code = load_code(binaries[j].cubin, v.kernel);
+            code.registers_capped = v.registers_capped;
+            code.trace_inlined = v.trace_inlined;
             std::vector<LaunchShape> shapes = launch_shapes(code.function, nullptr);
             for (LaunchShape& shape : shapes) {
                 shape.variant = int(k.codes.size());
@@ -468,16 +498,16 @@ class CudaBackend final : public core::Backend {
             k.shapes.insert(k.shapes.end(), shapes.begin(), shapes.end());
             // Entries already tuned time the new shapes too.
             for (auto& [key, tuning] : m_tuning)
-                if (size_t(m_scene->ray_generation(key.first).id) == i)
+                if (size_t(m_scene->ray_generation(key.first).id) == v.kernel)
                     tuning.add_shapes(shapes.size());
         }
-        m_capped_kernels.clear();
+        m_variants.clear();
     }
 
     void unload_kernels() {
-        if (m_capped.valid()) m_capped.wait();  // its results are of these kernels
-        m_capped = {};
-        m_capped_kernels.clear();
+        if (m_variants_compiling.valid()) m_variants_compiling.wait();  // of these kernels
+        m_variants_compiling = {};
+        m_variants.clear();
         for (RayGenerationKernel& k : m_kernels)
             for (KernelCode& code : k.codes)
                 if (code.module) m_driver.cuModuleUnload(code.module);
@@ -564,9 +594,14 @@ class CudaBackend final : public core::Backend {
     RayGenerationKernel* m_kernel = nullptr;      // the current launch's
     KernelCode* m_code = nullptr;                 // its variant in this launch's shape
     int m_grid = 1;                               // and that shape's grid
-    std::future<std::vector<CompileResult>> m_capped;  // capped variants being compiled
+    /// A kernel's variant being compiled: which kernel, and how it is compiled.
+    struct Variant {
+        size_t kernel = 0;
+        bool registers_capped = false, trace_inlined = false;
+    };
+    std::future<std::vector<CompileResult>> m_variants_compiling;
+    std::vector<Variant> m_variants;  // what m_variants_compiling compiles, in its order
     RegisterVariants m_register_variants;
-    std::vector<size_t> m_capped_kernels;              // the kernels they are of
     // The GPU BVH builder being made on another thread, until a GpuScene takes it.
     std::future<std::unique_ptr<GpuBvhBuilder>> m_bvh_builder_on_the_way;
     int m_largest_grid = 1;                       // of every kernel's shapes

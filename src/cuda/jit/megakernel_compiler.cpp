@@ -102,6 +102,17 @@ std::vector<CompileResult> compile_units(const std::vector<CompileRequest>& requ
     return binaries;
 }
 
+bool can_inline_trace(const CompileResult& binary) {
+    if (!binary.call_graph_known) return false;
+    // trace_ray's mangled name: lucent::gpu::trace_ray(...), whatever its parameters.
+    const auto trace = std::find_if(
+        binary.call_graph.begin(), binary.call_graph.end(),
+        [](const auto& f) { return f.first.starts_with("_ZN6lucent3gpu9trace_ray"); });
+    if (trace == binary.call_graph.end()) return false;
+    const std::vector<std::string> recursive = recursive_functions(binary.call_graph);
+    return std::find(recursive.begin(), recursive.end(), trace->first) == recursive.end();
+}
+
 void compile_megakernel(Megakernel& k, int sm) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();

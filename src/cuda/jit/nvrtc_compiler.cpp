@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "core/cache_directory.h"
 #include "core/cache_key.h"
 #include "cuda/jit/embedded_sources.h"
+#include "cuda/jit/ptx_calls.h"
 #include "lucent/error.h"
 
 namespace lucent::cuda {
@@ -32,6 +34,8 @@ struct NvrtcApi {
     decltype(&::nvrtcGetProgramLog) log = nullptr;
     decltype(&::nvrtcGetCUBINSize) cubin_size = nullptr;
     decltype(&::nvrtcGetCUBIN) cubin = nullptr;
+    decltype(&::nvrtcGetPTXSize) ptx_size = nullptr;
+    decltype(&::nvrtcGetPTX) ptx = nullptr;
     decltype(&::nvrtcGetErrorString) error_string = nullptr;
     bool ok = false;
     std::string why;
@@ -64,6 +68,8 @@ const NvrtcApi& nvrtc() {
         get(a.log, "nvrtcGetProgramLog");
         get(a.cubin_size, "nvrtcGetCUBINSize");
         get(a.cubin, "nvrtcGetCUBIN");
+        get(a.ptx_size, "nvrtcGetPTXSize");
+        get(a.ptx, "nvrtcGetPTX");
         get(a.error_string, "nvrtcGetErrorString");
         a.ok = a.why.empty();
         return a;
@@ -149,6 +155,37 @@ void write_entry(const std::filesystem::path& file, const std::string& key,
     if (!ok || ::rename(tmp.c_str(), file.c_str()) != 0) ::unlink(tmp.c_str());
 }
 
+/// Beside a cached CUBIN, the call graph of its PTX (the PTX itself is not kept):
+/// `<key>.calls`, written and read as the CUBIN's entry is; one line per function, its name
+/// and then its callees', separated by spaces.
+std::filesystem::path call_graph_entry(const std::filesystem::path& cubin_entry) {
+    std::filesystem::path p = cubin_entry;
+    return p.replace_extension(".calls");
+}
+
+std::string call_graph_text(const PtxCallGraph& graph) {
+    std::string text;
+    for (const auto& [name, callees] : graph) {
+        text += name;
+        for (const std::string& c : callees) text += " " + c;
+        text += "\n";
+    }
+    return text;
+}
+
+PtxCallGraph parse_call_graph(const std::string& text) {
+    PtxCallGraph graph;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+        std::istringstream words(line);
+        std::string name;
+        if (!(words >> name)) continue;
+        std::set<std::string>& callees = graph[name];
+        for (std::string c; words >> c;) callees.insert(c);
+    }
+    return graph;
+}
+
 }  // namespace
 
 std::string nvrtc_version(std::string* why) {
@@ -210,6 +247,10 @@ CompileResult compile_cubin(const CompileRequest& request) {
         dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / (hex + ".cubin");
     if (!dir.empty() && read_entry(file, hex, result.cubin)) {
         result.from_cache = true;
+        // Entries cached before call graphs were kept have none: unknown then.
+        std::string calls;
+        result.call_graph_known = read_entry(call_graph_entry(file), hex, calls);
+        if (result.call_graph_known) result.call_graph = parse_call_graph(calls);
         result.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         return result;
     }
@@ -234,6 +275,10 @@ CompileResult compile_cubin(const CompileRequest& request) {
     if (log_size) api.log(program, result.log.data());
     while (!result.log.empty() && (result.log.back() == '\0' || result.log.back() == '\n'))
         result.log.pop_back();
+    // LUCENT_NVRTC_LOG=1: print the compile's log, e.g. ptxas's register and stack report
+    // with LUCENT_NVRTC_OPTIONS=--ptxas-options=-v (a tuning aid; docs/performance.md).
+    if (compiled == NVRTC_SUCCESS && !result.log.empty() && std::getenv("LUCENT_NVRTC_LOG"))
+        std::fprintf(stderr, "NVRTC log of %s:\n%s\n", request.name.c_str(), result.log.c_str());
     if (compiled != NVRTC_SUCCESS) {
         api.destroy(&program);
         throw Error("NVRTC could not compile " + request.name + " (" + api.error_string(compiled) +
@@ -243,8 +288,20 @@ CompileResult compile_cubin(const CompileRequest& request) {
     api.cubin_size(program, &size);
     result.cubin.resize(size);
     api.cubin(program, result.cubin.data());
+    size_t ptx_size = 0;
+    if (api.ptx_size(program, &ptx_size) == NVRTC_SUCCESS && ptx_size > 0) {
+        std::string ptx(ptx_size, '\0');
+        if (api.ptx(program, ptx.data()) == NVRTC_SUCCESS) {
+            result.call_graph = ptx_call_graph(ptx);
+            result.call_graph_known = true;
+        }
+    }
     api.destroy(&program);
-    if (!dir.empty()) write_entry(file, hex, result.cubin);
+    if (!dir.empty()) {
+        write_entry(file, hex, result.cubin);
+        if (result.call_graph_known)
+            write_entry(call_graph_entry(file), hex, call_graph_text(result.call_graph));
+    }
     result.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return result;
 }

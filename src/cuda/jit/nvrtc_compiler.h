@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "cuda/jit/ptx_calls.h"
+
 namespace lucent::cuda {
 
 struct CompileRequest {
@@ -21,6 +23,10 @@ struct CompileResult {
     bool from_cache = false;
     double ms = 0;    // compile (cold) or cache load time
     std::string log;  // NVRTC's log, even on success
+    // Which functions of the compiled code call which (ptx_calls.h), kept beside the cached
+    // CUBIN; not known for an entry cached before call graphs were.
+    bool call_graph_known = false;
+    PtxCallGraph call_graph;
 };
 
 /// A request for `source`, which may include any of Lucent's embedded device headers

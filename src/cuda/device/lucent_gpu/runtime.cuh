@@ -43,6 +43,9 @@
 #ifndef LUCENT_GPU_MIN_BLOCKS
 #define LUCENT_GPU_MIN_BLOCKS 1  // __launch_bounds__ hint: blocks per SM to fit in registers
 #endif
+#ifndef LUCENT_GPU_INLINE_TRACE
+#define LUCENT_GPU_INLINE_TRACE 0  // 1: trace() inlined into the ray-generation program (trace.cuh)
+#endif
 #ifndef LUCENT_GPU_SELECTORS
 #define LUCENT_GPU_SELECTORS 1
 #endif

@@ -335,15 +335,31 @@ __device__ inline void count_exception(int code, unsigned long long linear) {
 
 namespace lucent {
 namespace detail {
+#if LUCENT_GPU_INLINE_TRACE
+// The kernel's inline-trace variant, compiled only where no program that a trace runs
+// traces again (src/cuda/backend/cuda_backend.cpp): the trace is inlined into the
+// ray-generation program, so its frame, the ray and the payload can stay in registers and
+// the call's saves and restores are gone.
+__forceinline__
+#endif
 LUCENT_HD void trace_erased(Handle root, const Ray& ray, void* payload, const void* signature,
                            unsigned ray_flags, unsigned visibility_mask) {
-#if LUCENT_GPU_RAY_CONTROL
-    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)),
-                   ray_flags, visibility_mask);
-#else
+    const unsigned payload_signature = unsigned(reinterpret_cast<unsigned long long>(signature));
+#if !LUCENT_GPU_RAY_CONTROL
+    // Without per-ray control the flags are constants (api.h refuses others at compile time).
     (void)ray_flags;
     (void)visibility_mask;
-    gpu::trace_ray(root, ray, payload, unsigned(reinterpret_cast<unsigned long long>(signature)));
+#endif
+#if LUCENT_GPU_INLINE_TRACE && LUCENT_GPU_RAY_CONTROL
+    runtime::trace(gpu::GpuPolicy{}, root, ray, payload, payload_signature, ray_flags,
+                   visibility_mask);
+#elif LUCENT_GPU_INLINE_TRACE
+    runtime::trace(gpu::GpuPolicy{}, root, ray, payload, payload_signature, kRayFlagNone,
+                   kVisibilityMaskAll);
+#elif LUCENT_GPU_RAY_CONTROL
+    gpu::trace_ray(root, ray, payload, payload_signature, ray_flags, visibility_mask);
+#else
+    gpu::trace_ray(root, ray, payload, payload_signature);
 #endif
 }
 }  // namespace detail
