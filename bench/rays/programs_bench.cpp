@@ -15,12 +15,17 @@ namespace programs = lucent_bench_rays;
 
 constexpr unsigned kPrimaryEntry = 0, kShadowEntry = 1, kDiffuseEntry = 2;
 
-/// A ray-generation program with its own ray set bound to it (its own variable scope).
+/// A ray-generation program with its own ray set bound to it (its own variable scope), two
+/// float4s a ray: (origin, tmin), (direction, tmax).
 std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySet& rays) {
+    std::vector<float4> packed(2 * rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const float3 o = rays.origin[i], d = rays.direction[i];
+        packed[2 * i] = float4{o.x, o.y, o.z, 0.0f};  // BENCH.md: tmin is 0 for every ray
+        packed[2 * i + 1] = float4{d.x, d.y, d.z, rays.tmax[i]};
+    }
     auto program = ctx.create_program(name);
-    (*program)["origins"] = input_buffer(ctx, rays.origin);
-    (*program)["directions"] = input_buffer(ctx, rays.direction);
-    (*program)["tmax"] = input_buffer(ctx, rays.tmax);
+    (*program)["rays"] = input_buffer(ctx, packed);
     return program;
 }
 
@@ -33,7 +38,18 @@ constexpr int kMostLaunches = 96;
 /// first launch compiles the scene and, on the GPU, the kernel; trial launches are not
 /// timed, and a trial after timing began (new shapes to try) restarts the timing, since the
 /// choice may change (before, a median of 5 could be a trial shape's time).
-Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing) {
+/// The kernel variant a CUDA launch ran (empty on the CPU): as compiled, or compiled with
+/// registers capped, trace() inlined or both (ContextOptions::register_variants).
+std::string variant_of(const LaunchReport& report) {
+    if (report.kernel_ms <= 0) return "";
+    if (report.trace_inlined && report.registers_capped) return "trace inlined, registers capped";
+    if (report.trace_inlined) return "trace inlined";
+    if (report.registers_capped) return "registers capped";
+    return "as compiled";
+}
+
+Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing,
+                    std::string& variant) {
     std::vector<double> mrays;
     ctx.launch(entry, unsigned(count));
     for (int launch = 1; launch < kMostLaunches && int(mrays.size()) < repeat; ++launch) {
@@ -43,6 +59,7 @@ Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std:
             mrays.clear();
             continue;
         }
+        variant = variant_of(report);  // the tuning's choice once the trials are over
         const bool kernel = report.kernel_ms > 0;
         timing = kernel ? "kernel" : "launch";
         const double ms = kernel ? report.kernel_ms : report.launch_ms;
@@ -82,28 +99,30 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     ProgramsResult res;
     res.backend = ctx.backend_name();
     auto closest_outputs = [&](Program& program, size_t count) {
-        auto t = ctx.create_buffer<float>(BufferType::kOutput, unsigned(count));
-        auto prim = ctx.create_buffer<unsigned>(BufferType::kOutput, unsigned(count));
-        program["t"] = t;
-        program["prim"] = prim;
-        return std::pair{t, prim};
+        auto hits = ctx.create_buffer<programs::RayHit>(BufferType::kOutput, unsigned(count));
+        program["hits"] = hits;
+        return hits;
     };
-    auto sum_hits = [](const float* t, size_t count, size_t& hits, double& sum_t) {
+    auto sum_hits = [](const programs::RayHit* hit, size_t count, size_t& hits, double& sum_t) {
         for (size_t i = 0; i < count; ++i)
-            if (t[i] >= 0.0f) ++hits, sum_t += t[i];
+            if (hit[i].t >= 0.0f) ++hits, sum_t += hit[i].t;
     };
 
     // Primary rays, then the shadow and diffuse sets from their hits (BENCH.md).
     auto primary_program = program_for(ctx, "closest_rays", primary);
-    auto [primary_t, primary_prim] = closest_outputs(*primary_program, primary.size());
+    auto primary_hits = closest_outputs(*primary_program, primary.size());
     // Each set's entry point is added when its rays exist (every entry needs its program).
     ctx.set_entry_point_count(1);
     ctx.set_ray_generation_program(kPrimaryEntry, primary_program);
-    res.primary = timed_launches(ctx, kPrimaryEntry, primary.size(), in.repeat, res.timing);
-    const float* t = primary_t->data<float>();
-    sum_hits(t, primary.size(), res.primary_hits, res.primary_sum_t);
+    res.primary = timed_launches(ctx, kPrimaryEntry, primary.size(), in.repeat, res.timing,
+                                 res.primary_variant);
+    const auto* hit = primary_hits->data<programs::RayHit>();
+    sum_hits(hit, primary.size(), res.primary_hits, res.primary_sum_t);
+    std::vector<float> t(primary.size());
+    std::vector<unsigned> prim(primary.size());
+    for (size_t i = 0; i < primary.size(); ++i) t[i] = hit[i].t, prim[i] = hit[i].prim;
     RaySet shadow, diffuse;
-    secondary_rays(primary, t, primary_prim->data<unsigned>(), mesh, in.light, shadow, diffuse);
+    secondary_rays(primary, t.data(), prim.data(), mesh, in.light, shadow, diffuse);
     res.shadow_rays = shadow.size();
     res.diffuse_rays = diffuse.size();
     if (shadow.size() == 0) return res;  // no primary hit: nothing more to trace
@@ -113,16 +132,19 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     (*shadow_program)["blocked"] = blocked;
     ctx.set_entry_point_count(2);
     ctx.set_ray_generation_program(kShadowEntry, shadow_program);
-    res.shadow = timed_launches(ctx, kShadowEntry, shadow.size(), in.repeat, res.timing);
+    res.shadow = timed_launches(ctx, kShadowEntry, shadow.size(), in.repeat, res.timing,
+                                res.shadow_variant);
     const unsigned char* b = blocked->data<unsigned char>();
     for (size_t i = 0; i < shadow.size(); ++i) res.occluded += b[i];
 
     auto diffuse_program = program_for(ctx, "closest_rays", diffuse);
-    auto [diffuse_t, diffuse_prim] = closest_outputs(*diffuse_program, diffuse.size());
+    auto diffuse_hits = closest_outputs(*diffuse_program, diffuse.size());
     ctx.set_entry_point_count(3);
     ctx.set_ray_generation_program(kDiffuseEntry, diffuse_program);
-    res.diffuse = timed_launches(ctx, kDiffuseEntry, diffuse.size(), in.repeat, res.timing);
-    sum_hits(diffuse_t->data<float>(), diffuse.size(), res.diffuse_hits, res.diffuse_sum_t);
+    res.diffuse = timed_launches(ctx, kDiffuseEntry, diffuse.size(), in.repeat, res.timing,
+                                 res.diffuse_variant);
+    sum_hits(diffuse_hits->data<programs::RayHit>(), diffuse.size(), res.diffuse_hits,
+             res.diffuse_sum_t);
     return res;
 }
 

@@ -30,6 +30,9 @@ struct ProgramsResult : RayChecksums {
     // What a launch's time is: "launch" (the CPU backend's whole launch, programs and
     // thread pool) or "kernel" (the megakernel alone, CUDA events).
     std::string timing;
+    // CUDA: the kernel variant each set's timed launches ran, as the launch-shape tuning
+    // chose it ("as compiled", "registers capped", "trace inlined", or both); empty on the CPU.
+    std::string primary_variant, shadow_variant, diffuse_variant;
 };
 
 /// Builds the Context (one GeometryTriangles under a GeometryGroup, the module's programs),

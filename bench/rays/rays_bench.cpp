@@ -383,12 +383,17 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
         j["backend"] = p.backend;
         j["timing"] = p.timing;
         j["checksums_agree_with_cpu_kernels"] = differences.empty();
+        j["kernel_variants"] = Json{{"primary", p.primary_variant},
+                                    {"shadow", p.shadow_variant},
+                                    {"diffuse", p.diffuse_variant}};
         document["programs"] = j;  // beside the kernels' figures: one document
         return;
     }
     std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
                 p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
     print_engine("programs ", engine_of(p));
+    std::printf("programs' kernel variants: primary %s, shadow %s, diffuse %s\n",
+                p.primary_variant.c_str(), p.shadow_variant.c_str(), p.diffuse_variant.c_str());
     if (differences.empty())
         std::printf("programs' checksums agree with the CPU kernels\n");
     else

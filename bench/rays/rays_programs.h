@@ -18,8 +18,10 @@
 //     of triangles it is the BVH's bare any-hit traversal (no frame, no program runs).
 //   - No any-hit program is bound, so the closest-hit traversal is the plain one that
 //     commits the nearest triangle and computes nothing until the shade phase.
-//   - The rays are structure-of-arrays buffers read once per launch index, and answers are
-//     written once: no read-modify-write of an output.
+//   - A ray is two float4s, (origin, tmin) and (direction, tmax), the layout the bare
+//     kernels read: two 16-byte loads where three float3/float buffers took seven 4-byte
+//     loads from three streams. A closest hit's answer is one 8-byte store (RayHit is
+//     8-aligned). Each is read or written once: no read-modify-write of an output.
 #pragma once
 
 #include "lucent/device.h"
@@ -34,30 +36,33 @@ using lucent::Handle;
 constexpr unsigned kBenchRay = 0;  // the one ray type
 constexpr unsigned kNoTriangle = 0xffffffffu;
 
-/// What a closest-hit ray carries back: t of the first hit (-1: none) and its triangle.
-struct RayHit {
+/// What a closest-hit ray carries back, and what closest_rays writes per ray: t of the
+/// first hit (-1: none) and its triangle. 8-aligned, so that it is written in one store.
+struct alignas(8) RayHit {
     float t;
     unsigned prim;
 };
 
-/// One ray set in, closest hits out (tmin is 0 for every BENCH.md ray).
+/// Ray i of a set of rays stored as two float4s each: (origin, tmin), (direction, tmax).
+LUCENT_HD inline lucent::Ray ray_at(const BufferView<const float4>& rays, unsigned i) {
+    const float4 o = rays[2 * i], d = rays[2 * i + 1];
+    return lucent::make_ray(make_float3(o.x, o.y, o.z), make_float3(d.x, d.y, d.z), kBenchRay,
+                            o.w, d.w);
+}
+
+/// One ray set in, closest hits out.
 struct ClosestRaysRecord {
-    BufferView<const float3> origins, directions;
-    BufferView<const float> tmax;
-    BufferView<float> t;          // -1 where the ray hits nothing
-    BufferView<unsigned> prim;    // kNoTriangle where it hits nothing
+    BufferView<const float4> rays;  // two per ray: (origin, tmin), (direction, tmax)
+    BufferView<RayHit> hits;        // t = -1 and prim = kNoTriangle where the ray hits nothing
     Handle scene;
 };
-LUCENT_RECORD(ClosestRaysRecord, origins, directions, tmax, t, prim, scene)
+LUCENT_RECORD(ClosestRaysRecord, rays, hits, scene)
 
 LUCENT_RAY_GENERATION(closest_rays, ClosestRaysRecord) {
     const unsigned i = lucent::launch_index().x;
     RayHit hit;
-    lucent::trace(rec.scene,
-                  lucent::make_ray(rec.origins[i], rec.directions[i], kBenchRay, 0.0f, rec.tmax[i]),
-                  hit);
-    rec.t[i] = hit.t;
-    rec.prim[i] = hit.prim;
+    lucent::trace(rec.scene, ray_at(rec.rays, i), hit);
+    rec.hits[i] = hit;
 }
 
 LUCENT_CLOSEST_HIT(record_hit, lucent::NoRecord, RayHit, lucent::TriangleAttributes) {
@@ -72,19 +77,15 @@ LUCENT_MISS(record_miss, lucent::NoRecord, RayHit) {
 
 /// The shadow set in, one byte per ray out.
 struct ShadowRaysRecord {
-    BufferView<const float3> origins, directions;
-    BufferView<const float> tmax;
+    BufferView<const float4> rays;      // two per ray, as closest_rays reads them
     BufferView<unsigned char> blocked;  // 1: something between the origin and the light
     Handle scene;
 };
-LUCENT_RECORD(ShadowRaysRecord, origins, directions, tmax, blocked, scene)
+LUCENT_RECORD(ShadowRaysRecord, rays, blocked, scene)
 
 LUCENT_RAY_GENERATION(shadow_rays, ShadowRaysRecord) {
     const unsigned i = lucent::launch_index().x;
-    const bool blocked = lucent::occluded(
-        rec.scene,
-        lucent::make_ray(rec.origins[i], rec.directions[i], kBenchRay, 0.0f, rec.tmax[i]));
-    rec.blocked[i] = blocked ? 1 : 0;
+    rec.blocked[i] = lucent::occluded(rec.scene, ray_at(rec.rays, i)) ? 1 : 0;
 }
 
 }  // namespace lucent_bench_rays
