@@ -33,7 +33,7 @@ for t in $suites; do cp "$build/tests/${t}_test" "$out/bin/"; done
 cp "$build/lucent" "$out/bin/"
 # The examples, built as a user builds them: against the installed package.
 prefix="$PWD/$build/prefix"
-cmake --install "$build" --prefix "$prefix" > /dev/null
+[ "${LUCENT_BUNDLE_EXAMPLES:-1}" = 0 ] || cmake --install "$build" --prefix "$prefix" > /dev/null
 for dir in examples/*/; do
   [ "${LUCENT_BUNDLE_EXAMPLES:-1}" = 0 ] && break
   [ -f "$dir/CMakeLists.txt" ] || continue  # examples/python: scripts, run by gpu-check.sh python
