@@ -30,9 +30,26 @@ inline RenderResult result_for(const Context& ctx) {
 /// "megakernel JIT" (cold compile or cache load) when the CUDA backend ran it.
 void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& stages);
 
-/// Launches `entry` over width x height, then `settings.repeat - 1` more times when asked,
-/// and fills `result`: report of the first launch, stages "compile + accel", "megakernel
-/// JIT" (when it ran) and "launch" (the first, or the median of the repeats with spread).
+/// The launches a median is taken over: those after the CUDA backend's launch-shape tuning.
+/// A trial launch runs a shape (or kernel variant) being tried, not the one chosen, so it
+/// is left out; one that comes after timing began (a variant compiled in the background
+/// arrived, with new shapes to try) also drops the launches before it, since the choice
+/// may change.
+struct SteadyLaunches {
+    std::vector<double> ms, kernel_ms;  // whole launch, and the kernel alone (0: no kernel)
+    unsigned trials = 0;                // trial launches left out
+
+    void add(const LaunchReport& report);
+};
+
+/// The most launches timed_launch makes beyond the repeats asked for: the tuning spends a
+/// handful per kernel, a few more when a variant arrives from its background compile.
+constexpr unsigned kMostTrialLaunches = 96;
+
+/// Launches `entry` over width x height, then more times when `settings.repeat` asks, and
+/// fills `result`: report of the first launch, stages "compile + accel", "megakernel JIT"
+/// (when it ran) and "launch" (the first, or the median with spread of `repeat - 1` launches
+/// after the launch-shape tuning: SteadyLaunches).
 void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
                   RenderResult& result);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "samples/stages.h"
@@ -20,6 +21,17 @@ void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& st
              report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
 }
 
+void SteadyLaunches::add(const LaunchReport& report) {
+    if (report.launch_shape_trial) {
+        ++trials;
+        ms.clear();
+        kernel_ms.clear();
+        return;
+    }
+    ms.push_back(report.launch_ms);
+    kernel_ms.push_back(report.kernel_ms);
+}
+
 void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
                   RenderResult& result) {
     ctx.launch(entry, settings.width, settings.height);
@@ -29,22 +41,33 @@ void timed_launch(Context& ctx, unsigned entry, const RenderSettings& settings,
         result.stages.push_back({"launch", result.report.launch_ms, ""});
         return;
     }
-    std::vector<double> ms, kernel;
-    for (unsigned i = 1; i < settings.repeat; ++i) {
+    SteadyLaunches steady;
+    const unsigned wanted = settings.repeat - 1;
+    for (unsigned i = 0; steady.ms.size() < wanted && i < wanted + kMostTrialLaunches; ++i) {
         ctx.launch(entry, settings.width, settings.height);
-        ms.push_back(ctx.last_launch().launch_ms);
-        kernel.push_back(ctx.last_launch().kernel_ms);
-        if (settings.progress) settings.progress(i, settings.repeat - 1);
+        steady.add(ctx.last_launch());
+        if (settings.progress) settings.progress(unsigned(steady.ms.size()), wanted);
+    }
+    std::vector<double> ms = steady.ms, kernel = steady.kernel_ms;
+    if (ms.empty()) {  // the tuning never settled within the launches allowed: say so
+        result.stages.push_back({"launch", result.report.launch_ms,
+                                 "the first launch: the launch-shape tuning was still trying "
+                                 "shapes after " + std::to_string(wanted + kMostTrialLaunches) +
+                                 " more"});
+        return;
     }
     std::sort(ms.begin(), ms.end());
     std::sort(kernel.begin(), kernel.end());
     const double median = ms[ms.size() / 2];
-    char note[200];
+    char note[240];
     int n = std::snprintf(note, sizeof note, "median of %zu (min %.3f, max %.3f): %.1f frames/s",
                           ms.size(), ms.front(), ms.back(), 1000.0 / median);
     if (kernel.back() > 0)
-        std::snprintf(note + n, sizeof note - size_t(n), "; kernel alone %.3f ms",
-                      kernel[kernel.size() / 2]);
+        n += std::snprintf(note + n, sizeof note - size_t(n), "; kernel alone %.3f ms",
+                           kernel[kernel.size() / 2]);
+    if (steady.trials > 0)
+        std::snprintf(note + n, sizeof note - size_t(n), "; after %u launch-shape trials",
+                      steady.trials);
     result.stages.push_back({"launch", median, note});
 }
 

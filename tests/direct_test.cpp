@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "samples/sample.h"
+#include "samples/stages.h"
 #include "scene/image_io.h"
 #include "tests/test_support.h"
 
@@ -77,6 +78,44 @@ TEST(DirectSample, DiffuseMapFromAnMtlTexturesTheSurface) {
     const float3 left = pixel(r, 0.3f, 0.5f), right = pixel(r, 0.7f, 0.5f);
     EXPECT_GT(left.x, 10 * left.z) << "left half red";
     EXPECT_GT(right.z, 10 * right.x) << "right half blue";
+}
+
+// `render --repeat N` times the launches after the launch-shape tuning: a trial launch runs
+// a shape being tried, and one after timing began drops what came before it.
+TEST(TimedLaunch, TrialLaunchesAreLeftOutOfTheMedian) {
+    lucent::samples::SteadyLaunches steady;
+    auto launch = [&](double ms, bool trial) {
+        lucent::LaunchReport r;
+        r.launch_ms = ms;
+        r.kernel_ms = ms - 0.1;
+        r.launch_shape_trial = trial;
+        steady.add(r);
+    };
+    launch(3.0, true);
+    launch(1.0, false);
+    launch(1.1, false);
+    launch(4.0, true);  // a variant arrived: its shapes are tried, the choice may change
+    launch(0.6, false);
+    launch(0.7, false);
+    EXPECT_EQ(steady.trials, 2u);
+    EXPECT_EQ(steady.ms, (std::vector<double>{0.6, 0.7}));
+    ASSERT_EQ(steady.kernel_ms.size(), 2u);
+    EXPECT_DOUBLE_EQ(steady.kernel_ms[1], 0.6);
+}
+
+TEST(TimedLaunch, RenderRepeatReportsTheMedianOfTheRepeats) {
+    RenderSettings settings;
+    settings.width = settings.height = 32;
+    settings.backend = lucent_tests::test_backend();
+    settings.scene = "cornell";
+    settings.repeat = 4;
+    const RenderResult r = lucent::samples::find_sample("direct").render(settings);
+    const lucent::samples::StageTiming* launch = nullptr;
+    for (const auto& stage : r.stages)
+        if (stage.name == "launch") launch = &stage;
+    ASSERT_NE(launch, nullptr);
+    EXPECT_EQ(launch->note.rfind("median of 3 ", 0), 0u) << launch->note;
+    EXPECT_GT(launch->ms, 0.0);
 }
 
 }  // namespace
