@@ -6,6 +6,7 @@
 #include "bench/common/input_buffer.h"
 #include "bench/rays/rays_programs.h"
 #include "lucent/lucent.h"
+#include "samples/stages.h"
 
 namespace lucent::bench {
 
@@ -34,10 +35,6 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
 /// variant of the kernel arrives from its background compile).
 constexpr int kMostLaunches = 96;
 
-/// Mrays/s of `repeat` launches of `entry` over `count` rays, all after the tuning: the
-/// first launch compiles the scene and, on the GPU, the kernel; trial launches are not
-/// timed, and a trial after timing began (new shapes to try) restarts the timing, since the
-/// choice may change (before, a median of 5 could be a trial shape's time).
 /// The kernel variant a CUDA launch ran (empty on the CPU): as compiled, or compiled with
 /// registers capped, trace() inlined or both (ContextOptions::register_variants).
 std::string variant_of(const LaunchReport& report) {
@@ -48,21 +45,25 @@ std::string variant_of(const LaunchReport& report) {
     return "as compiled";
 }
 
+/// Mrays/s of `repeat` launches of `entry` over `count` rays, all after the tuning: the
+/// first launch compiles the scene and, on the GPU, the kernel; trial launches are left out
+/// as the samples' `render --repeat` leaves them (samples::SteadyLaunches), so a median of
+/// 5 is never a trial shape's time.
 Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing,
                     std::string& variant) {
-    std::vector<double> mrays;
+    samples::SteadyLaunches steady;
     ctx.launch(entry, unsigned(count));
-    for (int launch = 1; launch < kMostLaunches && int(mrays.size()) < repeat; ++launch) {
+    for (int launch = 1; launch < kMostLaunches && int(steady.ms.size()) < repeat; ++launch) {
         ctx.launch(entry, unsigned(count));
         const LaunchReport& report = ctx.last_launch();
-        if (report.launch_shape_trial) {
-            mrays.clear();
-            continue;
-        }
-        variant = variant_of(report);  // the tuning's choice once the trials are over
-        const bool kernel = report.kernel_ms > 0;
+        steady.add(report);
+        if (!report.launch_shape_trial) variant = variant_of(report);  // the tuning's choice
+    }
+    std::vector<double> mrays;
+    for (size_t i = 0; i < steady.ms.size(); ++i) {
+        const bool kernel = steady.kernel_ms[i] > 0;
         timing = kernel ? "kernel" : "launch";
-        const double ms = kernel ? report.kernel_ms : report.launch_ms;
+        const double ms = kernel ? steady.kernel_ms[i] : steady.ms[i];
         mrays.push_back(ms > 0 ? count / (ms * 1e3) : 0.0);
     }
     return rate_of(mrays);
