@@ -493,6 +493,39 @@ TEST_F(GpuBvhBuilderTest, SmallAndUnindexedMeshes) {
                                       make_float3(0, 0, 1), 0.0f, kInfinity, h));
 }
 
+TEST_F(GpuBvhBuilderTest, APreparedLayoutIsTakenByTheFirstBuildItHolds) {
+    const Mesh mesh = test_mesh(5, 1500);
+    const unsigned n = unsigned(mesh.indices.size());
+    const size_t prepared_node_bytes = sizeof(float4) * gpu::kGpuNodeFloat4s * (3000 - 1);
+    builder->prepare(3000);  // room for more triangles than the mesh has (2,076)
+    for (auto algorithm : kAlgorithms) {
+        SCOPED_TRACE(name_of(algorithm));
+        cuda::GpuBvhBuildOptions options;
+        options.gpu_algorithm = algorithm;
+        // The first build into an empty layout takes the prepared one (its size shows it);
+        // the next allocates its own, sized for the mesh.
+        GpuTriangleBvhDevice first, second;
+        builder->build(mesh.positions, mesh.indices, first, options);
+        builder->build(mesh.positions, mesh.indices, second, options);
+        if (algorithm == kAlgorithms[0]) {
+            EXPECT_EQ(first.nodes.size(), prepared_node_bytes);
+            EXPECT_EQ(second.nodes.size(), sizeof(float4) * gpu::kGpuNodeFloat4s * (n - 1));
+        }
+        for (const GpuTriangleBvhDevice* d : {&first, &second}) {
+            const GpuTriangleBvh bvh = download(*d);
+            expect_complete(bvh, mesh);
+            if (HasFatalFailure()) return;
+            expect_brute_force_hits(bvh, mesh, 13, 1000);
+        }
+    }
+    // A prepared layout too small for the mesh is left for a later build.
+    builder->prepare(100);
+    GpuTriangleBvhDevice d;
+    builder->build(mesh.positions, mesh.indices, d);
+    EXPECT_EQ(d.nodes.size(), sizeof(float4) * gpu::kGpuNodeFloat4s * (n - 1));
+    expect_complete(download(d), mesh);
+}
+
 TEST_F(GpuBvhBuilderTest, IndexOutOfRangeIsAnErrorNamingTheTriangle) {
     Mesh mesh = test_mesh(3, 50);
     mesh.indices[37].y = (unsigned)mesh.positions.size() + 4;

@@ -92,6 +92,32 @@ TEST(TriangleGather, BoundsHoldEveryTriangleAndOnlyWhatTheBufferHolds) {
     EXPECT_EQ(box.hi.z, 3.0f);
 }
 
+TEST(TriangleGather, BoundsOfLongBuffersFindEachAxisExtremeWhereverItIs) {
+    // Buffers long enough for the bounds' 16-point steps and a tail: each axis's extreme is
+    // planted at a different point (in a step's first, middle or last point, or in the
+    // tail), so a running minimum kept for the wrong axis, a skipped step or tail shows.
+    for (const unsigned count : {16u, 17u, 48u, 100u, 1003u}) {
+        std::vector<float3> v(count);
+        for (unsigned i = 0; i < count; ++i)
+            v[i] = {float(i % 7) - 3.0f, float(i % 11) * 0.5f, float(i % 5) + 10.0f};
+        const unsigned at[6] = {0, count / 2, count - 1, count / 3, 15 % count, count - 2};
+        v[at[0]].x = -1e3f, v[at[1]].y = -2e3f, v[at[2]].z = -3e3f;
+        v[at[3]].x = 4e3f, v[at[4]].y = 5e3f, v[at[5]].z = 6e3f;
+        std::vector<uint3> indices;  // as many indices as vertices: the buffer is read whole
+        for (unsigned i = 0; i + 2 < count; i += 3) indices.push_back({i, i + 1, i + 2});
+        indices.push_back({count - 3, count - 2, count - 1});
+        GatherScene g;
+        g.add(v, indices);
+        const Aabb box = core::triangle_bounds(g.scene, g.node);
+        EXPECT_EQ(box.lo.x, -1e3f) << count;
+        EXPECT_EQ(box.lo.y, -2e3f) << count;
+        EXPECT_EQ(box.lo.z, -3e3f) << count;
+        EXPECT_EQ(box.hi.x, 4e3f) << count;
+        EXPECT_EQ(box.hi.y, 5e3f) << count;
+        EXPECT_EQ(box.hi.z, 6e3f) << count;
+    }
+}
+
 TEST(TriangleGather, NoTrianglesGiveAnEmptyBox) {
     GatherScene g;
     g.add({}, {});

@@ -34,13 +34,39 @@ void gather_triangles(const CompiledScene& scene, const CompiledNode& node,
     }
 }
 
+namespace {
+
+/// Grows lo/hi (x, y, z) by every point of `points`, read as the flat array of floats it is.
+/// Per point, a min and a max on each axis would be six chains of dependent steps the
+/// compiler cannot turn into vector code (the stride is 3 floats). Read flat, 48 floats at a
+/// time, float j of a step always belongs to axis j % 3, so 48 independent running minima
+/// and maxima are plain vector code: about 5x faster on the development machine (150K
+/// points: 0.10 against 0.49 ms). Same comparisons as std::min and std::max (a NaN
+/// coordinate is skipped); minima and maxima do not depend on the order they are taken in.
+void grow_by_points(const float3* points, size_t count, float lo[3], float hi[3]) {
+    constexpr size_t kStep = 48;  // 16 points; a multiple of 3 and of the vector widths
+    static_assert(sizeof(float3) == 3 * sizeof(float), "float3 must be three packed floats");
+    const float* f = &points[0].x;
+    const size_t floats = 3 * count, whole = floats / kStep * kStep;
+    float step_lo[kStep], step_hi[kStep];
+    for (size_t j = 0; j < kStep; ++j) step_lo[j] = lo[j % 3], step_hi[j] = hi[j % 3];
+    for (size_t i = 0; i < whole; i += kStep)
+        for (size_t j = 0; j < kStep; ++j) {
+            // Written as comparisons: std::min's reference return keeps GCC from vectorizing.
+            const float x = f[i + j];
+            step_lo[j] = x < step_lo[j] ? x : step_lo[j];
+            step_hi[j] = step_hi[j] < x ? x : step_hi[j];
+        }
+    for (size_t j = 0; j < kStep; ++j)
+        lo[j % 3] = std::min(lo[j % 3], step_lo[j]), hi[j % 3] = std::max(hi[j % 3], step_hi[j]);
+    for (size_t i = whole; i < floats; ++i)
+        lo[i % 3] = std::min(lo[i % 3], f[i]), hi[i % 3] = std::max(hi[i % 3], f[i]);
+}
+
+}  // namespace
+
 Aabb triangle_bounds(const CompiledScene& scene, const CompiledNode& node) {
     float lo[3] = {kInfinity, kInfinity, kInfinity}, hi[3] = {-kInfinity, -kInfinity, -kInfinity};
-    auto grow = [&](float3 p) {
-        lo[0] = std::min(lo[0], p.x), hi[0] = std::max(hi[0], p.x);
-        lo[1] = std::min(lo[1], p.y), hi[1] = std::max(hi[1], p.y);
-        lo[2] = std::min(lo[2], p.z), hi[2] = std::max(hi[2], p.z);
-    };
     for (unsigned i : node.instances) {
         const CompiledInstance& inst = scene.instances[i];
         const float3* v = inst.vertices;
@@ -48,15 +74,15 @@ Aabb triangle_bounds(const CompiledScene& scene, const CompiledNode& node) {
         if (inst.primitive_count == 0) continue;
         if (vertex_count <= 3 * size_t(inst.primitive_count)) {
             // Every vertex of the buffer, in order, rather than through the indices (Sponza's
-            // 66K triangles: 0.12 against 0.21 ms), when the buffer holds no more vertices
-            // than the indices name. A vertex no triangle uses only makes the box larger,
-            // which a box for culling may be.
-            for (size_t j = 0; j < vertex_count; ++j) grow(v[j]);
+            // 66K triangles: 0.12 against 0.21 ms before grow_by_points), when the buffer
+            // holds no more vertices than the indices name. A vertex no triangle uses only
+            // makes the box larger, which a box for culling may be.
+            grow_by_points(v, vertex_count, lo, hi);
         } else {
             // A buffer shared by instances that each use a part of it.
             for (unsigned p = 0; p < inst.primitive_count; ++p) {
                 const uint3 t = inst.triangle(p);
-                grow(v[t.x]), grow(v[t.y]), grow(v[t.z]);
+                for (const unsigned k : {t.x, t.y, t.z}) grow_by_points(&v[k], 1, lo, hi);
             }
         }
     }

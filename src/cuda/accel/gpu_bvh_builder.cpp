@@ -63,6 +63,38 @@ void reserve_layout(GpuTriangleBvhDevice& out, unsigned n) {
     reserve(out.parents, 4 * out_nodes);
 }
 
+/// Places the binned-SAH build's scratch arrays for n triangles in `p`, carved out of one
+/// allocation at `base` (a first build would otherwise pay for twenty allocations); returns
+/// the bytes they take (with base 0: the size to allocate).
+size_t carve_sah_scratch(gpu::GpuSahBuildParams& p, unsigned n, const gpu::GpuSahScratch& scratch,
+                         CUdeviceptr base) {
+    const size_t nodes = 2 * size_t(n) - 1;
+    size_t at = 0;
+    const auto take = [&](auto*& array, size_t count) {
+        using T = std::remove_reference_t<decltype(*array)>;
+        array = reinterpret_cast<T*>(base + at);
+        at += (sizeof(T) * count + 255) & ~size_t(255);
+    };
+    take(p.prim_lo, n);
+    take(p.prim_hi, n);
+    take(p.order, n);
+    for (int k = 0; k < 2; ++k) {
+        take(p.work[k], n);
+        take(p.place_task[k], n);
+        take(p.tasks[k], scratch.task_capacity);
+        take(p.bins[k], scratch.bin_words);
+    }
+    take(p.small, scratch.small_capacity);
+    take(p.node_lo, nodes);
+    take(p.node_hi, nodes);
+    take(p.node_range, nodes);
+    take(p.node_parent, nodes);
+    take(p.node_inner, nodes);
+    take(p.node_arrivals, nodes);
+    take(p.counters, gpu::kSahCounterCount);
+    return at;
+}
+
 /// The inputs and outputs both algorithms' parameters have (gpu::GpuBuildParams,
 /// gpu::GpuSahBuildParams).
 template <class Params>
@@ -126,7 +158,9 @@ struct GpuBvhBuilder::Impl {
     // gather(): the piece table, then the mesh's positions and indices (one allocation).
     DeviceBuffer gather_scratch;
     // Scratch of the binned-SAH build.
-    DeviceBuffer sah_scratch;  // one allocation, carved into the arrays (sah_scratch_layout)
+    DeviceBuffer sah_scratch;  // one allocation, carved into the arrays (carve_sah_scratch)
+    // A layout allocated ahead by prepare(), taken by the first build it is big enough for.
+    GpuTriangleBvhDevice spare_layout;
 
     void launch(CUfunction f, unsigned grid, unsigned block, void** args, const char* what) {
         if (grid == 0) return;
@@ -146,6 +180,14 @@ struct GpuBvhBuilder::Impl {
         return ms;
     }
     void sort(unsigned n);
+    /// Room for the layout of a tree over n triangles in `out`: the spare layout when `out`
+    /// has none yet and the spare is big enough, else its own buffers grown.
+    void reserve_out(GpuTriangleBvhDevice& out, unsigned n) {
+        if (out.nodes.empty() && !spare_layout.nodes.empty() &&
+            spare_layout.triangle_ids.size() >= 4 * size_t(n))
+            out = std::move(spare_layout);
+        reserve_layout(out, n);
+    }
     GpuBvhStats build_sah(const DeviceTriangles& tris, GpuTriangleBvhDevice& out,
                           const GpuBvhBuildOptions& options);
     /// Copies host triangles to the device (host_positions, host_indices).
@@ -226,6 +268,14 @@ GpuBvhBuilder::~GpuBvhBuilder() {
     }
 }
 
+void GpuBvhBuilder::prepare(unsigned triangles) {
+    if (triangles == 0) return;
+    gpu::GpuSahBuildParams p{};
+    const gpu::GpuSahScratch scratch = gpu::gpu_sah_scratch(triangles, sah_small_limit());
+    reserve(m->sah_scratch, carve_sah_scratch(p, triangles, scratch, 0));
+    reserve_layout(m->spare_layout, triangles);
+}
+
 /// Sorts (keys, order) by key in four 8-bit passes; the result ends where it started.
 void GpuBvhBuilder::Impl::sort(unsigned n) {
     unsigned tiles = blocks_for(n, gpu::kSortTile);
@@ -282,7 +332,7 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
     reserve(s.node_parent, 4 * nodes);
     reserve(s.histogram_buffer, 4 * 256 * size_t(blocks_for(n, gpu::kSortTile)));
     reserve(s.counters, 4 * gpu::kCounterCount);
-    reserve_layout(out, n);
+    s.reserve_out(out, n);
 
     gpu::GpuBuildParams p{};
     set_common_params(p, tris, options, out);
@@ -343,47 +393,19 @@ GpuBvhStats GpuBvhBuilder::build(const DeviceTriangles& tris, GpuTriangleBvhDevi
 GpuBvhStats GpuBvhBuilder::Impl::build_sah(const DeviceTriangles& tris, GpuTriangleBvhDevice& out,
                                            const GpuBvhBuildOptions& options) {
     const unsigned n = tris.triangle_count;
-    const size_t nodes = 2 * size_t(n) - 1, out_nodes = n > 1 ? n - 1 : 1;
+    const size_t out_nodes = n > 1 ? n - 1 : 1;
     const auto reserved = std::chrono::steady_clock::now();
     const unsigned small_limit = sah_small_limit();
     const gpu::GpuSahScratch scratch = gpu::gpu_sah_scratch(n, small_limit);
-    reserve_layout(out, n);
+    reserve_out(out, n);
 
     gpu::GpuSahBuildParams p{};
     set_common_params(p, tris, options, out);
     p.small_limit = small_limit;
     p.task_capacity = unsigned(scratch.task_capacity);
     p.small_capacity = unsigned(scratch.small_capacity);
-    // The scratch arrays, carved out of one allocation (a first build would otherwise pay
-    // for twenty allocations): placed from `base`, returning the bytes they take.
-    const auto carve = [&](CUdeviceptr base) {
-        size_t at = 0;
-        const auto take = [&](auto*& array, size_t count) {
-            using T = std::remove_reference_t<decltype(*array)>;
-            array = reinterpret_cast<T*>(base + at);
-            at += (sizeof(T) * count + 255) & ~size_t(255);
-        };
-        take(p.prim_lo, n);
-        take(p.prim_hi, n);
-        take(p.order, n);
-        for (int k = 0; k < 2; ++k) {
-            take(p.work[k], n);
-            take(p.place_task[k], n);
-            take(p.tasks[k], scratch.task_capacity);
-            take(p.bins[k], scratch.bin_words);
-        }
-        take(p.small, scratch.small_capacity);
-        take(p.node_lo, nodes);
-        take(p.node_hi, nodes);
-        take(p.node_range, nodes);
-        take(p.node_parent, nodes);
-        take(p.node_inner, nodes);
-        take(p.node_arrivals, nodes);
-        take(p.counters, gpu::kSahCounterCount);
-        return at;
-    };
-    reserve(sah_scratch, carve(0));
-    carve(sah_scratch.ptr());
+    reserve(sah_scratch, carve_sah_scratch(p, n, scratch, 0));
+    carve_sah_scratch(p, n, scratch, sah_scratch.ptr());
     if (print_times())
         std::fprintf(stderr, "lucent: GPU BVH build: device memory (scratch, layout) %.3f ms\n",
                      ms_since(reserved));

@@ -52,6 +52,14 @@ class GpuBvhBuilder {
     GpuBvhBuilder(const GpuBvhBuilder&) = delete;
     GpuBvhBuilder& operator=(const GpuBvhBuilder&) = delete;
 
+    /// Allocates ahead what a binned-SAH build of up to `triangles` triangles needs: its
+    /// scratch, and a layout that the first build into an empty GpuTriangleBvhDevice takes.
+    /// Allocating device memory is a sizeable part of a first build (0.23-0.31 ms of Sponza's
+    /// 1.4-1.7 ms on an H200, docs/performance.md); done ahead, on another thread while the
+    /// application loads its scene, the first build starts at once. Throws lucent::Error when
+    /// the memory cannot be had; a build then allocates what it needs itself.
+    void prepare(unsigned triangles);
+
     /// Builds over triangles already on the device, into `out` (its buffers are reused when
     /// big enough). stats.build_ms is the GPU time of the build kernels (CUDA events).
     /// Throws lucent::Error for an index out of range (naming the triangle), GpuBvhTooDeep for
