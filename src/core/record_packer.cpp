@@ -99,8 +99,7 @@ CompiledProgram SceneCompiler::pack(const std::shared_ptr<Program>& program,
                         field_kind_name(field.kind) + ") is not set on " + chain_names(chain) +
                         "; set it on one of them, e.g. context[\"" + std::string(field.name) +
                         "\"] = ...");
-        pack_field(field, *value, out.record->data() + field.offset,
-                   out.label + ", variable '" + std::string(field.name) + "'", output_buffers);
+        pack_field(field, *value, out.record->data() + field.offset, out.label, output_buffers);
         if (value->kind == FieldKind::kBuffer) {
             out.buffers.push_back(value->buffer);
             if (!field.read_only) out.writable_buffers.push_back(value->buffer);
@@ -114,10 +113,12 @@ CompiledProgram SceneCompiler::pack(const std::shared_ptr<Program>& program,
 }
 
 void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& value,
-                               unsigned char* dst, const std::string& where,
+                               unsigned char* dst, const std::string& label,
                                std::vector<const Buffer*>* output_buffers) {
+    // Where the field is, for messages: built only for one, not for every field packed.
+    const auto where = [&] { return label + ", variable '" + std::string(field.name) + "'"; };
     auto mismatch = [&](const std::string& expected) {
-        return Error(where + ": the record field is " + expected + " but the variable holds " +
+        return Error(where() + ": the record field is " + expected + " but the variable holds " +
                      value.describe() + "; set it to a " + expected);
     };
     const bool checked = m_scene->exception_enabled(kExceptionBufferIndexOutOfBounds);
@@ -127,7 +128,7 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
                 throw mismatch("buffer of " + std::string(field.element->name));
             const Buffer& b = *value.buffer;
             if (!same_type(b.element(), *field.element))
-                throw Error(where + ": the program reads BufferView<" +
+                throw Error(where() + ": the program reads BufferView<" +
                             std::string(field.element->name) + "> but " + b.describe() + " holds " +
                             std::string(b.element().name) +
                             "; bind a buffer created with that element type");
@@ -145,7 +146,7 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
                 throw mismatch("texture sampler");
             const TextureSampler& t = *value.texture;
             if (!t.buffer())
-                throw Error(where + ": " + t.describe() +
+                throw Error(where() + ": " + t.describe() +
                             " has no texels; give it a 2D float4 buffer with set_buffer");
             TextureView view{t.buffer()->data<float4>(),
                              t.buffer()->size().x,
@@ -168,13 +169,13 @@ void SceneCompiler::pack_field(const FieldInfo& field, const VariableValue& valu
                 throw mismatch("callable program of signature " + std::string(field.element->name));
             const Program& p = *value.program;
             if (p.kind() != ProgramKind::kCallable)
-                throw Error(where + ": " + p.describe() +
+                throw Error(where() + ": " + p.describe() +
                             " is not a callable program; define it with LUCENT_CALLABLE");
             if (!same_type(*p.desc().signature, *field.element))
-                throw Error(where + ": the field wants a callable of signature " +
+                throw Error(where() + ": the field wants a callable of signature " +
                             std::string(field.element->name) + " but " + p.describe() + " is " +
                             std::string(p.desc().signature->name));
-            auto record = pack_callable(value.program, where);
+            auto record = pack_callable(value.program, where());
             // Callable<Sig> is {fn, record}; the fn pointer type is erased here.
             struct ErasedCallable {
                 void (*fn)();

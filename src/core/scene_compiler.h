@@ -55,8 +55,9 @@ class SceneCompiler {
     CompiledProgram pack(const std::shared_ptr<Program>& program, const ScopeChain& chain,
                          const std::string& owner,
                          std::vector<const Buffer*>* output_buffers = nullptr);
+    /// `label` names the program whose record holds the field (CompiledProgram::label).
     void pack_field(const FieldInfo& field, const VariableValue& value, unsigned char* dst,
-                    const std::string& where, std::vector<const Buffer*>* output_buffers);
+                    const std::string& label, std::vector<const Buffer*>* output_buffers);
     std::shared_ptr<PackedRecord> pack_callable(const std::shared_ptr<Program>& program,
                                                 const std::string& where);
 
