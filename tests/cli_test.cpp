@@ -644,4 +644,19 @@ TEST(CliBenchJson, SpheresBenchComparesTheSameWork) {
     EXPECT_GT(result["hit_fraction"].get<double>(), 0.5);
     EXPECT_GT(result["builtin_mrays"]["mrays"].get<double>(), 0.0);
     EXPECT_GT(result["custom_mrays"]["mrays"].get<double>(), 0.0);
+    // The CPU has no launch-shape tuning: no trial launch to leave out.
+    EXPECT_EQ(result["launch_shape_trials_left_out"], 0);
+}
+
+// `bench curves` times primary rays into a head of hair and one diffuse ray per primary hit.
+TEST(CliBenchJson, CurvesBenchTimesBothRaySets) {
+    CliRun run = run_cli("bench curves --segments 2000 --size 64x48 --repeat 2 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json result = nlohmann::json::parse(run.output);
+    EXPECT_EQ(result["segments"], 2000);
+    EXPECT_GT(result["primary_hit_fraction"].get<double>(), 0.1);
+    EXPECT_GT(result["diffuse_hit_fraction"].get<double>(), 0.0);
+    EXPECT_GT(result["primary_mrays"]["mrays"].get<double>(), 0.0);
+    EXPECT_GT(result["diffuse_mrays"]["mrays"].get<double>(), 0.0);
+    EXPECT_EQ(result["launch_shape_trials_left_out"], 0);
 }

@@ -2,7 +2,8 @@
 // unit sphere, bending under gravity, tapering); the head itself is a built-in sphere in the
 // same group. Primary rays (entry 0) and one diffuse ray from each primary hit (entry 1) are
 // launched alternately after warm-ups, timed per launch (CUDA events on the GPU, the launch
-// on the CPU): Mrays/s as median and spread.
+// on the CPU) after the launch-shape tuning (trial launches left out, as render --repeat):
+// Mrays/s as median and spread.
 #include "bench/curves/curves_bench.h"
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include "bench/common/report.h"
 #include "bench/curves/curves_programs.h"
 #include "lucent/lucent.h"
+#include "samples/stages.h"
 #include "scene/hair_strands.h"
 
 namespace lucent::bench {
@@ -32,10 +34,12 @@ const char* type_name(CurveType type) {
     }
 }
 
-double mrays(const LaunchReport& report, double rays, std::string& timing) {
-    const bool kernel = report.kernel_ms > 0;
+/// Mrays/s of a launch of `rays` rays: by its kernel's time where there is one (the GPU's
+/// CUDA events), else the whole launch's.
+double mrays(double kernel_ms, double launch_ms, double rays, std::string& timing) {
+    const bool kernel = kernel_ms > 0;
     timing = kernel ? "kernel" : "launch";
-    const double ms = kernel ? report.kernel_ms : report.launch_ms;
+    const double ms = kernel ? kernel_ms : launch_ms;
     return ms > 0 ? rays / (ms * 1e3) : 0.0;
 }
 
@@ -104,14 +108,36 @@ int run_curves_bench(const CurvesBenchOptions& options) {
     }
     unsigned primary_hits = 0;
     for (unsigned i = 0; i < pixels; ++i) primary_hits += points->data<float4>()[i].w != 0.0f;
-    std::vector<double> primary, diffuse;
-    for (int run = 0; run < options.repeat; ++run) {
+    // Each entry's launches after its launch-shape tuning, as render --repeat counts them
+    // (samples::SteadyLaunches leaves out trial launches, and the launches before a late one).
+    samples::SteadyLaunches primary_launches, diffuse_launches;
+    const size_t repeat = size_t(options.repeat);
+    const int most = options.repeat + int(samples::kMostTrialLaunches);
+    for (int run = 0; run < most && (primary_launches.ms.size() < repeat ||
+                                     diffuse_launches.ms.size() < repeat);
+         ++run) {
         ctx["seed"] = unsigned(run + 2);
         ctx.launch(0, options.width, options.height);
-        primary.push_back(mrays(ctx.last_launch(), pixels, timing));
+        primary_launches.add(ctx.last_launch());
         ctx.launch(1, options.width, options.height);
-        diffuse.push_back(mrays(ctx.last_launch(), primary_hits, timing));
+        diffuse_launches.add(ctx.last_launch());
     }
+    if (primary_launches.ms.empty() || diffuse_launches.ms.empty()) {
+        std::fprintf(stderr,
+                     "lucent bench curves: the launch-shape tuning was still trying shapes "
+                     "after %d launches of each entry; no steady launch to time\n",
+                     most);
+        return 1;
+    }
+    const auto rates = [&](const samples::SteadyLaunches& launches, double rays) {
+        std::vector<double> out;
+        for (size_t i = 0; i < launches.ms.size() && out.size() < repeat; ++i)
+            out.push_back(mrays(launches.kernel_ms[i], launches.ms[i], rays, timing));
+        return out;
+    };
+    const std::vector<double> primary = rates(primary_launches, pixels),
+                              diffuse = rates(diffuse_launches, primary_hits);
+    const unsigned trials = primary_launches.trials + diffuse_launches.trials;
     unsigned diffuse_hit_count = 0;
     for (unsigned i = 0; i < pixels; ++i) diffuse_hit_count += diffuse_hits->data<unsigned>()[i];
     const Rate primary_rate = rate_of(primary), diffuse_rate = rate_of(diffuse);
@@ -128,7 +154,8 @@ int run_curves_bench(const CurvesBenchOptions& options) {
                         {"diffuse_hit_fraction",
                          rounded(primary_hits ? double(diffuse_hit_count) / primary_hits : 0, 4)},
                         {"primary_mrays", rate_json(primary_rate)},
-                        {"diffuse_mrays", rate_json(diffuse_rate)}});
+                        {"diffuse_mrays", rate_json(diffuse_rate)},
+                        {"launch_shape_trials_left_out", trials}});
     } else {
         std::printf("curves: %zu %s segments of hair on a sphere, %ux%u on %s (%s time)\n",
                     hair.segments.size(), type_name(options.type), options.width,
@@ -138,6 +165,8 @@ int run_curves_bench(const CurvesBenchOptions& options) {
         std::printf("  diffuse rays  %s (one per primary hit), %.1f %% hit\n",
                     rate_text(diffuse_rate).c_str(),
                     primary_hits ? 100.0 * diffuse_hit_count / primary_hits : 0.0);
+        if (trials > 0)
+            std::printf("  (after %u launch-shape trial launches, left out)\n", trials);
     }
     return 0;
 }

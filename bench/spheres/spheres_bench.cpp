@@ -1,6 +1,7 @@
 // Built-in spheres against the same spheres as a custom primitive: two Contexts on one
 // backend, each with the field as its scene, launched alternately (A B, B A, ...) after a
-// warm-up each, timed per launch (CUDA events on the GPU, the launch on the CPU); Mrays/s as
+// warm-up each, timed per launch (CUDA events on the GPU, the launch on the CPU) and after
+// the launch-shape tuning (trial launches left out, as render --repeat); Mrays/s as
 // median and spread, and the ratio as the median of neighbouring launches' ratios. Both
 // must give every pixel the same sphere: the figure is of the same work.
 #include "bench/spheres/spheres_bench.h"
@@ -15,6 +16,7 @@
 #include "bench/common/report.h"
 #include "bench/spheres/spheres_programs.h"
 #include "lucent/lucent.h"
+#include "samples/stages.h"
 
 namespace lucent::bench {
 
@@ -99,14 +101,20 @@ SpherePath make_path(const SpheresBenchOptions& options, const SphereField& fiel
     return path;
 }
 
-/// Mrays/s of one launch of `path`.
-double timed_launch(SpherePath& path, const SpheresBenchOptions& options, std::string& timing) {
+/// One launch of `path`: its Mrays/s, and whether it was a launch-shape trial.
+struct PathLaunch {
+    double mrays;
+    bool trial;
+};
+PathLaunch timed_launch(SpherePath& path, const SpheresBenchOptions& options,
+                        std::string& timing) {
     path.ctx->launch(0, options.width, options.height);
     const LaunchReport& report = path.ctx->last_launch();
     const bool kernel = report.kernel_ms > 0;
     timing = kernel ? "kernel" : "launch";
     const double ms = kernel ? report.kernel_ms : report.launch_ms;
-    return ms > 0 ? double(options.width) * options.height / (ms * 1e3) : 0.0;
+    return {ms > 0 ? double(options.width) * options.height / (ms * 1e3) : 0.0,
+            report.launch_shape_trial};
 }
 
 }  // namespace
@@ -116,14 +124,21 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
     SpherePath builtin = make_path(options, field, true);
     SpherePath custom = make_path(options, field, false);
     std::string timing;
-    // Warm-ups: compile, accel build, the GPU's megakernel and its launch-shape tuning.
+    // Warm-ups: compile, accel build, the GPU's megakernel and most of its launch-shape
+    // tuning (the timed loop below leaves out any trial launch still to come).
     for (int i = 0; i < 6; ++i) {
         timed_launch(builtin, options, timing);
         timed_launch(custom, options, timing);
     }
+    // Pairs of launches after the launch-shape tuning, as render --repeat counts them
+    // (samples::SteadyLaunches): a pair with a trial launch in it (a shape or a kernel
+    // variant being tried, not the one chosen; variants arrive from a background compile)
+    // is left out, with the pairs before it, since the choice may change.
     std::vector<double> a, b, ratios;
-    for (int run = 0; run < options.repeat; ++run) {
-        double x, y;
+    unsigned trials = 0;
+    const int most = options.repeat + int(samples::kMostTrialLaunches);
+    for (int run = 0; int(a.size()) < options.repeat && run < most; ++run) {
+        PathLaunch x, y;
         if (run % 2 == 0) {
             x = timed_launch(builtin, options, timing);
             y = timed_launch(custom, options, timing);
@@ -131,9 +146,21 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
             y = timed_launch(custom, options, timing);
             x = timed_launch(builtin, options, timing);
         }
-        a.push_back(x);
-        b.push_back(y);
-        ratios.push_back(y > 0 ? x / y : 0.0);
+        if (x.trial || y.trial) {
+            trials += unsigned(x.trial) + unsigned(y.trial);
+            a.clear(), b.clear(), ratios.clear();
+            continue;
+        }
+        a.push_back(x.mrays);
+        b.push_back(y.mrays);
+        ratios.push_back(y.mrays > 0 ? x.mrays / y.mrays : 0.0);
+    }
+    if (a.empty()) {
+        std::fprintf(stderr,
+                     "lucent bench spheres: the launch-shape tuning was still trying shapes "
+                     "after %d pairs of launches; no steady launch to time\n",
+                     most);
+        return 1;
     }
     // The same work: every pixel the same sphere (or none), t to float rounding.
     const unsigned* pa = builtin.prim->data<unsigned>();
@@ -158,7 +185,8 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
                         {"pixels_that_differ", differ},
                         {"builtin_mrays", rate_json(builtin_rate)},
                         {"custom_mrays", rate_json(custom_rate)},
-                        {"builtin_over_custom", rounded(ratio, 3)}});
+                        {"builtin_over_custom", rounded(ratio, 3)},
+                        {"launch_shape_trials_left_out", trials}});
     } else {
         std::printf("spheres: %u in [-1,1]^3, primary rays %ux%u on %s (%s time), %.1f %% hit\n",
                     options.count, options.width, options.height, backend.c_str(),
@@ -166,6 +194,8 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
         std::printf("  built-in spheres       %s\n", rate_text(builtin_rate).c_str());
         std::printf("  custom program spheres %s\n", rate_text(custom_rate).c_str());
         std::printf("  built-in / custom      %.3f (median of paired launches)\n", ratio);
+        if (trials > 0)
+            std::printf("  (after %u launch-shape trial launches, left out)\n", trials);
         std::printf("  pixels whose sphere differs: %u of %u\n", differ, pixels);
     }
     if (differ > pixels / 10000) {
