@@ -46,6 +46,7 @@ namespace {
 void grow_by_points(const float3* points, size_t count, float lo[3], float hi[3]) {
     constexpr size_t kStep = 48;  // 16 points; a multiple of 3 and of the vector widths
     static_assert(sizeof(float3) == 3 * sizeof(float), "float3 must be three packed floats");
+    if (count == 0) return;
     const float* f = &points[0].x;
     const size_t floats = 3 * count, whole = floats / kStep * kStep;
     float step_lo[kStep], step_hi[kStep];

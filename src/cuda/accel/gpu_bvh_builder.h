@@ -54,9 +54,10 @@ class GpuBvhBuilder {
 
     /// Allocates ahead what a binned-SAH build of up to `triangles` triangles needs: its
     /// scratch, and a layout that the first build into an empty GpuTriangleBvhDevice takes.
-    /// Allocating device memory is a sizeable part of a first build (0.23-0.31 ms of Sponza's
-    /// 1.4-1.7 ms on an H200, docs/performance.md); done ahead, on another thread while the
-    /// application loads its scene, the first build starts at once. Throws lucent::Error when
+    /// Allocating device memory is a sizeable part of a first build (Sponza on an H200:
+    /// 0.23-0.31 ms, against 1.1-1.2 ms for the build's kernels; docs/performance.md); done
+    /// ahead, on another thread while the application loads its scene, the first build
+    /// starts at once. Throws lucent::Error when
     /// the memory cannot be had; a build then allocates what it needs itself.
     void prepare(unsigned triangles);
 
