@@ -662,33 +662,49 @@ LUCENT_RUNTIME_INLINE void begin_frame(FrameOf<P>& f, const Ray& ray, void* payl
     f.context = ProgramContext::kIntersection;
 }
 
+/// The closest-hit program of the committed hit, if one is bound and not disabled, with
+/// the hit's attributes.
+template <class P>
+LUCENT_RUNTIME_INLINE void run_closest_hit(const P& p, FrameOf<P>& f,
+                                           const typename P::Instance& inst, const Ray& ray,
+                                           const typename FrameOf<P>::Attributes& attributes) {
+    if constexpr (P::kTransforms) f.object_ray = ray;
+    const typename P::Program closest = p.closest_hit(inst, f.hit_material, f.ray_type);
+    if (p.bound(closest) && !(f.ray_flags & kRayFlagDisableClosestHit)) {
+        f.context = ProgramContext::kClosestHit;
+        p.call_closest_hit(closest, f.payload, attributes.bytes);
+    }
+}
+
 /// After traversal: the attributes of a pending triangle hit, then closest hit or miss.
 template <class P>
 LUCENT_RUNTIME_INLINE void shade(const P& p, FrameOf<P>& f, const Ray& ray) {
     if (f.has_hit) {
         const typename P::Instance& inst = p.instance(f.hit_instance);
-        if (f.hit_pending) {
-            // The attribute program runs as at the hit: its primitive, transform and ray.
-            f.instance = f.hit_instance;
-            f.prim = f.hit_prim;
-            if constexpr (P::kTransforms) {
-                f.object_ray = ray;
-                f.transformed = f.hit_transformed;
-                if (f.hit_transformed) {
-                    f.to_world = f.hit_to_world;
-                    f.to_object = f.hit_to_object;
-                    f.object_ray.origin = transform_point(f.hit_to_object, ray.origin);
-                    f.object_ray.direction = transform_vector(f.hit_to_object, ray.direction);
-                }
+        if (!f.hit_pending) {
+            run_closest_hit(p, f, inst, ray, f.hit_attr);
+            return;
+        }
+        // The attribute program runs as at the hit: its primitive, transform and ray.
+        f.instance = f.hit_instance;
+        f.prim = f.hit_prim;
+        if constexpr (P::kTransforms) {
+            f.object_ray = ray;
+            f.transformed = f.hit_transformed;
+            if (f.hit_transformed) {
+                f.to_world = f.hit_to_world;
+                f.to_object = f.hit_to_object;
+                f.object_ray.origin = transform_point(f.hit_to_object, ray.origin);
+                f.object_ray.direction = transform_vector(f.hit_to_object, ray.direction);
             }
-            triangle_attributes(p, f, inst, f.hit_prim, f.hit_bary, f.hit_attr);
         }
-        if constexpr (P::kTransforms) f.object_ray = ray;
-        const typename P::Program closest = p.closest_hit(inst, f.hit_material, f.ray_type);
-        if (p.bound(closest) && !(f.ray_flags & kRayFlagDisableClosestHit)) {
-            f.context = ProgramContext::kClosestHit;
-            p.call_closest_hit(closest, f.payload, f.hit_attr.bytes);
-        }
+        // In a local, not in the frame (which the thread state points at): where the
+        // closest-hit program is inlined and never reads its attributes (a program that
+        // needs only t_hit() and primitive_index()), the compiler drops their computation,
+        // the triangle's index and vertex loads included.
+        typename FrameOf<P>::Attributes attributes;
+        triangle_attributes(p, f, inst, f.hit_prim, f.hit_bary, attributes);
+        run_closest_hit(p, f, inst, ray, attributes);
     } else {
         const typename P::Program miss = p.miss(f.ray_type);
         if (p.bound(miss)) {

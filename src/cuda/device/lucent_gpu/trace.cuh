@@ -440,6 +440,7 @@ __device__ __forceinline__ void run_launch(RunRayGeneration run_ray_generation,
 #else
     const bool tiled = false;
 #endif
+    const bool one_dimension = p.launch_size.y == 1 && p.launch_size.z == 1;
     const unsigned long long first_row = piece_first / p.launch_size.x;
     const unsigned long long end_row = piece_last / p.launch_size.x;
     const unsigned tiles_x = (p.launch_size.x + 7) / 8;
@@ -461,6 +462,11 @@ __device__ __forceinline__ void run_launch(RunRayGeneration run_ray_generation,
             if (x >= p.launch_size.x || row >= end_row) continue;
             y = unsigned(row % p.launch_size.y);
             z = unsigned(row / p.launch_size.y);
+        } else if (one_dimension) {  // no divisions (two 64-bit ones below)
+            const unsigned long long index = piece_first + base + lane;
+            if (index >= piece_last) continue;
+            x = unsigned(index);
+            y = z = 0;
         } else {
             unsigned long long index = piece_first + base + lane;
             if (index >= piece_last) continue;
