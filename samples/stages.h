@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <string>
 #include <vector>
 
 #include "lucent/context.h"
@@ -45,6 +46,11 @@ struct SteadyLaunches {
 /// The most launches timed_launch makes beyond the repeats asked for: the tuning spends a
 /// handful per kernel, a few more when a variant arrives from its background compile.
 constexpr unsigned kMostTrialLaunches = 96;
+
+/// Mrays/s of a launch that traced `rays` rays: from the kernel's own time where the backend
+/// measured it (the GPU's CUDA events), else from the whole launch's. `timing` is set to
+/// "kernel" or "launch", saying which.
+double launch_mrays(double rays, double kernel_ms, double launch_ms, std::string& timing);
 
 /// Launches `entry` over width x height, then more times when `settings.repeat` asks, and
 /// fills `result`: report of the first launch, stages "compile + accel", "megakernel JIT"

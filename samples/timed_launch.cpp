@@ -21,6 +21,13 @@ void add_compile_stages(const LaunchReport& report, std::vector<StageTiming>& st
              report.jit_cached ? "loaded from the kernel cache" : "cold NVRTC compile"});
 }
 
+double launch_mrays(double rays, double kernel_ms, double launch_ms, std::string& timing) {
+    const bool kernel = kernel_ms > 0;
+    timing = kernel ? "kernel" : "launch";
+    const double ms = kernel ? kernel_ms : launch_ms;
+    return ms > 0 ? rays / (ms * 1e3) : 0.0;
+}
+
 void SteadyLaunches::add(const LaunchReport& report) {
     if (report.launch_shape_trial) {
         ++trials;

@@ -34,15 +34,6 @@ const char* type_name(CurveType type) {
     }
 }
 
-/// Mrays/s of a launch of `rays` rays: by its kernel's time where there is one (the GPU's
-/// CUDA events), else the whole launch's.
-double mrays(double kernel_ms, double launch_ms, double rays, std::string& timing) {
-    const bool kernel = kernel_ms > 0;
-    timing = kernel ? "kernel" : "launch";
-    const double ms = kernel ? kernel_ms : launch_ms;
-    return ms > 0 ? rays / (ms * 1e3) : 0.0;
-}
-
 }  // namespace
 
 int run_curves_bench(const CurvesBenchOptions& options) {
@@ -132,7 +123,8 @@ int run_curves_bench(const CurvesBenchOptions& options) {
     const auto rates = [&](const samples::SteadyLaunches& launches, double rays) {
         std::vector<double> out;
         for (size_t i = 0; i < launches.ms.size() && out.size() < repeat; ++i)
-            out.push_back(mrays(launches.kernel_ms[i], launches.ms[i], rays, timing));
+            out.push_back(
+                samples::launch_mrays(rays, launches.kernel_ms[i], launches.ms[i], timing));
         return out;
     };
     const std::vector<double> primary = rates(primary_launches, pixels),

@@ -30,11 +30,6 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
     return program;
 }
 
-/// The most launches one measurement makes: the timed ones, and those the GPU backend's
-/// launch-shape tuning spends (a handful per entry, a few more when a register-capped
-/// variant of the kernel arrives from its background compile).
-constexpr int kMostLaunches = 96;
-
 /// The kernel variant a CUDA launch ran (empty on the CPU): as compiled, or compiled with
 /// registers capped, trace() inlined or both (ContextOptions::register_variants).
 std::string variant_of(const LaunchReport& report) {
@@ -53,19 +48,17 @@ Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std:
                     std::string& variant) {
     samples::SteadyLaunches steady;
     ctx.launch(entry, unsigned(count));
-    for (int launch = 1; launch < kMostLaunches && int(steady.ms.size()) < repeat; ++launch) {
+    const int most = repeat + int(samples::kMostTrialLaunches);
+    for (int launch = 1; launch < most && int(steady.ms.size()) < repeat; ++launch) {
         ctx.launch(entry, unsigned(count));
         const LaunchReport& report = ctx.last_launch();
         steady.add(report);
         if (!report.launch_shape_trial) variant = variant_of(report);  // the tuning's choice
     }
     std::vector<double> mrays;
-    for (size_t i = 0; i < steady.ms.size(); ++i) {
-        const bool kernel = steady.kernel_ms[i] > 0;
-        timing = kernel ? "kernel" : "launch";
-        const double ms = kernel ? steady.kernel_ms[i] : steady.ms[i];
-        mrays.push_back(ms > 0 ? count / (ms * 1e3) : 0.0);
-    }
+    for (size_t i = 0; i < steady.ms.size(); ++i)
+        mrays.push_back(
+            samples::launch_mrays(double(count), steady.kernel_ms[i], steady.ms[i], timing));
     return rate_of(mrays);
 }
 

@@ -110,10 +110,8 @@ PathLaunch timed_launch(SpherePath& path, const SpheresBenchOptions& options,
                         std::string& timing) {
     path.ctx->launch(0, options.width, options.height);
     const LaunchReport& report = path.ctx->last_launch();
-    const bool kernel = report.kernel_ms > 0;
-    timing = kernel ? "kernel" : "launch";
-    const double ms = kernel ? report.kernel_ms : report.launch_ms;
-    return {ms > 0 ? double(options.width) * options.height / (ms * 1e3) : 0.0,
+    return {samples::launch_mrays(double(options.width) * options.height, report.kernel_ms,
+                                  report.launch_ms, timing),
             report.launch_shape_trial};
 }
 
