@@ -95,8 +95,13 @@ class Buffer : public ContextObject {
 
   private:
     void check_element(const TypeInfo& requested) const;
-    struct alignas(16) Block {
-        unsigned char bytes[16];
+    /// The host copy starts on a cache line. The CPU backend's workers write neighbouring
+    /// pieces of a launch's output (64 launch indices each in 1D); starting mid-line, each
+    /// piece shared its first and last lines with the pieces beside it, often another
+    /// worker's, and every such write moved the line between cores: `bench rays --programs`
+    /// shadow rays (one byte each) ran 20-25 % slower on two threads (docs/performance.md).
+    struct alignas(64) Block {
+        unsigned char bytes[64];
     };
     unsigned char* bytes() { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
     const unsigned char* bytes() const { return m_blocks.empty() ? nullptr : m_blocks[0].bytes; }
@@ -104,7 +109,7 @@ class Buffer : public ContextObject {
     const TypeInfo* m_element;
     unsigned m_dimensionality;
     uint3 m_size;
-    std::vector<Block> m_blocks;  // 16-byte aligned backing store
+    std::vector<Block> m_blocks;  // cache-line aligned backing store
     bool m_mapped = false;
     mutable bool m_device_newer = false;
     mutable bool m_zeroed = true;  // see zeroed()

@@ -50,7 +50,7 @@ void Buffer::resize(unsigned width, unsigned height, unsigned depth) {
     m_device_newer = false;
     m_zeroed = true;
     size_t bytes = count() * m_element->size;
-    m_blocks.assign((bytes + 15) / 16, Block{});
+    m_blocks.assign((bytes + sizeof(Block) - 1) / sizeof(Block), Block{});
     ++m_version;
     changed();
 }
