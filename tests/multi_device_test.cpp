@@ -309,6 +309,22 @@ TEST(BufferContents, AreZeroedUntilSomethingWritesThem) {
     EXPECT_FALSE(sum->zeroed()) << "mapped: the host may have written it";
 }
 
+TEST(BufferContents, StartOnACacheLineWhateverTheirSize) {
+    // The CPU backend's workers write neighbouring 64-index pieces of an output; a host
+    // copy that started mid-line made neighbouring pieces share lines (false sharing).
+    Scene s(options_for({kCpu}));
+    for (unsigned count : {1u, 3u, 1000u, 786432u}) {
+        auto bytes = s.ctx.create_buffer<unsigned char>(BufferType::kOutput, count);
+        const auto address = reinterpret_cast<uintptr_t>(bytes->map<unsigned char>());
+        bytes->unmap();
+        EXPECT_EQ(address % 64, 0u) << count << " bytes";
+        bytes->resize(count + 17);
+        EXPECT_EQ(reinterpret_cast<uintptr_t>(bytes->map<unsigned char>()) % 64, 0u)
+            << "resized to " << count + 17;
+        bytes->unmap();
+    }
+}
+
 TEST(DeviceList, ParsesNumbersCpuAndAll) {
     EXPECT_EQ(parse_device_list("0,1"), (std::vector<DeviceSpec>{gpu(0), gpu(1)}));
     EXPECT_EQ(parse_device_list(" CPU , 0 "), (std::vector<DeviceSpec>{kCpu, gpu(0)}));

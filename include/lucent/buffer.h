@@ -99,7 +99,7 @@ class Buffer : public ContextObject {
     /// pieces of a launch's output (64 launch indices each in 1D); starting mid-line, each
     /// piece shared its first and last lines with the pieces beside it, often another
     /// worker's, and every such write moved the line between cores: `bench rays --programs`
-    /// shadow rays (one byte each) ran 20-25 % slower on two threads (docs/performance.md).
+    /// shadow rays (one byte each) ran up to 12 % slower on two threads (docs/performance.md).
     struct alignas(64) Block {
         unsigned char bytes[64];
     };
