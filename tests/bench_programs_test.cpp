@@ -1,8 +1,10 @@
 // `lucent bench rays --programs` (bench/rays/programs_bench.h): the ray sets traced by the
 // rays_programs.h module through a Context on the CPU give the checksums of the bare
-// traversal (TriangleAccel) on the same rays.
+// traversal (TriangleAccel) on the same rays, and the passes paired with the launches
+// give the ratios.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,40 @@ TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
     EXPECT_GT(p.shadow.median, 0.0);
     EXPECT_GT(p.diffuse.median, 0.0);
     EXPECT_EQ(p.timing, "launch");
+}
+
+TEST(BenchPrograms, PairedPassesRunBesideEachLaunchAndGiveTheirRatios) {
+    const scene::ObjMesh mesh = open_box_with_occluder();
+    const Camera cam{make_float3(0, 0.8f, 3), make_float3(0, 0.4f, 0), make_float3(0, 1, 0),
+                     60.0f, make_float3(0.1f, 1.5f, 0.1f)};
+    const RaySet primary = primary_rays(cam, 96, 72);
+    ProgramsInput in;
+    in.mesh = &mesh;
+    in.primary = &primary;
+    in.light = cam.light;
+    in.threads = 2;
+    in.repeat = 3;
+    // Two engines whose passes take 1 s and 2 s: each ratio is then the launch's rate in
+    // rays per second over the set's size (times 2), a median of odd count like the rate's.
+    std::map<RayKind, std::vector<size_t>> calls;
+    in.paired_passes = [&](RayKind kind, const RaySet& rays) {
+        calls[kind].push_back(rays.size());
+        return std::vector<double>{1.0, 2.0};
+    };
+    const ProgramsResult p = run_programs(in);
+    // One warm-up pass and one pass per timed launch, over the rays the launch traces.
+    EXPECT_EQ(calls[RayKind::kPrimary], std::vector<size_t>(4, primary.size()));
+    EXPECT_EQ(calls[RayKind::kShadow], std::vector<size_t>(4, p.shadow_rays));
+    EXPECT_EQ(calls[RayKind::kDiffuse], std::vector<size_t>(4, p.diffuse_rays));
+    ASSERT_EQ(p.paired.size(), 2u);
+    EXPECT_NEAR(p.paired[0].primary, p.primary.median * 1e6 / primary.size(),
+                1e-9 * p.paired[0].primary);
+    EXPECT_NEAR(p.paired[0].shadow, p.shadow.median * 1e6 / p.shadow_rays,
+                1e-9 * p.paired[0].shadow);
+    EXPECT_NEAR(p.paired[0].diffuse, p.diffuse.median * 1e6 / p.diffuse_rays,
+                1e-9 * p.paired[0].diffuse);
+    EXPECT_DOUBLE_EQ(p.paired[1].primary, 2 * p.paired[0].primary);
+    EXPECT_DOUBLE_EQ(p.paired[1].diffuse, 2 * p.paired[0].diffuse);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "bench/rays/programs_bench.h"
 
 #include <cstdlib>
+#include <functional>
 #include <vector>
 
 #include "bench/common/input_buffer.h"
@@ -44,17 +45,38 @@ std::string variant_of(const LaunchReport& report) {
 /// first launch compiles the scene and, on the GPU, the kernel; trial launches are left out
 /// as the samples' `render --repeat` leaves them (samples::SteadyLaunches), so a median of
 /// 5 is never a trial shape's time.
+/// With `paired` (a set's PairedPasses bound to its rays), each timed launch also has the
+/// paired engines' passes beside it, in turn before and after it; `ratios[e]` gets the
+/// median of engine e's pass seconds over its neighbouring launch's.
 Rate timed_launches(Context& ctx, unsigned entry, size_t count, int repeat, std::string& timing,
-                    std::string& variant) {
+                    std::string& variant, const std::function<std::vector<double>()>& paired,
+                    std::vector<double>& ratios) {
     samples::SteadyLaunches steady;
     ctx.launch(entry, unsigned(count));
+    if (paired) paired();  // their warm-up pass, as the launch above is the programs'
+    std::vector<std::vector<double>> pair_ratios;
     const int most = repeat + int(samples::kMostTrialLaunches);
     for (int launch = 1; launch < most && int(steady.ms.size()) < repeat; ++launch) {
+        const bool paired_first = paired && launch % 2 == 0;
+        std::vector<double> passes;
+        if (paired_first) passes = paired();
         ctx.launch(entry, unsigned(count));
         const LaunchReport& report = ctx.last_launch();
-        steady.add(report);
-        if (!report.launch_shape_trial) variant = variant_of(report);  // the tuning's choice
+        if (paired && !paired_first) passes = paired();
+        const size_t kept = steady.ms.size();
+        steady.add(report);  // a launch-shape trial clears the launches before it
+        if (steady.ms.size() <= kept) pair_ratios.clear();
+        if (!report.launch_shape_trial) {
+            variant = variant_of(report);  // the tuning's choice
+            const double launch_s =
+                (report.kernel_ms > 0 ? report.kernel_ms : report.launch_ms) * 1e-3;
+            pair_ratios.resize(passes.size());
+            for (size_t e = 0; e < passes.size(); ++e)
+                pair_ratios[e].push_back(launch_s > 0 ? passes[e] / launch_s : 0.0);
+        }
     }
+    ratios.clear();
+    for (const std::vector<double>& r : pair_ratios) ratios.push_back(median_of(r));
     std::vector<double> mrays;
     for (size_t i = 0; i < steady.ms.size(); ++i)
         mrays.push_back(
@@ -108,8 +130,17 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     // Each set's entry point is added when its rays exist (every entry needs its program).
     ctx.set_entry_point_count(1);
     ctx.set_ray_generation_program(kPrimaryEntry, primary_program);
+    // The paired engines' passes over a set's rays, and where their ratios go.
+    std::vector<double> primary_ratios, shadow_ratios, diffuse_ratios;
+    auto paired_on = [&](RayKind kind, const RaySet& rays) -> std::function<std::vector<double>()> {
+        if (!in.paired_passes) return {};
+        return [&in, kind, &rays] { return in.paired_passes(kind, rays); };
+    };
     res.primary = timed_launches(ctx, kPrimaryEntry, primary.size(), in.repeat, res.timing,
-                                 res.primary_variant);
+                                 res.primary_variant, paired_on(RayKind::kPrimary, primary),
+                                 primary_ratios);
+    res.paired.resize(primary_ratios.size());
+    for (size_t e = 0; e < res.paired.size(); ++e) res.paired[e].primary = primary_ratios[e];
     const auto* hit = primary_hits->data<programs::RayHit>();
     sum_hits(hit, primary.size(), res.primary_hits, res.primary_sum_t);
     std::vector<float> t(primary.size());
@@ -127,7 +158,8 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     ctx.set_entry_point_count(2);
     ctx.set_ray_generation_program(kShadowEntry, shadow_program);
     res.shadow = timed_launches(ctx, kShadowEntry, shadow.size(), in.repeat, res.timing,
-                                res.shadow_variant);
+                                res.shadow_variant, paired_on(RayKind::kShadow, shadow),
+                                shadow_ratios);
     const unsigned char* b = blocked->data<unsigned char>();
     for (size_t i = 0; i < shadow.size(); ++i) res.occluded += b[i];
 
@@ -136,7 +168,12 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     ctx.set_entry_point_count(3);
     ctx.set_ray_generation_program(kDiffuseEntry, diffuse_program);
     res.diffuse = timed_launches(ctx, kDiffuseEntry, diffuse.size(), in.repeat, res.timing,
-                                 res.diffuse_variant);
+                                 res.diffuse_variant, paired_on(RayKind::kDiffuse, diffuse),
+                                 diffuse_ratios);
+    for (size_t e = 0; e < res.paired.size(); ++e) {
+        res.paired[e].shadow = e < shadow_ratios.size() ? shadow_ratios[e] : 0.0;
+        res.paired[e].diffuse = e < diffuse_ratios.size() ? diffuse_ratios[e] : 0.0;
+    }
     sum_hits(diffuse_hits->data<programs::RayHit>(), diffuse.size(), res.diffuse_hits,
              res.diffuse_sum_t);
     return res;

@@ -4,7 +4,9 @@
 // per-ray path (ray generation, trace, closest hit or miss) costs.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "bench/common/rate.h"
 #include "bench/common/ray_checksums.h"
@@ -14,6 +16,13 @@
 
 namespace lucent::bench {
 
+/// The three ray sets of BENCH.md.
+enum class RayKind { kPrimary, kShadow, kDiffuse };
+
+/// Timed passes of other engines (the bare kernels, a peer) over the rays a set's launch
+/// traces, seconds each, in a fixed order of engines.
+using PairedPasses = std::function<std::vector<double>(RayKind kind, const RaySet& rays)>;
+
 struct ProgramsInput {
     const scene::ObjMesh* mesh = nullptr;
     const RaySet* primary = nullptr;  // primary_rays(); shadow and diffuse follow from its hits
@@ -21,6 +30,17 @@ struct ProgramsInput {
     BackendKind backend = BackendKind::kCpu;
     unsigned threads = 0;  // CPU workers, 0 = one per core
     int repeat = 5;        // timed launches per ray set (median), after one warm-up launch
+    // When set, each timed launch has a neighbour: these passes run beside it, before it
+    // and after it in turn (A B, B A, ...), as the kernels and the peer take turns. The
+    // machines this runs on slow down for seconds at a time, so a ratio of two rates
+    // timed seconds apart measures the machine as much as the engines.
+    PairedPasses paired_passes;
+};
+
+/// The programs' rate over each paired engine's, per ray set: medians over the timed
+/// launches of (the engine's pass seconds / the neighbouring launch's seconds).
+struct PairedRatios {
+    double primary = 0, shadow = 0, diffuse = 0;
 };
 
 /// Mrays/s per ray set and the checksums, in RayChecksums' terms.
@@ -33,6 +53,8 @@ struct ProgramsResult : RayChecksums {
     // CUDA: the kernel variant each set's timed launches ran, as the launch-shape tuning
     // chose it ("as compiled", "registers capped", "trace inlined", or both); empty on the CPU.
     std::string primary_variant, shadow_variant, diffuse_variant;
+    // With ProgramsInput::paired_passes: one entry per paired engine, in its order.
+    std::vector<PairedRatios> paired;
 };
 
 /// Builds the Context (one GeometryTriangles under a GeometryGroup, the module's programs),

@@ -206,6 +206,27 @@ BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float
     return res;
 }
 
+/// Seconds of one pass of an engine over `rays`: closest hits for primary and diffuse
+/// rays, occlusion for shadow rays, the answers written as run_engines writes them.
+template <class Closest, class Any>
+double engine_pass(RayKind kind, const RaySet& rays, unsigned threads, Closest& closest,
+                   Any& any) {
+    if (kind == RayKind::kShadow) {
+        ResultVector<unsigned char> blocked(rays.size());
+        return timed_pass(rays.size(), threads, [&](size_t i) {
+            blocked[i] = any(rays.origin[i], rays.direction[i], rays.tmax[i]);
+        });
+    }
+    Hits out{ResultVector<float>(rays.size()), ResultVector<uint32_t>(rays.size())};
+    return timed_pass(rays.size(), threads, [&](size_t i) {
+        float t;
+        uint32_t prim;
+        const bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
+        out.t[i] = hit ? t : -1.0f;
+        out.prim[i] = hit ? prim : 0;
+    });
+}
+
 void print_engine(const char* prefix, const EngineResult& r) {
     std::printf("%sprimary %s hits=%zu sum_t=%.6e\n", prefix, rate_text(r.primary).c_str(),
                 r.primary_hits, r.primary_sum_t);
@@ -255,18 +276,27 @@ EngineResult engine_of(const ProgramsResult& p) {
     return r;
 }
 
+/// The programs' rate over another engine's, per ray set: the median of the paired passes'
+/// ratios where the run paired them with this engine's (`paired` is its position), else
+/// the ratio of the two medians.
+PairedRatios programs_ratios(const ProgramsResult& p, const EngineResult& other, size_t paired) {
+    if (paired < p.paired.size()) return p.paired[paired];
+    return PairedRatios{median_ratio(p.primary, other.primary), median_ratio(p.shadow, other.shadow),
+                        median_ratio(p.diffuse, other.diffuse)};
+}
+
 Json programs_json(const ProgramsResult& p, const EngineResult& kernels, const EngineResult* peer,
                    const std::string& differences) {
     Json j = json_engine(engine_of(p));
     j["backend"] = p.backend;
     j["timing"] = p.timing;
-    j["ratio_to_kernels"] = Json{{"primary", rounded(median_ratio(p.primary, kernels.primary), 4)},
-                                 {"shadow", rounded(median_ratio(p.shadow, kernels.shadow), 4)},
-                                 {"diffuse", rounded(median_ratio(p.diffuse, kernels.diffuse), 4)}};
-    if (peer)
-        j["ratio_to_embree"] = Json{{"primary", rounded(median_ratio(p.primary, peer->primary), 4)},
-                                    {"shadow", rounded(median_ratio(p.shadow, peer->shadow), 4)},
-                                    {"diffuse", rounded(median_ratio(p.diffuse, peer->diffuse), 4)}};
+    auto ratios = [](const PairedRatios& r) {
+        return Json{{"primary", rounded(r.primary, 4)},
+                    {"shadow", rounded(r.shadow, 4)},
+                    {"diffuse", rounded(r.diffuse, 4)}};
+    };
+    j["ratio_to_kernels"] = ratios(programs_ratios(p, kernels, 0));
+    if (peer) j["ratio_to_embree"] = ratios(programs_ratios(p, *peer, 1));
     j["checksums_agree"] = differences.empty();
     return j;
 }
@@ -277,13 +307,12 @@ void print_programs(const ProgramsResult& p, const EngineResult& kernels, const 
     std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
                 p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
     print_engine("programs ", engine_of(p));
-    auto ratios = [&](const char* what, const EngineResult& b) {
+    auto ratios = [&](const char* what, const PairedRatios& r) {
         std::printf("ratio programs/%s primary %.2fx, shadow %.2fx, diffuse %.2fx\n", what,
-                    median_ratio(p.primary, b.primary), median_ratio(p.shadow, b.shadow),
-                    median_ratio(p.diffuse, b.diffuse));
+                    r.primary, r.shadow, r.diffuse);
     };
-    ratios("kernels", kernels);
-    if (peer) ratios("embree", *peer);
+    ratios("kernels", programs_ratios(p, kernels, 0));
+    if (peer) ratios("embree", programs_ratios(p, *peer, 1));
     if (differences.empty())
         std::printf("programs' checksums agree with the kernels\n");
     else
@@ -462,6 +491,22 @@ int run_bench_rays(const RaysOptions& options) {
         ProgramsInput in;
         in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
         in.backend = BackendKind::kCpu, in.threads = threads, in.repeat = options.repeat;
+        // The kernels' pass and the peer's beside each launch, so that the programs' ratios
+        // to them compare neighbouring passes, as the kernels' ratio to the peer does.
+        auto kernel_closest = closest_query(accel);
+        auto kernel_any = occluded_query(accel);
+        auto peer_closest = [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
+            return embree_peer->intersect(o, d, 0.0f, tmax, t, prim);
+        };
+        auto peer_any = [&](float3 o, float3 d, float tmax) {
+            return embree_peer->occluded(o, d, 0.0f, tmax);
+        };
+        in.paired_passes = [&](RayKind kind, const RaySet& rays) {
+            std::vector<double> seconds;
+            seconds.push_back(engine_pass(kind, rays, threads, kernel_closest, kernel_any));
+            if (peer) seconds.push_back(engine_pass(kind, rays, threads, peer_closest, peer_any));
+            return seconds;
+        };
         result.programs = true;
         result.program_figures = run_programs(in);
         result.program_differences = checksum_differences(
