@@ -65,10 +65,15 @@ scene::ObjMesh open_box_with_occluder() {
     return mesh;
 }
 
+/// A camera looking into that box, its light above the floating quad.
+Camera box_camera() {
+    return Camera{make_float3(0, 0.8f, 3), make_float3(0, 0.4f, 0), make_float3(0, 1, 0), 60.0f,
+                  make_float3(0.1f, 1.5f, 0.1f)};
+}
+
 TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
     const scene::ObjMesh mesh = open_box_with_occluder();
-    const Camera cam{make_float3(0, 0.8f, 3), make_float3(0, 0.4f, 0), make_float3(0, 1, 0),
-                     60.0f, make_float3(0.1f, 1.5f, 0.1f)};
+    const Camera cam = box_camera();
     const RaySet primary = primary_rays(cam, 96, 72);
     const RayChecksums kernels = kernel_checksums(mesh, primary, cam.light);
     // Every kind of answer occurs: hits and misses, blocked and free shadow rays.
@@ -100,8 +105,7 @@ TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
 
 TEST(BenchPrograms, PairedPassesRunBesideEachLaunchAndGiveTheirRatios) {
     const scene::ObjMesh mesh = open_box_with_occluder();
-    const Camera cam{make_float3(0, 0.8f, 3), make_float3(0, 0.4f, 0), make_float3(0, 1, 0),
-                     60.0f, make_float3(0.1f, 1.5f, 0.1f)};
+    const Camera cam = box_camera();
     const RaySet primary = primary_rays(cam, 96, 72);
     ProgramsInput in;
     in.mesh = &mesh;

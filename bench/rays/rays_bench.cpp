@@ -36,7 +36,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr unsigned kChunk = 64;   // rays per work item handed out by the atomic counter
+constexpr unsigned kChunk = 64;  // rays per work item handed out by the atomic counter
 static_assert(kChunk % 64 == 0, "a chunk's 1-byte results must fill whole cache lines");
 
 /// Allocates on cache-line boundaries. The threads of a pass write their results in chunks
@@ -96,6 +96,31 @@ double timed_pass(size_t count, unsigned threads, const Body& body) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The hits of `rays`, one slot per ray.
+Hits hits_for(const RaySet& rays) {
+    return Hits{ResultVector<float>(rays.size()), ResultVector<uint32_t>(rays.size())};
+}
+
+/// The body of a closest-hit pass: ray i's t (-1 on a miss) and triangle into `out`.
+template <class Closest>
+auto closest_body(Closest& closest, const RaySet& rays, Hits& out) {
+    return [&closest, &rays, &out](size_t i) {
+        float t;
+        uint32_t prim;
+        const bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
+        out.t[i] = hit ? t : -1.0f;
+        out.prim[i] = hit ? prim : 0;
+    };
+}
+
+/// The body of an occlusion pass: whether ray i is blocked into `out`.
+template <class Any>
+auto occlusion_body(Any& any, const RaySet& rays, ResultVector<unsigned char>& out) {
+    return [&any, &rays, &out](size_t i) {
+        out[i] = any(rays.origin[i], rays.direction[i], rays.tmax[i]);
+    };
+}
+
 /// Two engines' rates on the same rays, and the median of the ratios of their neighbouring
 /// passes.
 struct PairedRates {
@@ -153,27 +178,15 @@ BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float
                         LucentAny&& lucent_any, PeerClosest&& peer_closest, PeerAny&& peer_any,
                         bool with_peer) {
     BenchResult res;
-    auto tracer = [](auto& closest, const RaySet& rays, Hits& out) {
-        return [&closest, &rays, &out](size_t i) {
-            float t;
-            uint32_t prim;
-            const bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
-            out.t[i] = hit ? t : -1.0f;
-            out.prim[i] = hit ? prim : 0;
-        };
-    };
     auto sum_hits = [](const Hits& hits, size_t& count, double& sum_t) {
         for (float t : hits.t)
             if (t >= 0.0f) ++count, sum_t += t;
     };
-    auto hits_for = [](const RaySet& rays) {
-        return Hits{ResultVector<float>(rays.size()), ResultVector<uint32_t>(rays.size())};
-    };
 
     Hits lucent_hits = hits_for(primary), peer_hits = hits_for(primary);
-    PairedRates p =
-        timed_pair(primary.size(), threads, repeat, tracer(lucent_closest, primary, lucent_hits),
-                   tracer(peer_closest, primary, peer_hits), with_peer);
+    PairedRates p = timed_pair(primary.size(), threads, repeat,
+                               closest_body(lucent_closest, primary, lucent_hits),
+                               closest_body(peer_closest, primary, peer_hits), with_peer);
     res.lucent.primary = p.a, res.peer.primary = p.b, res.primary_ratio = p.ratio;
     sum_hits(lucent_hits, res.lucent.primary_hits, res.lucent.primary_sum_t);
     sum_hits(peer_hits, res.peer.primary_hits, res.peer.primary_sum_t);
@@ -182,23 +195,18 @@ BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float
     secondary_rays(primary, lucent_hits.t.data(), lucent_hits.prim.data(), mesh, light, shadow,
                    diffuse);
     ResultVector<unsigned char> lucent_blocked(shadow.size()), peer_blocked(shadow.size());
-    p = timed_pair(
-        shadow.size(), threads, repeat,
-        [&](size_t i) {
-            lucent_blocked[i] = lucent_any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
-        },
-        [&](size_t i) {
-            peer_blocked[i] = peer_any(shadow.origin[i], shadow.direction[i], shadow.tmax[i]);
-        },
-        with_peer);
+    p = timed_pair(shadow.size(), threads, repeat,
+                   occlusion_body(lucent_any, shadow, lucent_blocked),
+                   occlusion_body(peer_any, shadow, peer_blocked), with_peer);
     res.lucent.shadow = p.a, res.peer.shadow = p.b, res.shadow_ratio = p.ratio;
     res.lucent.shadow_rays = res.peer.shadow_rays = shadow.size();
     for (unsigned char b : lucent_blocked) res.lucent.occluded += b;
     for (unsigned char b : peer_blocked) res.peer.occluded += b;
 
     Hits lucent_bounce = hits_for(diffuse), peer_bounce = hits_for(diffuse);
-    p = timed_pair(diffuse.size(), threads, repeat, tracer(lucent_closest, diffuse, lucent_bounce),
-                   tracer(peer_closest, diffuse, peer_bounce), with_peer);
+    p = timed_pair(diffuse.size(), threads, repeat,
+                   closest_body(lucent_closest, diffuse, lucent_bounce),
+                   closest_body(peer_closest, diffuse, peer_bounce), with_peer);
     res.lucent.diffuse = p.a, res.peer.diffuse = p.b, res.diffuse_ratio = p.ratio;
     res.lucent.diffuse_rays = res.peer.diffuse_rays = diffuse.size();
     sum_hits(lucent_bounce, res.lucent.diffuse_hits, res.lucent.diffuse_sum_t);
@@ -209,22 +217,13 @@ BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float
 /// Seconds of one pass of an engine over `rays`: closest hits for primary and diffuse
 /// rays, occlusion for shadow rays, the answers written as run_engines writes them.
 template <class Closest, class Any>
-double engine_pass(RayKind kind, const RaySet& rays, unsigned threads, Closest& closest,
-                   Any& any) {
+double engine_pass(RayKind kind, const RaySet& rays, unsigned threads, Closest& closest, Any& any) {
     if (kind == RayKind::kShadow) {
         ResultVector<unsigned char> blocked(rays.size());
-        return timed_pass(rays.size(), threads, [&](size_t i) {
-            blocked[i] = any(rays.origin[i], rays.direction[i], rays.tmax[i]);
-        });
+        return timed_pass(rays.size(), threads, occlusion_body(any, rays, blocked));
     }
-    Hits out{ResultVector<float>(rays.size()), ResultVector<uint32_t>(rays.size())};
-    return timed_pass(rays.size(), threads, [&](size_t i) {
-        float t;
-        uint32_t prim;
-        const bool hit = closest(rays.origin[i], rays.direction[i], rays.tmax[i], t, prim);
-        out.t[i] = hit ? t : -1.0f;
-        out.prim[i] = hit ? prim : 0;
-    });
+    Hits out = hits_for(rays);
+    return timed_pass(rays.size(), threads, closest_body(closest, rays, out));
 }
 
 void print_engine(const char* prefix, const EngineResult& r) {
@@ -281,7 +280,8 @@ EngineResult engine_of(const ProgramsResult& p) {
 /// the ratio of the two medians.
 PairedRatios programs_ratios(const ProgramsResult& p, const EngineResult& other, size_t paired) {
     if (paired < p.paired.size()) return p.paired[paired];
-    return PairedRatios{median_ratio(p.primary, other.primary), median_ratio(p.shadow, other.shadow),
+    return PairedRatios{median_ratio(p.primary, other.primary),
+                        median_ratio(p.shadow, other.shadow),
                         median_ratio(p.diffuse, other.diffuse)};
 }
 
@@ -305,7 +305,8 @@ Json programs_json(const ProgramsResult& p, const EngineResult& kernels, const E
 void print_programs(const ProgramsResult& p, const EngineResult& kernels, const EngineResult* peer,
                     const std::string& differences) {
     std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
-                p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
+                p.backend.c_str(),
+                p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
     print_engine("programs ", engine_of(p));
     auto ratios = [&](const char* what, const PairedRatios& r) {
         std::printf("ratio programs/%s primary %.2fx, shadow %.2fx, diffuse %.2fx\n", what,
@@ -402,10 +403,9 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     in.backend = BackendKind::kCuda, in.repeat = options.repeat;
     const ProgramsResult p = run_programs(in);
     auto none = [](auto&&...) { return false; };
-    const BenchResult kernels = run_engines(
-        primary, mesh, cam.light, threads, 1,
-        closest_query(accel), occluded_query(accel), none,
-        none, false);
+    const BenchResult kernels =
+        run_engines(primary, mesh, cam.light, threads, 1, closest_query(accel),
+                    occluded_query(accel), none, none, false);
     const std::string differences = checksum_differences(p, kernels.lucent, "programs", "kernels");
     if (options.json) {
         Json j = json_engine(engine_of(p));
@@ -419,7 +419,8 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
         return;
     }
     std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
-                p.backend.c_str(), p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
+                p.backend.c_str(),
+                p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
     print_engine("programs ", engine_of(p));
     std::printf("programs' kernel variants: primary %s, shadow %s, diffuse %s\n",
                 p.primary_variant.c_str(), p.shadow_variant.c_str(), p.diffuse_variant.c_str());
@@ -479,8 +480,8 @@ int run_bench_rays(const RaysOptions& options) {
 
     const RaySet primary = primary_rays(cam, options.width, options.height);
     result.engines = run_engines(
-        primary, mesh, cam.light, threads, options.repeat,
-        closest_query(accel), occluded_query(accel),
+        primary, mesh, cam.light, threads, options.repeat, closest_query(accel),
+        occluded_query(accel),
         [&](float3 o, float3 d, float tmax, float& t, uint32_t& prim) {
             return embree_peer->intersect(o, d, 0.0f, tmax, t, prim);
         },
