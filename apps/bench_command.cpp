@@ -73,6 +73,14 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
     r->add_flag("--programs", rays.programs,
                 "Also trace the ray sets through a program module launched by a Context "
                 "(bench/rays/rays_programs.h): the engine's per-ray path beside the kernels");
+    r->add_option("--builder", rays.builder,
+                  "The BVH: auto (the engine's default: built on the GPU with --backend cuda, "
+                  "object splits only) or sah (Builder::kBinnedSah: the host's binned SAH with "
+                  "spatial splits, the traversal-first build). The CUDA kernels and --programs "
+                  "trace it; the CPU backend builds sah either way")
+        ->type_name("NAME")
+        ->check(CLI::IsMember({"auto", "sah"}))
+        ->capture_default_str();
     r->add_flag("--json", rays.json, "Machine-readable output");
     r->add_option("--backend", rays.backend, "cpu, auto or cuda")
         ->type_name("KIND")
@@ -162,6 +170,7 @@ int run_bench_rays_command(const BenchRaysArgs& args) {
     options.threads = args.threads;
     options.peer = !args.no_peer;
     options.programs = args.programs;
+    options.builder = args.builder == "sah" ? Builder::kBinnedSah : Builder::kAuto;
     options.json = args.json;
 
     // A partial camera would silently mix given and default values: refuse it.

@@ -17,6 +17,7 @@ struct BenchRaysArgs {
     unsigned threads = 0;
     bool no_peer = false;
     bool programs = false;  // --programs
+    std::string builder = "auto";  // --builder: auto or sah
     bool json = false;
 };
 

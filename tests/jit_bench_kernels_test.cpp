@@ -1,6 +1,7 @@
 // The bench kernels compile with NVRTC, and the GPU triangle BVH layout, traversed on the
 // CPU by the very code the GPU runs (triangle_bvh.cuh is host/device), finds the same
-// hits as brute force and as TriangleAccel (every layout has a CPU traversal checked against brute force).
+// hits as brute force and as TriangleAccel (every layout has a CPU traversal checked against brute
+// force).
 #include <gtest/gtest.h>
 
 #ifdef LUCENT_HAVE_CUDA
@@ -11,8 +12,8 @@
 
 #include "accel/triangle_accel.h"
 #include "bench/gpu/bench_sources.h"
-#include "cuda/device/lucent_gpu/ray_order.cuh"
 #include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/device/lucent_gpu/ray_order.cuh"
 #include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/device/triangle_intersect.h"
 #include "scene/obj_mesh.h"
@@ -92,9 +93,9 @@ TEST(jit, display_kernels) {
     std::string why;
     if (cuda::nvrtc_version(&why).empty()) GTEST_SKIP() << why;
     setenv("LUCENT_CACHE_DIR", "off", 1);
-    const cuda::CompileResult result = cuda::compile_cubin(cuda::embedded_request(
-        "lucent_display.cu", "#include \"lucent_gpu/display.cuh\"\n",
-        {"--std=c++17", "--ptxas-options=-v"}, 90));
+    const cuda::CompileResult result = cuda::compile_cubin(
+        cuda::embedded_request("lucent_display.cu", "#include \"lucent_gpu/display.cuh\"\n",
+                               {"--std=c++17", "--ptxas-options=-v"}, 90));
     EXPECT_FALSE(result.cubin.empty());
     EXPECT_EQ(result.log.find("warning"), std::string::npos) << result.log;
     for (const char* kernel : {"lucent_display_srgb8", "lucent_display_to_surface"})
@@ -105,49 +106,67 @@ TEST(jit, gpu_bvh_layout_matches_brute_force) {
     const Mesh mesh = test_mesh(7, 1500);
     const Brute brute{mesh};
     const std::vector<TestRay> rays = test_rays(11, 3000);
-    for (int leaf : {1, 4, 8}) {
-        cuda::GpuBvhBuildOptions opt;
-        opt.max_leaf_size = leaf;
-        const GpuTriangleBvh bvh = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, opt);
-        ASSERT_EQ(bvh.triangle_ids.size(), mesh.indices.size());
-        ASSERT_EQ(bvh.triangles.size(), 3 * mesh.indices.size());
-        const gpu::GpuTriangleBvhView view = bvh.host_view();
-        for (size_t i = 0; i < rays.size(); ++i) {
-            const TestRay& r = rays[i];
-            SCOPED_TRACE("leaf size " + std::to_string(leaf));
-            // Closest.
-            GpuHit g{};
-            const bool hit = gpu::gpu_bvh_closest(view, r.o, r.d, 0.0f, r.tmax, g);
-            const GpuHit b = brute.closest(r.o, r.d, 0.0f, r.tmax, [](unsigned) { return true; });
-            expect_same_closest(brute, r, hit, g, b, (int)i);
-            // Any hit.
-            EXPECT_EQ(gpu::gpu_bvh_occluded(view, r.o, r.d, 0.0f, r.tmax), b.t >= 0.0f) << i;
-            // Filtered: ignore every third triangle; the closest of the others must come out.
-            int offered = 0;
-            GpuHit gf{};
-            const bool fhit =
-                gpu::gpu_bvh_filtered(view, r.o, r.d, 0.0f, r.tmax, gf, [&](const GpuHit& c) {
-                    ++offered;
-                    return c.prim % 3 == 0 ? gpu::kGpuIgnore : gpu::kGpuAccept;
-                });
-            const GpuHit bf =
-                brute.closest(r.o, r.d, 0.0f, r.tmax, [](unsigned p) { return p % 3 != 0; });
-            expect_same_closest(brute, r, fhit, gf, bf, (int)i);
-            // Accept-and-stop ends at the first candidate.
-            offered = 0;
-            GpuHit gs{};
-            const bool shit =
-                gpu::gpu_bvh_filtered(view, r.o, r.d, 0.0f, r.tmax, gs, [&](const GpuHit&) {
-                    ++offered;
-                    return gpu::kGpuAcceptAndStop;
-                });
-            EXPECT_EQ(shit, b.t >= 0.0f) << i;
-            EXPECT_LE(offered, 1) << i;
-            if (shit) {
-                EXPECT_EQ(brute.t_of(gs.prim, r.o, r.d), gs.t) << i;
+    for (int leaf : {1, 4, 8})
+        for (bool splits : {false, true}) {
+            cuda::GpuBvhBuildOptions opt;
+            opt.max_leaf_size = leaf;
+            opt.spatial_splits = splits;
+            const GpuTriangleBvh bvh =
+                cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, opt);
+            // Every triangle in some leaf; with spatial splits in several, within the budget
+            // (a quarter more references than triangles).
+            std::vector<int> slots(mesh.indices.size(), 0);
+            for (uint32_t id : bvh.triangle_ids) {
+                ASSERT_LT(id, mesh.indices.size());
+                ++slots[id];
+            }
+            for (size_t t = 0; t < slots.size(); ++t) ASSERT_GE(slots[t], 1) << t;
+            if (splits) {
+                EXPECT_GT(bvh.triangle_ids.size(), mesh.indices.size());
+                EXPECT_LE(bvh.triangle_ids.size(), mesh.indices.size() * 5 / 4 + 1);
+            } else {
+                ASSERT_EQ(bvh.triangle_ids.size(), mesh.indices.size());
+            }
+            ASSERT_EQ(bvh.triangles.size(), 3 * bvh.triangle_ids.size());
+            const gpu::GpuTriangleBvhView view = bvh.host_view();
+            for (size_t i = 0; i < rays.size(); ++i) {
+                const TestRay& r = rays[i];
+                SCOPED_TRACE("leaf size " + std::to_string(leaf) +
+                             (splits ? ", spatial splits" : ""));
+                // Closest.
+                GpuHit g{};
+                const bool hit = gpu::gpu_bvh_closest(view, r.o, r.d, 0.0f, r.tmax, g);
+                const GpuHit b =
+                    brute.closest(r.o, r.d, 0.0f, r.tmax, [](unsigned) { return true; });
+                expect_same_closest(brute, r, hit, g, b, (int)i);
+                // Any hit.
+                EXPECT_EQ(gpu::gpu_bvh_occluded(view, r.o, r.d, 0.0f, r.tmax), b.t >= 0.0f) << i;
+                // Filtered: ignore every third triangle; the closest of the others must come out.
+                int offered = 0;
+                GpuHit gf{};
+                const bool fhit =
+                    gpu::gpu_bvh_filtered(view, r.o, r.d, 0.0f, r.tmax, gf, [&](const GpuHit& c) {
+                        ++offered;
+                        return c.prim % 3 == 0 ? gpu::kGpuIgnore : gpu::kGpuAccept;
+                    });
+                const GpuHit bf =
+                    brute.closest(r.o, r.d, 0.0f, r.tmax, [](unsigned p) { return p % 3 != 0; });
+                expect_same_closest(brute, r, fhit, gf, bf, (int)i);
+                // Accept-and-stop ends at the first candidate.
+                offered = 0;
+                GpuHit gs{};
+                const bool shit =
+                    gpu::gpu_bvh_filtered(view, r.o, r.d, 0.0f, r.tmax, gs, [&](const GpuHit&) {
+                        ++offered;
+                        return gpu::kGpuAcceptAndStop;
+                    });
+                EXPECT_EQ(shit, b.t >= 0.0f) << i;
+                EXPECT_LE(offered, 1) << i;
+                if (shit) {
+                    EXPECT_EQ(brute.t_of(gs.prim, r.o, r.d), gs.t) << i;
+                }
             }
         }
-    }
 }
 
 TEST(jit, gpu_bvh_small_meshes) {
@@ -198,7 +217,9 @@ TEST(jit, gpu_bvh_layout_matches_triangle_accel_on_sponza) {
     const std::string file = std::string(LUCENT_SCENES_DIR) + "/sponza.obj";
     if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
     const scene::ObjMesh mesh = scene::load_obj_mesh(file);
+    // Both with spatial splits (their default): Sponza's long triangles get split.
     const GpuTriangleBvh bvh = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+    EXPECT_GT(bvh.triangle_ids.size(), mesh.indices.size());
     accel::TriangleAccel accel;
     accel.build(mesh.positions, mesh.indices);
     const Aabb box = accel.bounds();

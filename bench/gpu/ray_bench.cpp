@@ -25,6 +25,7 @@ bool env_flag(const char* name, bool fallback) {
 
 GpuBvhBuildOptions gpu_build_options() {
     GpuBvhBuildOptions o;
+    o.spatial_splits = false;  // the GPU builder's tree; callers turn them on
     if (const char* v = std::getenv("LUCENT_GPU_LEAF_SIZE"); v && *v) {
         o.max_leaf_size = std::atoi(v);
         if (o.max_leaf_size < 1 || o.max_leaf_size > gpu::kGpuMaxLeafSize)
@@ -138,9 +139,11 @@ void RayBench::make_rays(const gpu::GpuTriangleBvhView& view, const DeviceBuffer
 }
 
 DeviceBuffer triangles_by_prim(const GpuTriangleBvh& bvh) {
-    const size_t tri_count = bvh.triangle_ids.size();
+    // With spatial splits a triangle fills several leaf slots: size by the largest index.
+    size_t tri_count = 0;
+    for (uint32_t id : bvh.triangle_ids) tri_count = std::max<size_t>(tri_count, size_t(id) + 1);
     std::vector<float4> by_prim(3 * tri_count);
-    for (size_t i = 0; i < tri_count; ++i)
+    for (size_t i = 0; i < bvh.triangle_ids.size(); ++i)
         for (int v = 0; v < 3; ++v) by_prim[3 * bvh.triangle_ids[i] + v] = bvh.triangles[3 * i + v];
     DeviceBuffer out;
     out.upload(std::span<const float4>(by_prim));

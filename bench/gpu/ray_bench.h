@@ -26,7 +26,8 @@ using bench::rate_of;
 /// Whether environment variable `name` is set to anything but 0 or off (`fallback` unset).
 bool env_flag(const char* name, bool fallback);
 
-/// The GPU layout's build options: LUCENT_GPU_LEAF_SIZE=1..8 (default 4).
+/// The GPU layout's build options: LUCENT_GPU_LEAF_SIZE=1..8 (default 4), no spatial splits
+/// (the tree the GPU builder makes from the same triangles).
 GpuBvhBuildOptions gpu_build_options();
 
 /// The compiled bench module and how to launch its trace kernels.

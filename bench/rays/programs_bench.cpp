@@ -109,6 +109,7 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     instance->set_geometry(triangles);
     instance->add_material(material);
     auto group = ctx.create_geometry_group();
+    group->set_acceleration(ctx.create_acceleration(in.builder));
     group->add_child(instance);
     ctx["scene"] = group;
 

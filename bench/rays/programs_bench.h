@@ -30,6 +30,7 @@ struct ProgramsInput {
     BackendKind backend = BackendKind::kCpu;
     unsigned threads = 0;  // CPU workers, 0 = one per core
     int repeat = 5;        // timed launches per ray set (median), after one warm-up launch
+    Builder builder = Builder::kAuto;  // the GeometryGroup's acceleration
     // When set, each timed launch has a neighbour: these passes run beside it, before it
     // and after it in turn (A B, B A, ...), as the kernels and the peer take turns. The
     // machines this runs on slow down for seconds at a time, so a ratio of two rates

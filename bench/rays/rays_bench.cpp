@@ -401,6 +401,7 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     ProgramsInput in;
     in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
     in.backend = BackendKind::kCuda, in.repeat = options.repeat;
+    in.builder = options.builder;
     const ProgramsResult p = run_programs(in);
     auto none = [](auto&&...) { return false; };
     const BenchResult kernels =
@@ -452,6 +453,7 @@ int run_bench_rays(const RaysOptions& options) {
         in.camera = cam;
         in.width = options.width, in.height = options.height;
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
+        in.spatial_splits = options.builder == Builder::kBinnedSah;
         Json document;
         if (options.json && options.programs) in.json_out = &document;
         const int code = cuda::run_bench_rays_cuda(in);
@@ -492,6 +494,7 @@ int run_bench_rays(const RaysOptions& options) {
         ProgramsInput in;
         in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
         in.backend = BackendKind::kCpu, in.threads = threads, in.repeat = options.repeat;
+        in.builder = options.builder;
         // The kernels' pass and the peer's beside each launch, so that the programs' ratios
         // to them compare neighbouring passes, as the kernels' ratio to the peer does.
         auto kernel_closest = closest_query(accel);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "lucent/device/vector_math.h"
+#include "lucent/nodes.h"
 
 namespace lucent::bench {
 
@@ -21,6 +22,10 @@ struct RaysOptions {
     bool peer = true;             // run Embree on the same rays when built with it
     bool json = false;            // machine-readable output
     bool programs = false;  // also the ray sets through a program module (programs_bench.h)
+    // The BVH the programs' scene is built with, and with --backend cuda the one the kernels
+    // trace: kAuto (on the GPU, object splits only) or kBinnedSah (the host's, with spatial
+    // splits). The CPU kernels always trace TriangleAccel's tree (spatial splits).
+    Builder builder = Builder::kAuto;
     std::string backend = "cpu";  // "cpu", or "cuda" (rays_bench_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,

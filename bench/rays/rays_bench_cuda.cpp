@@ -183,6 +183,7 @@ Json to_json(const CudaRaysResult& r) {
                 {"persistent", r.kernels.persistent},
                 {"build_ms", rounded(r.bvh_stats.build_ms + r.bvh_stats.convert_ms, 3)},
                 {"bvh_nodes", r.bvh_stats.node_count},
+                {"spatial_splits", in.spatial_splits},
                 {"sah_cost", rounded(r.bvh_stats.sah_cost, 4)},
                 {"lucent", Json{{"primary", primary}, {"shadow", shadow}, {"diffuse", diffuse}}},
                 {"cpu", Json{{"primary", Json{{"hits", r.cpu.sums.primary_hits},
@@ -206,9 +207,11 @@ void print_text(const CudaRaysResult& r) {
         in.scene.c_str(), r.triangles, in.width, in.height, r.device.c_str(), r.sm, r.sm_count,
         in.repeat);
     std::printf("kernels: %s\n", r.kernels.describe.c_str());
-    std::printf("build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u)\n",
-                r.bvh_stats.build_ms, r.bvh_stats.convert_ms, r.bvh_stats.sah_cost,
-                r.bvh_stats.node_count, r.bvh_stats.leaf_count, r.bvh_stats.depth);
+    std::printf(
+        "build %.2f ms + convert %.2f ms (sah %.2f, %zu nodes, %zu leaves, depth %u, spatial "
+        "splits %s)\n",
+        r.bvh_stats.build_ms, r.bvh_stats.convert_ms, r.bvh_stats.sah_cost, r.bvh_stats.node_count,
+        r.bvh_stats.leaf_count, r.bvh_stats.depth, in.spatial_splits ? "on" : "off");
     std::printf("primary %s hits=%zu sum_t=%.6e\n", rate_text(b.primary).c_str(), gpu.primary_hits,
                 gpu.primary_sum_t);
     std::printf("shadow %s rays=%zu occluded=%zu\n", rate_text(b.shadow).c_str(), gpu.shadow_rays,
@@ -230,6 +233,14 @@ void print_text(const CudaRaysResult& r) {
             r.cpu.differ_primary, r.cpu.differ_shadow, r.cpu.differ_diffuse);
 }
 
+/// The options of the tree the kernels trace (the environment's leaf size, see
+/// gpu_build_options), with spatial splits when the input asks for Builder::kBinnedSah's tree.
+GpuBvhBuildOptions build_options(const CudaRaysInput& in) {
+    GpuBvhBuildOptions options = gpu_build_options();
+    options.spatial_splits = in.spatial_splits;
+    return options;
+}
+
 }  // namespace
 
 int run_bench_rays_cuda(const CudaRaysInput& in) {
@@ -249,10 +260,10 @@ int run_bench_rays_cuda(const CudaRaysInput& in) {
 
     // The host SAH tree in the GPU layout.
     const GpuTriangleBvh bvh =
-        build_gpu_triangle_bvh(in.positions, in.indices, gpu_build_options());
+        build_gpu_triangle_bvh(in.positions, in.indices, build_options(in));
     GpuTriangleBvhDevice dbvh;
     upload_gpu_triangle_bvh(bvh, dbvh);
-    result.triangles = bvh.triangle_ids.size();
+    result.triangles = in.indices.empty() ? in.positions.size() / 3 : in.indices.size();
     result.bvh_stats = bvh.stats;
 
     // The rays (BENCH.md), generated on the GPU. The CPU reference traces the very rays the

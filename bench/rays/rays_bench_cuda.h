@@ -21,6 +21,10 @@ struct CudaRaysInput {
     unsigned width = 3840, height = 2160;
     int repeat = 5;
     unsigned threads = 0;  // CPU threads of the reference trace, 0 = all
+    // The tree the kernels trace: the host's binned SAH, with spatial splits (what
+    // Builder::kBinnedSah gives the CUDA backend) or without (the tree the GPU builder,
+    // Builder::kAuto, makes).
+    bool spatial_splits = false;
     bool json = false;
     /// With `json`: where the document goes instead of stdout (the caller adds to it, e.g.
     /// `--programs`' figures, and prints one document).

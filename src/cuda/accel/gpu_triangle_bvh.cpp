@@ -62,7 +62,8 @@ accel::Bvh build_source_bvh(std::span<const float3> positions, std::span<const u
     build.traversal_cost = options.traversal_cost;
     build.intersection_cost = options.intersection_cost;
     accel::Bvh bvh;
-    bvh.build(boxes, build, &stats);
+    const accel::SplitTriangles split{positions, indices};
+    bvh.build(boxes, build, &stats, options.spatial_splits ? &split : nullptr);
     if (stats.depth + 2 >= (unsigned)gpu::kGpuStackSize)
         throw Error(layout + ": depth " + std::to_string(stats.depth) +
                     " exceeds the traversal stack (" + std::to_string(gpu::kGpuStackSize) + ")");
@@ -108,6 +109,12 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
     auto emit_leaf = [&](const accel::BvhNode& n) {
         if (n.count > (uint32_t)gpu::kGpuMaxLeafSize)
             throw Error("GPU triangle BVH: a leaf of " + std::to_string(n.count) + " triangles");
+        // Spatial splits add references: the leaf's slots must still fit a reference.
+        if (out.triangle_ids.size() + n.count > size_t(gpu::kGpuLeafFirstMask))
+            throw Error("GPU triangle BVH: " + std::to_string(out.triangle_ids.size() + n.count) +
+                        " leaf slots with spatial splits, the layout holds at most " +
+                        std::to_string(gpu::kGpuLeafFirstMask) +
+                        "; build without spatial splits (GpuBvhBuildOptions::spatial_splits)");
         const unsigned first =
             append_leaf_triangles(positions, indices, bvh, n, out.triangles, out.triangle_ids);
         ++out.stats.leaf_count;

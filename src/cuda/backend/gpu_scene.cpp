@@ -535,14 +535,25 @@ void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
                 }
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
-                // bounds its depth (refits keep that tree's topology).
+                // bounds its depth. Without spatial splits it has one reference per
+                // triangle, so the refits that follow keep its topology.
                 const auto [vertices, indices] = host_mesh();
-                upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices), mirror.bvh);
+                GpuBvhBuildOptions host;
+                host.spatial_splits = false;
+                upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices, host),
+                                        mirror.bvh);
             }
         }
     } else {
+        // Builder::kBinnedSah, the traversal-first build: spatial splits as TriangleAccel
+        // gets them (core/accel_builder.cpp), unless an any-hit program must see each
+        // triangle once per ray.
         const auto [vertices, indices] = host_mesh();
-        upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices), mirror.bvh);
+        GpuBvhBuildOptions host;
+        host.spatial_splits = std::none_of(node.any_hit_enforced_for_ray_type.begin(),
+                                           node.any_hit_enforced_for_ray_type.end(),
+                                           [](bool any_hit) { return any_hit; });
+        upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices, host), mirror.bvh);
     }
     mirror.empty = ga.triangle_count == 0;
     mirror.structure = ga.structure_signature;
