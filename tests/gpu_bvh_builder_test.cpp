@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,14 @@ namespace {
 using cuda::GpuTriangleBvh;
 using cuda::GpuTriangleBvhDevice;
 using namespace test_meshes;
+
+/// The host's binned-SAH tree without spatial splits: the tree the GPU builder makes, one
+/// leaf slot per triangle (so refits apply to it).
+GpuTriangleBvh host_tree(std::span<const float3> positions, std::span<const uint3> indices,
+                         cuda::GpuBvhBuildOptions options = {}) {
+    options.spatial_splits = false;
+    return cuda::build_gpu_triangle_bvh(positions, indices, options);
+}
 
 /// Device 0's primary context, current for the test, and a builder for it.
 class GpuBvhBuilderTest : public ::testing::Test {
@@ -282,8 +291,7 @@ TEST(GpuSahBuildEmulation, MakesTheHostTree) {
             options.max_leaf_size = leaf;
             const EmulatedSahBuild gpu =
                 emulate_gpu_sah_build(mesh.positions, mesh.indices, options, limit);
-            const GpuTriangleBvh host =
-                cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, options);
+            const GpuTriangleBvh host = host_tree(mesh.positions, mesh.indices, options);
             EXPECT_EQ(gpu.fault, 0u);
             // The same splits: the same nodes, depth and cost (summed in another order).
             EXPECT_EQ(gpu.bvh.nodes.size(), host.nodes.size());
@@ -338,7 +346,7 @@ TEST(GpuSahBuildEmulation, ScenesAreTheHostTreeForEverySmallTaskLimit) {
         const std::string file = std::string(LUCENT_SCENES_DIR) + "/" + name + ".obj";
         if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
         const scene::ObjMesh mesh = scene::load_obj_mesh(file);
-        const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+        const GpuTriangleBvh host = host_tree(mesh.positions, mesh.indices);
         for (unsigned limit : {gpu::kSahSmallMin, gpu::kSahSmallDefault, gpu::kSahSmallMax}) {
             SCOPED_TRACE(std::string(name) + ", small tasks of up to " + std::to_string(limit));
             const EmulatedSahBuild gpu =
@@ -551,8 +559,7 @@ TEST_F(GpuBvhBuilderTest, RefitFollowsMovedVertices) {
     // A layout built on the GPU and one built on the host, refitted alike.
     GpuTriangleBvhDevice gpu_built, host_built;
     builder->build(mesh.positions, mesh.indices, gpu_built);
-    cuda::upload_gpu_triangle_bvh(cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices),
-                                  host_built);
+    cuda::upload_gpu_triangle_bvh(host_tree(mesh.positions, mesh.indices), host_built);
     for (float phase : {0.5f, 2.0f}) {
         SCOPED_TRACE("phase " + std::to_string(phase));
         const Mesh now = moved(mesh, phase);
@@ -606,7 +613,7 @@ TEST_F(GpuBvhBuilderTest, SponzaHitsEqualTriangleAccelAndSahIsClose) {
     const std::string file = std::string(LUCENT_SCENES_DIR) + "/sponza.obj";
     if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found";
     const scene::ObjMesh mesh = scene::load_obj_mesh(file);
-    const GpuTriangleBvh host = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+    const GpuTriangleBvh host = host_tree(mesh.positions, mesh.indices);
     for (auto algorithm : kAlgorithms) {
         SCOPED_TRACE(name_of(algorithm));
         cuda::GpuBvhBuildOptions options;
