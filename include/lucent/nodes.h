@@ -28,7 +28,7 @@ enum class Builder {
     kAuto,
     // Binned SAH built on the host with spatial splits (Stich et al. 2009) where no any-hit
     // program must see each triangle once: the best traversal (on the GPU Sponza's rays
-    // 1.2-1.3x kAuto's, docs/performance.md) for a slower build; rebuilt when marked dirty.
+    // 1.1-1.3x kAuto's, docs/performance.md) for a slower build; rebuilt when marked dirty.
     kBinnedSah,
     kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)
     // Triangles that change every frame: on the CUDA backend the BVH is built on the GPU
