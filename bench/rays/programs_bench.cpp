@@ -35,9 +35,10 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
 /// registers capped, trace() inlined or both (ContextOptions::register_variants).
 std::string variant_of(const LaunchReport& report) {
     if (report.kernel_ms <= 0) return "";
-    if (report.trace_inlined && report.registers_capped) return "trace inlined, registers capped";
+    const std::string cap = "registers capped to " + std::to_string(report.register_cap);
+    if (report.trace_inlined && report.registers_capped) return "trace inlined, " + cap;
     if (report.trace_inlined) return "trace inlined";
-    if (report.registers_capped) return "registers capped";
+    if (report.registers_capped) return cap;
     return "as compiled";
 }
 

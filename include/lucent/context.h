@@ -119,9 +119,11 @@ struct LaunchReport {
     /// and size (the first few launches, docs/performance.md "Launch shapes"); a benchmark
     /// times the launches after the tuning.
     bool launch_shape_trial = false;
-    /// CUDA: this launch ran the kernel's variant compiled for at most 64 registers a thread
-    /// (compiled in the background after the first launch; one more shape the tuning times).
+    /// CUDA: this launch ran a variant of the kernel compiled for at most register_cap
+    /// registers a thread, 64 or (with trace() inlined) 56 (compiled in the background after
+    /// the first launch; more shapes the tuning times).
     bool registers_capped = false;
+    unsigned register_cap = 0;  // 0: not capped
     /// CUDA: this launch ran the kernel's variant with trace() inlined into its
     /// ray-generation program (compiled in the background where no program that a trace
     /// runs traces again; one more shape the tuning times).

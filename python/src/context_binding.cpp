@@ -102,6 +102,7 @@ void bind_context(py::module_& m) {
         .def_readonly("kernel_ms", &LaunchReport::kernel_ms)
         .def_readonly("launch_shape_trial", &LaunchReport::launch_shape_trial)
         .def_readonly("registers_capped", &LaunchReport::registers_capped)
+        .def_readonly("register_cap", &LaunchReport::register_cap)
         .def_readonly("trace_inlined", &LaunchReport::trace_inlined)
         .def_readonly("exchange_ms", &LaunchReport::exchange_ms)
         .def_readonly("devices", &LaunchReport::devices,

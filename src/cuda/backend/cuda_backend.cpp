@@ -39,7 +39,18 @@ constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
 // for the path tracer on Sponza; so it is one more shape for the tuning to time, not a rule.
 constexpr int kCappedBlocksPerSm = 8;
 constexpr int kCappedRegisters = 65536 / (kCappedBlocksPerSm * 128);
-const std::string kCappedOption = "-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(kCappedBlocksPerSm);
+// With trace() inlined, a tighter cap too: 9 blocks, at most 56 registers. On an H100 it ran
+// bench rays --programs' shadow and diffuse rays 2-3 % faster than the tuning's choice
+// among the other variants (docs/performance.md, session 31); one more shape to time.
+constexpr int kTightCappedBlocksPerSm = 9;
+std::string capped_option(int blocks_per_sm) {
+    return "-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(blocks_per_sm);
+}
+/// The registers a thread gets with __launch_bounds__ for this many 128-thread blocks per SM
+/// (the register file's 64K, in the allocation's steps of 8).
+constexpr int capped_registers(int blocks_per_sm) {
+    return 65536 / (blocks_per_sm * 128) / 8 * 8;
+}
 // The inline-trace variant (megakernel_compiler.h, can_inline_trace): trace() inlined into
 // the ray-generation program where no program a trace runs traces again.
 const std::string kInlineTraceOption = "-DLUCENT_GPU_INLINE_TRACE=1";
@@ -71,7 +82,8 @@ class CudaBackend final : public core::Backend {
         CUfunction function = nullptr;
         CUdeviceptr params = 0;  // the module's launch parameters
         int carveout = -1;       // the carveout last set on the function
-        bool registers_capped = false, trace_inlined = false;  // the variant's options
+        int register_cap = 0;        // the variant's options: registers a thread at most
+        bool trace_inlined = false;  // (0: as compiled), trace() inlined
     };
     /// A ray-generation program's kernel: its variants (0: as compiled; then, once compiled,
     /// registers capped, trace inlined, or both) and the launch shapes of all of them
@@ -311,7 +323,8 @@ class CudaBackend final : public core::Backend {
         report.kernel_ms = kernel_ms;
         report.launch_shape_trial = m_shape_trial;
         const KernelCode& ran = m_kernel->codes.at(size_t(m_kernel->shapes[size_t(m_shape)].variant));
-        report.registers_capped = ran.registers_capped;
+        report.registers_capped = ran.register_cap > 0;
+        report.register_cap = unsigned(ran.register_cap);
         report.trace_inlined = ran.trace_inlined;
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
@@ -464,16 +477,17 @@ class CudaBackend final : public core::Backend {
                                         m_kernels[i].codes[0].function);
             const bool cap = registers > kCappedRegisters;
             const bool inline_trace = can_inline_trace(kernel.binaries.at(i));
-            auto add = [&](bool capped, bool inlined) {
+            auto add = [&](int capped_blocks, bool inlined) {
                 std::vector<std::string> extra;
-                if (capped) extra.push_back(kCappedOption);
+                if (capped_blocks > 0) extra.push_back(capped_option(capped_blocks));
                 if (inlined) extra.push_back(kInlineTraceOption);
                 requests.push_back(std::move(unit_requests(kernel, m_sm, {i}, extra).at(0)));
-                m_variants.push_back({i, capped, inlined});
+                m_variants.push_back({i, capped_blocks, inlined});
             };
-            if (cap) add(true, false);
-            if (inline_trace) add(false, true);
-            if (cap && inline_trace) add(true, true);
+            if (cap) add(kCappedBlocksPerSm, false);
+            if (inline_trace) add(0, true);
+            if (cap && inline_trace) add(kCappedBlocksPerSm, true);
+            if (inline_trace) add(kTightCappedBlocksPerSm, true);
         }
         if (m_variants.empty()) return;
         if (mode == "sync") {
@@ -512,7 +526,7 @@ class CudaBackend final : public core::Backend {
             const Variant& v = m_variants[j];
             RayGenerationKernel& k = m_kernels[v.kernel];
             KernelCode code = load_code(binaries[j].cubin, v.kernel);
-            code.registers_capped = v.registers_capped;
+            code.register_cap = v.capped_blocks > 0 ? capped_registers(v.capped_blocks) : 0;
             code.trace_inlined = v.trace_inlined;
             std::vector<LaunchShape> shapes = launch_shapes(code.function, nullptr);
             for (LaunchShape& shape : shapes) {
@@ -622,7 +636,8 @@ class CudaBackend final : public core::Backend {
     /// A kernel's variant being compiled: which kernel, and how it is compiled.
     struct Variant {
         size_t kernel = 0;
-        bool registers_capped = false, trace_inlined = false;
+        int capped_blocks = 0;  // __launch_bounds__' blocks per SM (0: none)
+        bool trace_inlined = false;
     };
     std::future<std::vector<CompileResult>> m_variants_compiling;
     std::vector<Variant> m_variants;  // what m_variants_compiling compiles, in its order
