@@ -1,6 +1,9 @@
 // lucent::occluded(): a shadow query that runs no hit programs. It must see triangles and
 // custom primitives under any graph (GeometryGroup, Group, Transform), respect the ray's
 // interval, and treat every primitive as opaque: any-hit programs are not run.
+#include <random>
+
+#include "lucent/device/triangle_intersect.h"
 #include "tests/programs/occlusion_programs.h"
 #include "tests/test_support.h"
 
@@ -106,6 +109,65 @@ TEST_F(OcclusionTest, AnyHitProgramsAreNotRun) {
     EXPECT_EQ(r, (std::vector<unsigned>{1}));
     EXPECT_EQ(traced[0].hit, 0) << "trace() ran the any-hit, which ignored the square";
     EXPECT_GE(traced[0].anyhit_count, 1u);
+}
+
+/// A floor of two big triangles under small ones: the floor's box overlaps everything, so
+/// the host's build splits it in space (Builder::kBinnedSah's spatial splits), and a leaf's
+/// box that holds a piece of the floor and some clutter lets a ray reach the whole floor
+/// triangle again from another leaf.
+std::vector<float3> floor_and_clutter(int clutter) {
+    std::vector<float3> v = {make_float3(0, 0, 0), make_float3(10, 0, 0),  make_float3(10, 10, 0),
+                             make_float3(0, 0, 0), make_float3(10, 10, 0), make_float3(0, 10, 0)};
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    for (int i = 0; i < clutter; ++i) {
+        const float3 a = make_float3(10 * uni(rng), 10 * uni(rng), 0.5f * uni(rng));
+        v.insert(v.end(), {a, a + make_float3(0.2f * uni(rng), 0.1f, 0.0f),
+                           a + make_float3(0.0f, 0.2f * uni(rng), 0.2f)});
+    }
+    return v;
+}
+
+TEST_F(OcclusionTest, AnAnyHitProgramSeesEachTriangleOncePerRayWithEveryBuilder) {
+    // Spatial splits put a triangle in several leaves; a group with an any-hit program is
+    // built without them, so the program runs once per triangle a ray crosses, as brute
+    // force counts them with the engine's own watertight test.
+    const std::vector<float3> v = floor_and_clutter(600);
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    std::vector<OcclusionQuery> queries;
+    std::vector<unsigned> expected;
+    const float tmin = 1e-4f;  // occlusion_cast's
+    for (int i = 0; i < 400; ++i) {
+        const float3 o = make_float3(10 * uni(rng), 10 * uni(rng), 2.0f);
+        const float3 to = make_float3(10 * uni(rng), 10 * uni(rng), -0.5f);
+        const float3 d = normalize(to - o);
+        const float tmax = 10.0f;
+        queries.push_back({o, d, tmax, 0});
+        const WatertightRay wt = make_watertight_ray(o, d);
+        unsigned crossed = 0;
+        for (size_t k = 0; k < v.size(); k += 3) {
+            float t, b1, b2;
+            crossed +=
+                intersect_triangle_watertight(wt, v[k], v[k + 1], v[k + 2], tmin, tmax, t, b1, b2);
+        }
+        expected.push_back(crossed);
+    }
+    for (Builder builder : {Builder::kAuto, Builder::kBinnedSah, Builder::kGpuHploc}) {
+        SCOPED_TRACE("builder " + std::to_string(int(builder)));
+        auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 3);
+        material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
+        auto top = make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, v), material)});
+        top->set_acceleration(ctx.create_acceleration(builder));
+        std::vector<TestPayload> traced;
+        query(top, queries, &traced);
+        unsigned crossing = 0;
+        for (size_t i = 0; i < queries.size(); ++i) {
+            EXPECT_EQ(traced[i].anyhit_count, expected[i]) << "ray " << i;
+            crossing += expected[i] > 1;
+        }
+        EXPECT_GT(crossing, 10u) << "too few rays cross more than the floor";
+    }
 }
 
 }  // namespace
