@@ -171,6 +171,7 @@ def test_the_gpu_megakernel_of_the_query_module_compiles_for_sm_90(rng):
     assert report.jit_ms > 0 or report.jit_cached
     # The CPU backend has no launch shapes to try and no kernel variants.
     assert report.launch_shape_trial is False and report.registers_capped is False
+    assert report.register_cap == 0
     assert report.trace_inlined is False
     np.testing.assert_array_equal(hits.prim[ref.clear], ref.prim[ref.clear])
     mesh.occluded(o, d)  # the occlusion entry is in the same megakernel
