@@ -27,7 +27,7 @@ struct GpuBvhBuildOptions {
     float intersection_cost = 1.0f;
     // The host build (build_gpu_triangle_bvh) only: split space too where a node's two
     // object-split boxes overlap (Stich et al. 2009), as TriangleAccel does, so a triangle
-    // may sit in several leaves. Sponza's rays trace 1.2-1.3x faster on an H100
+    // may sit in several leaves. Sponza's rays trace 1.1-1.3x faster on an H100
     // (docs/performance.md). Off where an any-hit program must see each triangle once per
     // ray. The GPU algorithms split objects only.
     bool spatial_splits = true;

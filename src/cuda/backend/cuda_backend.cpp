@@ -38,7 +38,6 @@ constexpr int kOccupancyFirst = 0;  // shape 0: every block the registers allow
 // against OptiX"): 13-17 % faster for bench rays --programs and 4-7 % for IGI, 20 % slower
 // for the path tracer on Sponza; so it is one more shape for the tuning to time, not a rule.
 constexpr int kCappedBlocksPerSm = 8;
-constexpr int kCappedRegisters = 65536 / (kCappedBlocksPerSm * 128);
 // With trace() inlined, a tighter cap too: 9 blocks, at most 56 registers. On an H100 it ran
 // bench rays --programs' shadow and diffuse rays 2-3 % faster than the tuning's choice
 // among the other variants (docs/performance.md, session 31); one more shape to time.
@@ -47,10 +46,11 @@ std::string capped_option(int blocks_per_sm) {
     return "-DLUCENT_GPU_MIN_BLOCKS=" + std::to_string(blocks_per_sm);
 }
 /// The registers a thread gets with __launch_bounds__ for this many 128-thread blocks per SM
-/// (the register file's 64K, in the allocation's steps of 8).
+/// (the register file's 64K, in the allocation's steps of 8): 64 for 8 blocks, 56 for 9.
 constexpr int capped_registers(int blocks_per_sm) {
     return 65536 / (blocks_per_sm * 128) / 8 * 8;
 }
+constexpr int kCappedRegisters = capped_registers(kCappedBlocksPerSm);
 // The inline-trace variant (megakernel_compiler.h, can_inline_trace): trace() inlined into
 // the ray-generation program where no program a trace runs traces again.
 const std::string kInlineTraceOption = "-DLUCENT_GPU_INLINE_TRACE=1";
