@@ -25,14 +25,13 @@
 #include "lucent/device/triangle_intersect.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
+#include "tests/mesh_fixtures.h"
 
 namespace lucent::accel {
 namespace {
 
-struct Mesh {
-    std::vector<float3> positions;
-    std::vector<uint3> indices;
-};
+using test_meshes::floor_and_clutter;
+using test_meshes::Mesh;
 
 struct BruteHit {
     bool hit = false;
@@ -455,25 +454,6 @@ TEST(TriangleAccel, FilterIgnoringOddPrimitivesEqualsBruteForceWithoutThem) {
             EXPECT_GE(calls, 1);
         }
     }
-}
-
-/// A floor of two big triangles under many small ones: the floor overlaps everything, so
-/// object splits cannot separate it and spatial splits pay (the case of Sponza's floors).
-Mesh floor_and_clutter(uint32_t seed, int count) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-    Mesh m;
-    m.positions = {make_float3(0, 0, 0), make_float3(10, 0, 0), make_float3(10, 10, 0),
-                   make_float3(0, 10, 0)};
-    m.indices = {make_uint3(0, 1, 2), make_uint3(0, 2, 3)};
-    for (int i = 0; i < count; ++i) {
-        const float3 a = make_float3(10 * uni(rng), 10 * uni(rng), 0.5f * uni(rng));
-        const uint32_t base = (uint32_t)m.positions.size();
-        m.positions.insert(m.positions.end(), {a, a + make_float3(0.2f * uni(rng), 0.1f, 0.0f),
-                                               a + make_float3(0.0f, 0.2f * uni(rng), 0.2f)});
-        m.indices.push_back(make_uint3(base, base + 1, base + 2));
-    }
-    return m;
 }
 
 TEST(Bvh, SpatialSplitsDuplicateReferencesWithinTheBudgetAndBoundTheirTriangles) {

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "lucent/device/triangle_intersect.h"
+#include "tests/mesh_fixtures.h"
 #include "tests/programs/occlusion_programs.h"
 #include "tests/test_support.h"
 
@@ -111,28 +112,13 @@ TEST_F(OcclusionTest, AnyHitProgramsAreNotRun) {
     EXPECT_GE(traced[0].anyhit_count, 1u);
 }
 
-/// A floor of two big triangles under small ones: the floor's box overlaps everything, so
-/// the host's build splits it in space (Builder::kBinnedSah's spatial splits), and a leaf's
-/// box that holds a piece of the floor and some clutter lets a ray reach the whole floor
-/// triangle again from another leaf.
-std::vector<float3> floor_and_clutter(int clutter) {
-    std::vector<float3> v = {make_float3(0, 0, 0), make_float3(10, 0, 0),  make_float3(10, 10, 0),
-                             make_float3(0, 0, 0), make_float3(10, 10, 0), make_float3(0, 10, 0)};
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-    for (int i = 0; i < clutter; ++i) {
-        const float3 a = make_float3(10 * uni(rng), 10 * uni(rng), 0.5f * uni(rng));
-        v.insert(v.end(), {a, a + make_float3(0.2f * uni(rng), 0.1f, 0.0f),
-                           a + make_float3(0.0f, 0.2f * uni(rng), 0.2f)});
-    }
-    return v;
-}
-
 TEST_F(OcclusionTest, AnAnyHitProgramSeesEachTriangleOncePerRayWithEveryBuilder) {
     // Spatial splits put a triangle in several leaves; a group with an any-hit program is
     // built without them, so the program runs once per triangle a ray crosses, as brute
-    // force counts them with the engine's own watertight test.
-    const std::vector<float3> v = floor_and_clutter(600);
+    // force counts them with the engine's own watertight test. The floor's box overlaps
+    // everything, so kBinnedSah would split it in space, and a leaf box holding a piece of
+    // the floor and some clutter lets a ray reach the whole floor triangle from another leaf.
+    const test_meshes::Mesh mesh = test_meshes::floor_and_clutter(5, 600);
     std::mt19937 rng(6);
     std::uniform_real_distribution<float> uni(0.0f, 1.0f);
     std::vector<OcclusionQuery> queries;
@@ -146,10 +132,11 @@ TEST_F(OcclusionTest, AnAnyHitProgramSeesEachTriangleOncePerRayWithEveryBuilder)
         queries.push_back({o, d, tmax, 0});
         const WatertightRay wt = make_watertight_ray(o, d);
         unsigned crossed = 0;
-        for (size_t k = 0; k < v.size(); k += 3) {
+        for (const uint3 tri : mesh.indices) {
             float t, b1, b2;
             crossed +=
-                intersect_triangle_watertight(wt, v[k], v[k + 1], v[k + 2], tmin, tmax, t, b1, b2);
+                intersect_triangle_watertight(wt, mesh.positions[tri.x], mesh.positions[tri.y],
+                                              mesh.positions[tri.z], tmin, tmax, t, b1, b2);
         }
         expected.push_back(crossed);
     }
@@ -157,7 +144,8 @@ TEST_F(OcclusionTest, AnAnyHitProgramSeesEachTriangleOncePerRayWithEveryBuilder)
         SCOPED_TRACE("builder " + std::to_string(int(builder)));
         auto material = make_material(ctx, program(ctx, LUCENT_PROGRAM(common_triangle_hit)), 3);
         material->set_any_hit(0, program(ctx, LUCENT_PROGRAM(occlusion_ignore_all)));
-        auto top = make_geometry_group(ctx, {make_instance(ctx, make_triangles(ctx, v), material)});
+        auto top = make_geometry_group(
+            ctx, {make_instance(ctx, make_triangles(ctx, mesh.positions, mesh.indices), material)});
         top->set_acceleration(ctx.create_acceleration(builder));
         std::vector<TestPayload> traced;
         query(top, queries, &traced);

@@ -9,6 +9,7 @@
 
 #include "cuda/device/lucent_gpu/triangle_bvh.cuh"
 #include "lucent/device/triangle_intersect.h"
+#include "tests/mesh_fixtures.h"
 
 namespace lucent::test_meshes {
 
@@ -16,11 +17,6 @@ using gpu::GpuHit;
 
 /// Triangles: random small ones, plus an axis-aligned grid of quads (shared edges, flat
 /// boxes), the cases where a careless box test loses hits.
-struct Mesh {
-    std::vector<float3> positions;
-    std::vector<uint3> indices;
-};
-
 inline Mesh test_mesh(unsigned seed, int random_count) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> pos(0.0f, 10.0f), off(-0.6f, 0.6f);
