@@ -75,11 +75,13 @@ BenchCommands add_bench_commands(CLI::App& app, BenchRaysArgs& rays, BenchBuildA
                 "(bench/rays/rays_programs.h): the engine's per-ray path beside the kernels");
     r->add_option("--builder", rays.builder,
                   "The BVH: auto (the engine's default: built on the GPU with --backend cuda, "
-                  "object splits only) or sah (Builder::kBinnedSah: the host's binned SAH with "
-                  "spatial splits, the traversal-first build). The CUDA kernels and --programs "
-                  "trace it; the CPU backend builds sah either way")
+                  "object splits only, and upgraded to the host's tree with spatial splits "
+                  "before the first timed launch), gpu (auto without the upgrade: the GPU-built "
+                  "tree) or sah (Builder::kBinnedSah: the host's binned SAH with spatial "
+                  "splits, the traversal-first build). The CUDA kernels and --programs trace "
+                  "it; the CPU backend builds sah either way")
         ->type_name("NAME")
-        ->check(CLI::IsMember({"auto", "sah"}))
+        ->check(CLI::IsMember({"auto", "gpu", "sah"}))
         ->capture_default_str();
     r->add_flag("--json", rays.json, "Machine-readable output");
     r->add_option("--backend", rays.backend, "cpu, auto or cuda")
@@ -171,6 +173,7 @@ int run_bench_rays_command(const BenchRaysArgs& args) {
     options.peer = !args.no_peer;
     options.programs = args.programs;
     options.builder = args.builder == "sah" ? Builder::kBinnedSah : Builder::kAuto;
+    options.tree_upgrades = args.builder == "gpu" ? TreeUpgrades::kOff : TreeUpgrades::kWithBuild;
     options.json = args.json;
 
     // A partial camera would silently mix given and default values: refuse it.

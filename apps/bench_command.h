@@ -17,7 +17,7 @@ struct BenchRaysArgs {
     unsigned threads = 0;
     bool no_peer = false;
     bool programs = false;  // --programs
-    std::string builder = "auto";  // --builder: auto or sah
+    std::string builder = "auto";  // --builder: auto, gpu or sah
     bool json = false;
 };
 

@@ -6,6 +6,7 @@
 
 #ifdef LUCENT_HAVE_CUDA
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "cuda/device/lucent_gpu/ray_order.cuh"
 #include "cuda/jit/nvrtc_compiler.h"
 #include "lucent/device/triangle_intersect.h"
+#include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #include "tests/triangle_test_meshes.h"
 
@@ -196,6 +198,47 @@ TEST(jit, gpu_bvh_small_meshes) {
             EXPECT_EQ(gpu::gpu_leaf_first(leaf), first);
             EXPECT_EQ(gpu::gpu_leaf_count(leaf), count);
         }
+}
+
+TEST(jit, gpu_bvh_layout_gives_back_its_input_triangles) {
+    // What a tree upgrade builds from (TreeUpgrader): the GPU tree's triangles, put back in
+    // input order, build the same tree with spatial splits as the input mesh does.
+    // The floor overlaps the clutter: spatial splits happen.
+    const Mesh mesh = floor_and_clutter(5, 600);
+    cuda::GpuBvhBuildOptions no_splits;
+    no_splits.spatial_splits = false;
+    const GpuTriangleBvh gpu_like =
+        cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices, no_splits);
+    const std::vector<float3> back =
+        cuda::layout_input_triangles(gpu_like.triangles, gpu_like.triangle_ids);
+    ASSERT_EQ(back.size(), 3 * mesh.indices.size());
+    for (size_t t = 0; t < mesh.indices.size(); ++t) {
+        const uint3 i = mesh.indices[t];
+        for (int v = 0; v < 3; ++v) {
+            const float3 expected = mesh.positions[v == 0 ? i.x : v == 1 ? i.y : i.z];
+            ASSERT_EQ(back[3 * t + v].x, expected.x) << "triangle " << t << " vertex " << v;
+            ASSERT_EQ(back[3 * t + v].y, expected.y) << "triangle " << t << " vertex " << v;
+            ASSERT_EQ(back[3 * t + v].z, expected.z) << "triangle " << t << " vertex " << v;
+        }
+    }
+    const GpuTriangleBvh upgraded = cuda::build_gpu_triangle_bvh(back, {});
+    const GpuTriangleBvh direct = cuda::build_gpu_triangle_bvh(mesh.positions, mesh.indices);
+    EXPECT_GT(direct.triangle_ids.size(), mesh.indices.size()) << "no spatial split happened";
+    EXPECT_EQ(upgraded.triangle_ids, direct.triangle_ids);
+    ASSERT_EQ(upgraded.nodes.size(), direct.nodes.size());
+    for (size_t n = 0; n < direct.nodes.size(); ++n) {
+        // Bit for bit: child references are integers in float bits (some are NaN patterns).
+        ASSERT_EQ(std::memcmp(&upgraded.nodes[n], &direct.nodes[n], sizeof(float4)), 0)
+            << "node float4 " << n;
+    }
+    // A layout with spatial splits holds some triangles twice: it cannot give its input back.
+    try {
+        cuda::layout_input_triangles(direct.triangles, direct.triangle_ids);
+        FAIL() << "a layout with spatial splits gave its input back";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("already in another slot"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(jit, tiled_ray_order_is_a_permutation) {

@@ -31,6 +31,13 @@ struct ProgramsInput {
     unsigned threads = 0;  // CPU workers, 0 = one per core
     int repeat = 5;        // timed launches per ray set (median), after one warm-up launch
     Builder builder = Builder::kAuto;  // the GeometryGroup's acceleration
+    TreeUpgrades tree_upgrades = TreeUpgrades::kWithBuild;  // of a GPU-built (kAuto) tree
+    // The image the primary rays cover. With tile_order, each set's rays are stored, and so
+    // launched, in the order of `bench rays --backend cuda`'s kernels: by 8x4 tiles of their
+    // pixels (ray_order.cuh), so that a warp traces a compact patch of the image, as the
+    // kernels' warps do and as a 2D launch's warps do; else in pixel order.
+    unsigned width = 0, height = 0;
+    bool tile_order = false;
     // When set, each timed launch has a neighbour: these passes run beside it, before it
     // and after it in turn (A B, B A, ...), as the kernels and the peer take turns. The
     // machines this runs on slow down for seconds at a time, so a ratio of two rates
@@ -54,6 +61,8 @@ struct ProgramsResult : RayChecksums {
     // CUDA: the kernel variant each set's timed launches ran, as the launch-shape tuning
     // chose it ("as compiled", "registers capped", "trace inlined", or both); empty on the CPU.
     std::string primary_variant, shadow_variant, diffuse_variant;
+    // CUDA: GPU-built trees replaced by their upgrades (ProgramsInput::tree_upgrades).
+    unsigned trees_upgraded = 0;
     // With ProgramsInput::paired_passes: one entry per paired engine, in its order.
     std::vector<PairedRatios> paired;
 };

@@ -27,6 +27,7 @@
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #ifdef LUCENT_HAVE_CUDA
+#include "bench/gpu/ray_bench.h"
 #include "bench/rays/rays_bench_cuda.h"
 #endif
 
@@ -402,6 +403,10 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     in.mesh = &mesh, in.primary = &primary, in.light = cam.light;
     in.backend = BackendKind::kCuda, in.repeat = options.repeat;
     in.builder = options.builder;
+    in.tree_upgrades = options.tree_upgrades;
+    // The kernels' ray order (LUCENT_BENCH_TILES), so that both trace the same warps' rays.
+    in.width = options.width, in.height = options.height;
+    in.tile_order = cuda::env_flag("LUCENT_BENCH_TILES", true);
     const ProgramsResult p = run_programs(in);
     auto none = [](auto&&...) { return false; };
     const BenchResult kernels =
@@ -416,6 +421,7 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
         j["kernel_variants"] = Json{{"primary", p.primary_variant},
                                     {"shadow", p.shadow_variant},
                                     {"diffuse", p.diffuse_variant}};
+        j["trees_upgraded"] = p.trees_upgraded;
         document["programs"] = j;  // beside the kernels' figures: one document
         return;
     }
@@ -425,6 +431,10 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     print_engine("programs ", engine_of(p));
     std::printf("programs' kernel variants: primary %s, shadow %s, diffuse %s\n",
                 p.primary_variant.c_str(), p.shadow_variant.c_str(), p.diffuse_variant.c_str());
+    if (p.trees_upgraded > 0)
+        std::printf(
+            "programs' tree: built on the GPU, then upgraded to the host's tree with "
+            "spatial splits before the first launch\n");
     if (differences.empty())
         std::printf("programs' checksums agree with the CPU kernels\n");
     else
@@ -453,7 +463,9 @@ int run_bench_rays(const RaysOptions& options) {
         in.camera = cam;
         in.width = options.width, in.height = options.height;
         in.repeat = options.repeat, in.threads = threads, in.json = options.json;
-        in.spatial_splits = options.builder == Builder::kBinnedSah;
+        // The tree the engine traces: the GPU's is upgraded to the host's with splits.
+        in.spatial_splits =
+            options.builder == Builder::kBinnedSah || options.tree_upgrades != TreeUpgrades::kOff;
         Json document;
         if (options.json && options.programs) in.json_out = &document;
         const int code = cuda::run_bench_rays_cuda(in);

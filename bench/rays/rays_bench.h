@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "lucent/context.h"
 #include "lucent/device/vector_math.h"
 #include "lucent/nodes.h"
 
@@ -23,9 +24,13 @@ struct RaysOptions {
     bool json = false;            // machine-readable output
     bool programs = false;  // also the ray sets through a program module (programs_bench.h)
     // The BVH the programs' scene is built with, and with --backend cuda the one the kernels
-    // trace: kAuto (on the GPU, object splits only) or kBinnedSah (the host's, with spatial
+    // trace: kAuto (on the GPU, object splits only, then upgraded to the host's tree with
+    // spatial splits unless tree_upgrades is kOff) or kBinnedSah (the host's, with spatial
     // splits). The CPU kernels always trace TriangleAccel's tree (spatial splits).
     Builder builder = Builder::kAuto;
+    // The programs' upgrades of the GPU-built tree: before the first launch, so that every
+    // timed launch traces the same tree, or off (the GPU-built tree alone).
+    TreeUpgrades tree_upgrades = TreeUpgrades::kWithBuild;
     std::string backend = "cpu";  // "cpu", or "cuda" (rays_bench_cuda.h)
 };
 /// Prints one line per ray kind (primary, shadow, diffuse) with Mrays/s and checksums,

@@ -54,6 +54,16 @@ enum class RegisterVariants {
     kOff,         // none: every kernel runs as compiled
 };
 
+/// CUDA, Builder::kAuto: the GPU builds a group's triangle tree at once, splitting objects
+/// only; the host's tree with spatial splits (Builder::kBinnedSah's) traces faster, by up to
+/// 1.3x on Sponza, but takes tens of ms to build (docs/performance.md). An upgrade builds
+/// that tree from the GPU tree's triangles and puts it in the GPU tree's place.
+enum class TreeUpgrades {
+    kBackground,  // built on another thread, used from the first launch after it is ready
+    kWithBuild,   // built right after the GPU build, before the launch: reproducible timings
+    kOff,         // none: groups trace the GPU-built tree
+};
+
 struct ContextOptions {
     BackendKind backend = BackendKind::kAuto;
     unsigned threads = 0;  // CPU backend workers; 0 = one per core
@@ -72,6 +82,10 @@ struct ContextOptions {
     /// CUDA: the register-capped variants of large kernels (the environment variable
     /// LUCENT_GPU_REGISTER_VARIANTS=background|sync|off overrides it, for experiments).
     RegisterVariants register_variants = RegisterVariants::kBackground;
+    /// CUDA: the upgrades of Builder::kAuto's GPU-built triangle trees (the environment
+    /// variable LUCENT_GPU_TREE_UPGRADES=background|sync|off overrides it, for experiments).
+    /// Groups with set_refit(true) or an any-hit program keep their GPU tree.
+    TreeUpgrades tree_upgrades = TreeUpgrades::kBackground;
     /// Called on the launching thread as bands of rows of a launch finish, where the
     /// device's copy of the buffers is host memory (the CPU backend, one device); an
     /// interactive viewer shows them while a slow frame renders. Empty: launches run whole.
@@ -128,6 +142,9 @@ struct LaunchReport {
     /// ray-generation program (compiled in the background where no program that a trace
     /// runs traces again; one more shape the tuning times).
     bool trace_inlined = false;
+    /// CUDA: triangle trees (TreeUpgrades) this launch traced for the first time, in place of
+    /// the GPU-built trees it replaced; the launch-shape tuning starts again after them.
+    unsigned trees_upgraded = 0;
     /// Multi-device launches: what each device ran, in ContextOptions::devices order.
     struct DeviceShare {
         std::string device;      // "cuda:0"

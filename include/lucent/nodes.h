@@ -23,14 +23,15 @@ const char* node_kind_name(NodeKind kind);
 enum class Builder {
     // The default: binned SAH (Wald 2007), built where the backend traces: on the CUDA
     // backend on the GPU (bvh_sah_build.cuh: the host's algorithm splitting objects only,
-    // 1.1 ms for Sponza on an H200 against 19 ms on the host), on the CPU backend (and
+    // 1.1 ms for Sponza on an H200 against 19 ms on the host), then upgraded to kBinnedSah's
+    // tree, built on another thread (ContextOptions::tree_upgrades); on the CPU backend (and
     // wherever a CPU device traces too) on the host, as kBinnedSah.
     kAuto,
     // Binned SAH built on the host with spatial splits (Stich et al. 2009) where no any-hit
     // program must see each triangle once: the best traversal (on the GPU Sponza's rays
     // 1.1-1.3x kAuto's, docs/performance.md) for a slower build; rebuilt when marked dirty.
     kBinnedSah,
-    kNone,       // no hierarchy: every child or primitive is tested (for tiny sets)
+    kNone,  // no hierarchy: every child or primitive is tested (for tiny sets)
     // Triangles that change every frame: on the CUDA backend the BVH is built on the GPU
     // (H-PLOC, Benthin et al. 2024; build and trace figures in docs/performance.md) and,
     // with set_refit(true), refitted there; the host builds nothing for it unless a CPU

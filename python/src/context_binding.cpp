@@ -52,11 +52,22 @@ RegisterVariants register_variants(const std::string& name) {
                           "'off'; got '" + name + "'");
 }
 
+TreeUpgrades tree_upgrades(const std::string& name) {
+    if (name == "background") return TreeUpgrades::kBackground;
+    if (name == "with_build") return TreeUpgrades::kWithBuild;
+    if (name == "off") return TreeUpgrades::kOff;
+    throw py::value_error(
+        "Context: tree_upgrades: expected 'background', 'with_build' or "
+        "'off'; got '" +
+        name + "'");
+}
+
 ContextOptions context_options(const std::string& backend, unsigned threads, int jit_check_sm,
                                const py::object& devices, const py::object& ranks,
-                               const std::string& variants) {
+                               const std::string& variants, const std::string& upgrades) {
     ContextOptions options;
     options.register_variants = register_variants(variants);
+    options.tree_upgrades = tree_upgrades(upgrades);
     options.ranks = ranks_argument(ranks, "Context: ranks");
     options.backend = backend_kind(backend, "Context: backend");
     options.threads = threads;
@@ -104,6 +115,9 @@ void bind_context(py::module_& m) {
         .def_readonly("registers_capped", &LaunchReport::registers_capped)
         .def_readonly("register_cap", &LaunchReport::register_cap)
         .def_readonly("trace_inlined", &LaunchReport::trace_inlined)
+        .def_readonly("trees_upgraded", &LaunchReport::trees_upgraded,
+                      "CUDA: triangle trees this launch traced for the first time in place of "
+                      "the GPU-built trees they upgraded (Context(tree_upgrades=...)).")
         .def_readonly("exchange_ms", &LaunchReport::exchange_ms)
         .def_readonly("devices", &LaunchReport::devices,
                       "Multi-device launches: a DeviceShare per device, in the Context's "
@@ -135,15 +149,15 @@ void bind_context(py::module_& m) {
         m, "Context", "Owns the entry points, ray types and objects of a scene, and launches.");
     ctx.def(py::init([](const std::string& backend, unsigned threads, int jit_check_sm,
                         const py::object& devices, const py::object& ranks,
-                        const std::string& variants) {
-                ContextOptions options =
-                    context_options(backend, threads, jit_check_sm, devices, ranks, variants);
+                        const std::string& variants, const std::string& upgrades) {
+                ContextOptions options = context_options(backend, threads, jit_check_sm, devices,
+                                                         ranks, variants, upgrades);
                 py::gil_scoped_release release;  // a CUDA context takes a while to start
                 return std::make_shared<Context>(std::move(options));
             }),
             py::arg("backend") = "auto", py::arg("threads") = 0u, py::arg("jit_check_sm") = 0,
             py::arg("devices") = py::none(), py::arg("ranks") = py::none(),
-            py::arg("register_variants") = "background",
+            py::arg("register_variants") = "background", py::arg("tree_upgrades") = "background",
             "backend: 'auto', 'cpu' or 'cuda'; threads: CPU workers (0: one per core); "
             "jit_check_sm: with the CPU backend, also compile the GPU megakernel for this "
             "compute capability (90: sm_90) at each compile, without a GPU; devices: '0,1', "
@@ -153,7 +167,11 @@ void bind_context(py::module_& m) {
             "script; docs/distributed.md); register_variants: CUDA, for kernels of more than "
             "64 registers a thread, a variant capped at 64 that the launch-shape tuning "
             "times beside the others: 'background' (compiled after the first launch), "
-            "'with_kernel' (compiled before it: reproducible timings) or 'off'.")
+            "'with_kernel' (compiled before it: reproducible timings) or 'off'; "
+            "tree_upgrades: CUDA, for groups of triangles the GPU builds (builder 'auto'), the "
+            "host's tree with spatial splits in place of the GPU's: 'background' (built on "
+            "another thread, used from the first launch after it is ready), 'with_build' "
+            "(built before the first launch: reproducible timings) or 'off'.")
         .def_property_readonly("backend", &Context::backend_name)
         .def_property_readonly("backend_notice", &Context::backend_notice)
         .def_property_readonly("device_count", &Context::device_count)

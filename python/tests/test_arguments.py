@@ -75,6 +75,14 @@ def test_register_variants():
         lucent.Context(backend="cpu", register_variants="sync")
 
 
+def test_tree_upgrades():
+    for upgrades in ("background", "with_build", "off"):
+        lucent.Context(backend="cpu", tree_upgrades=upgrades)
+    with pytest.raises(ValueError, match="tree_upgrades: expected 'background', "
+                                         "'with_build' or 'off'; got 'sync'"):
+        lucent.Context(backend="cpu", tree_upgrades="sync")
+
+
 @pytest.mark.parametrize("origins, directions, error, words", [
     (O.astype(np.int64), D, TypeError, ["intersect", "origins", "(R, 3) float32", "int64"]),
     (O, D.astype(np.float16), TypeError, ["directions", "float16"]),

@@ -21,7 +21,8 @@ std::unique_ptr<Backend> make_device_backend(const DeviceSpec& device,
     if (device.kind == DeviceSpec::Kind::kCpu) return make_cpu_backend(options.threads);
 #if LUCENT_HAVE_CUDA
     std::string why;
-    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why, options.register_variants))
+    if (auto backend = cuda::make_cuda_backend(device.ordinal, &why, options.register_variants,
+                                               options.tree_upgrades))
         return backend;
     throw Error("Context: device " + device_spec_name(device) + " cannot run here: " + why +
                 "; list the GPUs `nvidia-smi -L` shows, or cpu");
@@ -57,7 +58,8 @@ std::unique_ptr<Backend> make_local_backend(const ContextOptions& options, std::
     if (options.backend != BackendKind::kCpu) {
 #if LUCENT_HAVE_CUDA
         std::string why;
-        if (auto backend = cuda::make_cuda_backend(0, &why, options.register_variants))
+        if (auto backend =
+                cuda::make_cuda_backend(0, &why, options.register_variants, options.tree_upgrades))
             return backend;
         if (options.backend == BackendKind::kCuda)
             throw Error("Context: the CUDA backend cannot run here: " + why +

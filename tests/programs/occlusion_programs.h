@@ -1,6 +1,6 @@
 // Programs of the occlusion-query tests: a ray generation that asks lucent::occluded() for
-// each listed ray segment, and an any-hit that ignores every intersection (which occluded()
-// must never run).
+// each listed ray segment, an any-hit that ignores every intersection (which occluded() must
+// never run), and one that counts them.
 #pragma once
 
 #include "tests/programs/common.h"
@@ -39,6 +39,11 @@ LUCENT_RAY_GENERATION(occlusion_cast, OcclusionRecord) {
 LUCENT_ANY_HIT(occlusion_ignore_all, NoRecord, TestPayload, TriangleAttributes) {
     ++prd.anyhit_count;
     ignore_intersection();
+}
+
+// Counts the intersections and accepts them (tree_upgrade_test).
+LUCENT_ANY_HIT(occlusion_count_all, NoRecord, TestPayload, TriangleAttributes) {
+    ++prd.anyhit_count;
 }
 
 }  // namespace occlusion_module

@@ -163,6 +163,31 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
     return out;
 }
 
+std::vector<float3> layout_input_triangles(std::span<const float4> triangles,
+                                           std::span<const uint32_t> triangle_ids) {
+    const size_t count = triangle_ids.size();
+    if (triangles.size() != size_t(gpu::kGpuTriangleFloat4s) * count)
+        throw Error("GPU triangle BVH: " + std::to_string(triangles.size()) +
+                    " triangle float4s for " + std::to_string(count) + " triangle ids");
+    std::vector<float3> positions(3 * count);
+    std::vector<bool> seen(count, false);
+    for (size_t slot = 0; slot < count; ++slot) {
+        const uint32_t id = triangle_ids[slot];
+        if (id >= count || seen[id])
+            throw Error("GPU triangle BVH: leaf slot " + std::to_string(slot) + " holds triangle " +
+                        std::to_string(id) + ", " +
+                        (id >= count ? "out of range" : "already in another slot") +
+                        "; the input triangles come back only from a layout without "
+                        "spatial splits");
+        seen[id] = true;
+        for (int v = 0; v < 3; ++v) {
+            const float4 p = triangles[gpu::kGpuTriangleFloat4s * slot + v];
+            positions[3 * size_t(id) + v] = make_float3(p.x, p.y, p.z);
+        }
+    }
+    return positions;
+}
+
 void upload_gpu_triangle_bvh(const GpuTriangleBvh& bvh, GpuTriangleBvhDevice& device) {
     device.nodes.upload(std::span<const float4>(bvh.nodes));
     device.triangles.upload(std::span<const float4>(bvh.triangles));

@@ -63,6 +63,13 @@ GpuTriangleBvh build_gpu_triangle_bvh(std::span<const float3> positions,
                                       std::span<const uint3> indices,
                                       const GpuBvhBuildOptions& options = {});
 
+/// The triangles a layout without spatial splits was built from, in input order and
+/// unindexed (triangle i is vertices 3i .. 3i + 2): `triangles` and `triangle_ids` as a
+/// GpuTriangleBvh holds them. Throws lucent::Error when the ids are not each input triangle
+/// once (a layout with spatial splits, or a corrupt one).
+std::vector<float3> layout_input_triangles(std::span<const float4> triangles,
+                                           std::span<const uint32_t> triangle_ids);
+
 /// A GpuTriangleBvh in device memory.
 struct GpuTriangleBvhDevice {
     DeviceBuffer nodes, triangles, triangle_ids, parents;

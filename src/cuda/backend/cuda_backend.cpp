@@ -94,8 +94,12 @@ class CudaBackend final : public core::Backend {
     };
 
   public:
-    CudaBackend(const DriverApi& d, int ordinal, RegisterVariants register_variants)
-        : m_driver(d), m_ordinal(ordinal), m_register_variants(register_variants) {
+    CudaBackend(const DriverApi& d, int ordinal, RegisterVariants register_variants,
+                TreeUpgrades tree_upgrades)
+        : m_driver(d),
+          m_ordinal(ordinal),
+          m_register_variants(register_variants),
+          m_tree_upgrades(tree_upgrades) {
         check(d.cuDeviceGet(&m_device, ordinal), "cuDeviceGet");
         char name[256] = {};
         d.cuDeviceGetName(name, sizeof name, m_device);
@@ -171,11 +175,20 @@ class CudaBackend final : public core::Backend {
     void begin_launch(const core::CompiledScene& scene, const core::LaunchSpec& spec,
                       LaunchReport& report) override {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
+        // Trees upgraded on another thread since the last launch (TreeUpgrades::kBackground).
+        const auto adopting = std::chrono::steady_clock::now();
+        unsigned upgraded = m_scene ? m_scene->adopt_tree_upgrades() : 0;
+        if (upgraded > 0)
+            report.accel_ms += std::chrono::duration<double, std::milli>(
+                                   std::chrono::steady_clock::now() - adopting)
+                                   .count();
         if (!m_scene || &scene != m_last_scene || scene.generation != m_last_generation) {
             if (!m_scene)
-                m_scene = std::make_unique<GpuScene>(m_sm, std::move(m_bvh_builder_on_the_way));
+                m_scene = std::make_unique<GpuScene>(m_sm, m_context, m_tree_upgrades,
+                                                     std::move(m_bvh_builder_on_the_way));
             const auto start = std::chrono::steady_clock::now();
             m_scene->update(scene);
+            upgraded += m_scene->trees_upgraded_in_update();
             report.accel_ms += m_scene->accel_ms();  // the GPU layouts (GPU or host builds)
             m_last_scene = &scene;
             m_last_generation = scene.generation;
@@ -187,8 +200,15 @@ class CudaBackend final : public core::Backend {
                              std::chrono::duration<double, std::milli>(
                                  std::chrono::steady_clock::now() - updated)
                                  .count());
+        } else if (upgraded > 0) {
+            m_scene->update(scene);  // the flat arrays now point at the upgraded trees
         } else {
             m_scene->sync_buffers();
+        }
+        if (upgraded > 0) {
+            // The shapes were timed on the old trees: time them again on the new ones.
+            m_tuning.clear();
+            report.trees_upgraded = upgraded;
         }
         if (spec.device_keys.empty() || spec.device_keys.size() > gpu::kGpuMaxDeviceSlots)
             throw Error("CUDA backend: a launch needs 1 to 16 device keys");
@@ -642,6 +662,7 @@ class CudaBackend final : public core::Backend {
     std::future<std::vector<CompileResult>> m_variants_compiling;
     std::vector<Variant> m_variants;  // what m_variants_compiling compiles, in its order
     RegisterVariants m_register_variants;
+    TreeUpgrades m_tree_upgrades;
     // The GPU BVH builder being made on another thread, until a GpuScene takes it.
     std::future<std::unique_ptr<GpuBvhBuilder>> m_bvh_builder_on_the_way;
     int m_largest_grid = 1;                       // of every kernel's shapes
@@ -769,7 +790,8 @@ std::unique_ptr<core::SharedTileQueue> CudaBackend::share_tile_queue(
 }  // namespace
 
 std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why,
-                                                 RegisterVariants register_variants) {
+                                                 RegisterVariants register_variants,
+                                                 TreeUpgrades tree_upgrades) {
     const DriverApi* d = driver(why);
     if (!d) return nullptr;
     std::string nvrtc_why;
@@ -785,7 +807,7 @@ std::unique_ptr<core::Backend> make_cuda_backend(int ordinal, std::string* why,
                    std::to_string(count) + ")";
         return nullptr;
     }
-    return std::make_unique<CudaBackend>(*d, ordinal, register_variants);
+    return std::make_unique<CudaBackend>(*d, ordinal, register_variants, tree_upgrades);
 }
 
 int gpu_count() {

@@ -13,7 +13,8 @@ namespace lucent::cuda {
 /// such GPU or NVRTC answers.
 std::unique_ptr<core::Backend> make_cuda_backend(
     int ordinal, std::string* why,
-    RegisterVariants register_variants = RegisterVariants::kBackground);
+    RegisterVariants register_variants = RegisterVariants::kBackground,
+    TreeUpgrades tree_upgrades = TreeUpgrades::kBackground);
 
 /// GPUs the driver reports (0 without a driver).
 int gpu_count();

@@ -168,6 +168,7 @@ struct GpuScene::FlatScene {
 
 void GpuScene::update(const core::CompiledScene& scene) {
     m_accel_ms = 0;
+    m_upgraded_in_update = 0;
     // Only buffers this compile uses stay mirrored: others may no longer exist.
     m_previous_buffers = std::move(m_buffers);
     m_buffers.clear();
@@ -477,6 +478,73 @@ std::optional<std::vector<DeviceTriangles>> GpuScene::mirrored_triangles(
     return pieces;
 }
 
+namespace {
+
+/// Spatial splits put a triangle in several leaves: not where an any-hit program must see
+/// each triangle once per ray (TriangleAccel's rule, core/accel_builder.cpp).
+bool spatial_splits_allowed(const core::CompiledNode& node) {
+    return std::none_of(node.any_hit_enforced_for_ray_type.begin(),
+                        node.any_hit_enforced_for_ray_type.end(),
+                        [](bool any_hit) { return any_hit; });
+}
+
+/// LUCENT_GPU_TREE_UPGRADES=background|sync|off, else the context's choice.
+TreeUpgrades upgrades_mode(TreeUpgrades chosen) {
+    const char* env = std::getenv("LUCENT_GPU_TREE_UPGRADES");
+    if (!env || !*env) return chosen;
+    const std::string mode = env;
+    if (mode == "background") return TreeUpgrades::kBackground;
+    if (mode == "sync") return TreeUpgrades::kWithBuild;
+    if (mode == "off") return TreeUpgrades::kOff;
+    throw Error("LUCENT_GPU_TREE_UPGRADES=" + mode + ": expected background, sync or off");
+}
+
+}  // namespace
+
+/// Queues the upgrade of a group's GPU-built tree (TreeUpgrader): the host's tree with spatial
+/// splits, Builder::kBinnedSah's. With TreeUpgrades::kWithBuild it is waited for and adopted.
+void GpuScene::start_upgrade(const core::CompiledNode& node, GeometryMirror& mirror) {
+    const TreeUpgrades mode = upgrades_mode(m_upgrades);
+    if (mode == TreeUpgrades::kOff || mirror.upgrades_off) return;
+    if (!m_upgrader) m_upgrader = std::make_unique<TreeUpgrader>(m_context);
+    GpuBvhBuildOptions options;
+    options.spatial_splits = true;
+    m_upgrader->submit(node.geometry.get(), mirror.version, mirror.bvh, options);
+    mirror.upgrade_pending = true;
+    if (mode == TreeUpgrades::kWithBuild) {
+        m_upgrader->wait_idle();
+        m_upgraded_in_update += adopt_tree_upgrades();
+    }
+}
+
+unsigned GpuScene::adopt_tree_upgrades() {
+    if (!m_upgrader) return 0;
+    unsigned adopted = 0;
+    for (TreeUpgrader::Finished& done : m_upgrader->take_finished()) {
+        const auto found = m_geometry.find(static_cast<const core::GeometryAccel*>(done.group));
+        if (found == m_geometry.end()) continue;  // the group is gone
+        GeometryMirror& mirror = found->second;
+        if (!mirror.upgrade_pending || mirror.version != done.version) continue;  // rebuilt since
+        mirror.upgrade_pending = false;
+        if (done.tree.nodes.empty()) {
+            mirror.upgrades_off = true;  // it keeps the GPU's tree, which traces correctly
+            if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+                std::fprintf(stderr, "lucent: tree upgrade failed: %s\n", done.error.c_str());
+            continue;
+        }
+        upload_gpu_triangle_bvh(done.tree, mirror.bvh);
+        mirror.version = ++m_last_version;
+        ++adopted;
+        if (std::getenv("LUCENT_GPU_ACCEL_TIMES"))
+            std::fprintf(stderr,
+                         "lucent: tree upgraded: %zu triangle slots, host build %.3f ms, "
+                         "conversion %.3f ms, ready %.3f ms after the GPU build\n",
+                         done.tree.triangle_ids.size(), done.tree.stats.build_ms,
+                         done.tree.stats.convert_ms, done.ready_ms);
+    }
+    return adopted;
+}
+
 /// Rebuilds (or refits) the GPU layout of a GeometryGroup's triangles when they changed:
 /// on the GPU for Builder::kAuto (binned SAH) and kGpuHploc, on the host for kBinnedSah.
 /// `on_device`: the instances' triangles already in device memory, if they are (no upload).
@@ -488,6 +556,11 @@ void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
     if (mirror.structure == ga.structure_signature && mirror.content == ga.content_signature)
         return;
     const auto start = std::chrono::steady_clock::now();
+    // A new tree: an upgrade of the old one still building is of no use, and the group's
+    // triangles most likely change every frame.
+    if (mirror.upgrade_pending) mirror.upgrades_off = true;
+    mirror.upgrade_pending = false;
+    mirror.version = ++m_last_version;
     // The triangles as one mesh on the host: the compile's when it gathered them (a host
     // build), else gathered here (triangles the device cannot read in place, the host
     // build after a GPU tree too deep).
@@ -533,6 +606,9 @@ void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
                     const auto [vertices, indices] = host_mesh();
                     m_bvh_builder->build(vertices, indices, mirror.bvh, options);
                 }
+                if (accel.builder() == Builder::kAuto && !accel.refit() &&
+                    spatial_splits_allowed(node) && ga.triangle_count > 1)
+                    start_upgrade(node, mirror);
             } catch (const GpuBvhTooDeep&) {
                 // A chain of clusters deeper than the traversal stack: the host SAH build
                 // bounds its depth. Without spatial splits it has one reference per
@@ -550,9 +626,7 @@ void GpuScene::update_triangle_bvh(const core::CompiledScene& scene,
         // triangle once per ray.
         const auto [vertices, indices] = host_mesh();
         GpuBvhBuildOptions host;
-        host.spatial_splits = std::none_of(node.any_hit_enforced_for_ray_type.begin(),
-                                           node.any_hit_enforced_for_ray_type.end(),
-                                           [](bool any_hit) { return any_hit; });
+        host.spatial_splits = spatial_splits_allowed(node);
         upload_gpu_triangle_bvh(build_gpu_triangle_bvh(vertices, indices, host), mirror.bvh);
     }
     mirror.empty = ga.triangle_count == 0;

@@ -9,9 +9,10 @@
 #include <vector>
 
 #include "core/compiled_scene.h"
-#include "cuda/backend/device_buffer.h"
 #include "cuda/accel/gpu_bvh_builder.h"
 #include "cuda/accel/gpu_triangle_bvh.h"
+#include "cuda/backend/device_buffer.h"
+#include "cuda/backend/tree_upgrader.h"
 #include "cuda/jit/megakernel_generator.h"
 #include "lucent_gpu/launch_params.cuh"
 
@@ -19,17 +20,28 @@ namespace lucent::cuda {
 
 class GpuScene {
   public:
-    /// For the device of the current context, of compute capability `sm` (x10). `builder`, if
-    /// valid, is the GPU BVH builder being made on another thread (the first GPU build takes
-    /// it; otherwise that build makes one).
-    explicit GpuScene(int sm, std::future<std::unique_ptr<GpuBvhBuilder>> builder = {})
-        : m_sm(sm), m_builder_on_the_way(std::move(builder)) {}
+    /// For the device of `context` (current on the calling thread), of compute capability
+    /// `sm` (x10). `builder`, if valid, is the GPU BVH builder being made on another thread
+    /// (the first GPU build takes it; otherwise that build makes one). `upgrades`: what
+    /// becomes of Builder::kAuto's GPU-built triangle trees (ContextOptions::tree_upgrades).
+    GpuScene(int sm, CUcontext context, TreeUpgrades upgrades,
+             std::future<std::unique_ptr<GpuBvhBuilder>> builder = {})
+        : m_sm(sm),
+          m_context(context),
+          m_upgrades(upgrades),
+          m_builder_on_the_way(std::move(builder)) {}
 
     /// Brings the device copy up to date with `scene` (a new compile) and re-uploads
     /// buffers whose host contents changed.
     void update(const core::CompiledScene& scene);
     /// Time the last update() spent building or refitting GPU triangle layouts, in ms.
     double accel_ms() const { return m_accel_ms; }
+    /// Trees the last update() upgraded itself (TreeUpgrades::kWithBuild).
+    unsigned trees_upgraded_in_update() const { return m_upgraded_in_update; }
+    /// Puts the upgraded trees built since the last call (TreeUpgrades::kBackground) in place
+    /// of the GPU-built ones, in device memory; returns how many. The flat arrays still point
+    /// at the old trees: update() must run again before a launch when this returns more than 0.
+    unsigned adopt_tree_upgrades();
     /// Uploads buffers changed by the host since the last launch (same compile).
     void sync_buffers();
     /// After a launch: buffers programs may write (output, input-output) are newer on the
@@ -62,6 +74,11 @@ class GpuScene {
         uint64_t structure = 0, content = 0;
         GpuTriangleBvhDevice bvh;  // the triangles in the GPU layout (Aila and Laine 2009)
         bool empty = true;
+        uint64_t version = 0;          // of bvh: a number no other build or refit of any group had
+        bool upgrade_pending = false;  // an upgrade of this version is queued or building
+        // Its triangles changed while an upgrade was building (they move every frame, most
+        // likely), or an upgrade failed: it keeps its GPU-built trees from then on.
+        bool upgrades_off = false;
     };
 
     struct FlatScene;
@@ -85,10 +102,16 @@ class GpuScene {
     void update_triangle_bvh(const core::CompiledScene& scene, const core::CompiledNode& node,
                              const std::optional<std::vector<DeviceTriangles>>& on_device,
                              GeometryMirror& mirror);
+    void start_upgrade(const core::CompiledNode& node, GeometryMirror& mirror);
     std::optional<std::vector<DeviceTriangles>> mirrored_triangles(
         const core::CompiledScene& scene, const core::CompiledNode& node);
 
     int m_sm;
+    CUcontext m_context;
+    TreeUpgrades m_upgrades;
+    std::unique_ptr<TreeUpgrader> m_upgrader;  // made by the first upgrade
+    uint64_t m_last_version = 0;               // of the GeometryMirror trees
+    unsigned m_upgraded_in_update = 0;
     double m_accel_ms = 0;
     struct {
         unsigned count = 0, cleared = 0;
