@@ -509,7 +509,12 @@ void GpuScene::start_upgrade(const core::CompiledNode& node, GeometryMirror& mir
     if (!m_upgrader) m_upgrader = std::make_unique<TreeUpgrader>(m_context);
     GpuBvhBuildOptions options;
     options.spatial_splits = true;
-    m_upgrader->submit(node.geometry.get(), mirror.version, mirror.bvh, options);
+    try {
+        m_upgrader->submit(node.geometry.get(), mirror.version, mirror.bvh, options);
+    } catch (const Error&) {
+        mirror.upgrades_off = true;  // no memory for the copy: the GPU tree serves
+        return;
+    }
     mirror.upgrade_pending = true;
     if (mode == TreeUpgrades::kWithBuild) {
         m_upgrader->wait_idle();
