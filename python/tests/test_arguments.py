@@ -67,20 +67,17 @@ def test_bad_backend():
         lucent.render("whitted", backend="vulkan")
 
 
-def test_register_variants():
-    for variants in ("background", "with_kernel", "off"):
-        lucent.Context(backend="cpu", register_variants=variants)
-    with pytest.raises(ValueError, match="register_variants: expected 'background', "
-                                         "'with_kernel' or 'off'; got 'sync'"):
-        lucent.Context(backend="cpu", register_variants="sync")
-
-
-def test_tree_upgrades():
-    for upgrades in ("background", "with_build", "off"):
-        lucent.Context(backend="cpu", tree_upgrades=upgrades)
-    with pytest.raises(ValueError, match="tree_upgrades: expected 'background', "
-                                         "'with_build' or 'off'; got 'sync'"):
-        lucent.Context(backend="cpu", tree_upgrades="sync")
+@pytest.mark.parametrize("option, values", [
+    ("register_variants", ("background", "with_kernel", "off")),
+    ("tree_upgrades", ("background", "with_build", "off")),
+])
+def test_context_choices(option, values):
+    for value in values:
+        lucent.Context(backend="cpu", **{option: value})
+    first, second, third = values
+    with pytest.raises(ValueError, match=f"{option}: expected '{first}', '{second}' or "
+                                         f"'{third}'; got 'sync'"):
+        lucent.Context(backend="cpu", **{option: "sync"})
 
 
 @pytest.mark.parametrize("origins, directions, error, words", [
