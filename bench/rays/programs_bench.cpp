@@ -54,14 +54,16 @@ std::shared_ptr<Program> program_for(Context& ctx, const char* name, const RaySe
 }
 
 /// The kernel variant a CUDA launch ran (empty on the CPU): as compiled, or compiled with
-/// registers capped, trace() inlined or both (ContextOptions::register_variants).
+/// registers capped, trace() inlined (with lanes refilled) or both
+/// (ContextOptions::register_variants).
 std::string variant_of(const LaunchReport& report) {
     if (report.kernel_ms <= 0) return "";
-    const std::string cap = "registers capped to " + std::to_string(report.register_cap);
-    if (report.trace_inlined && report.registers_capped) return "trace inlined, " + cap;
-    if (report.trace_inlined) return "trace inlined";
-    if (report.registers_capped) return cap;
-    return "as compiled";
+    std::string variant;
+    auto add = [&](const std::string& part) { variant += (variant.empty() ? "" : ", ") + part; };
+    if (report.trace_inlined) add("trace inlined");
+    if (report.lanes_refilled) add("lanes refilled");
+    if (report.registers_capped) add("registers capped to " + std::to_string(report.register_cap));
+    return variant.empty() ? "as compiled" : variant;
 }
 
 /// Mrays/s of `repeat` launches of `entry` over `count` rays, all after the tuning: the

@@ -115,6 +115,7 @@ void bind_context(py::module_& m) {
         .def_readonly("registers_capped", &LaunchReport::registers_capped)
         .def_readonly("register_cap", &LaunchReport::register_cap)
         .def_readonly("trace_inlined", &LaunchReport::trace_inlined)
+        .def_readonly("lanes_refilled", &LaunchReport::lanes_refilled)
         .def_readonly("trees_upgraded", &LaunchReport::trees_upgraded,
                       "CUDA: triangle trees this launch traced for the first time in place of "
                       "the GPU-built trees they upgraded (Context(tree_upgrades=...)).")

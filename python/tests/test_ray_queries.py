@@ -173,6 +173,7 @@ def test_the_gpu_megakernel_of_the_query_module_compiles_for_sm_90(rng):
     assert report.launch_shape_trial is False and report.registers_capped is False
     assert report.register_cap == 0
     assert report.trace_inlined is False
+    assert report.lanes_refilled is False
     assert report.trees_upgraded == 0  # the CPU builds its tree with spatial splits at once
     np.testing.assert_array_equal(hits.prim[ref.clear], ref.prim[ref.clear])
     mesh.occluded(o, d)  # the occlusion entry is in the same megakernel

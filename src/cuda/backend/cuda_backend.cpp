@@ -54,6 +54,17 @@ constexpr int kCappedRegisters = capped_registers(kCappedBlocksPerSm);
 // The inline-trace variant (megakernel_compiler.h, can_inline_trace): trace() inlined into
 // the ray-generation program where no program a trace runs traces again.
 const std::string kInlineTraceOption = "-DLUCENT_GPU_INLINE_TRACE=1";
+// The inline-trace variants also refill lanes (lane_refill.cuh): a lane whose closest-hit
+// trace is done takes its next launch index alone and meets the lanes still tracing. On
+// bench rays --programs' diffuse rays it is worth 30-50 % (docs/performance.md, session 33).
+// Only there: a kernel whose traces recurse would meet inside nested traces, and one that
+// never calls trace() never meets, so its lanes, once apart, would stay apart.
+// LUCENT_GPU_LANE_REFILL=off leaves it out, for measurements.
+const std::string kLaneRefillOption = "-DLUCENT_GPU_LANE_REFILL=1";
+bool lane_refill_enabled() {
+    const char* v = std::getenv("LUCENT_GPU_LANE_REFILL");
+    return !(v && std::strcmp(v, "off") == 0);
+}
 
 constexpr size_t kExceptionBytes = sizeof(gpu::GpuExceptionSlot) * gpu::kGpuExceptionSlots;
 
@@ -83,7 +94,8 @@ class CudaBackend final : public core::Backend {
         CUdeviceptr params = 0;  // the module's launch parameters
         int carveout = -1;       // the carveout last set on the function
         int register_cap = 0;        // the variant's options: registers a thread at most
-        bool trace_inlined = false;  // (0: as compiled), trace() inlined
+        bool trace_inlined = false;  // (0: as compiled), trace() inlined,
+        bool lanes_refilled = false;  // lanes refilled (lane_refill.cuh)
     };
     /// A ray-generation program's kernel: its variants (0: as compiled; then, once compiled,
     /// registers capped, trace inlined, or both) and the launch shapes of all of them
@@ -254,6 +266,7 @@ class CudaBackend final : public core::Backend {
         m_size = spec.size;
         m_pieces = 0;
         m_indices = 0;
+        m_tiles_shared = false;
         check(m_driver.cuEventRecord(m_start, m_streams[0]), "cuEventRecord");
         for (unsigned i = 1; i < m_in_flight; ++i)
             check(m_driver.cuStreamWaitEvent(m_streams[i], m_start, 0), "cuStreamWaitEvent");
@@ -291,6 +304,7 @@ class CudaBackend final : public core::Backend {
         check(m_driver.cuCtxSetCurrent(m_context), "cuCtxSetCurrent");
         m_indices = count;
         ++m_pieces;
+        m_tiles_shared = true;  // whole tiles a warp: no lane refill (lane_refill.cuh)
         unsigned long long first = 0, last = count;
         void* counter_arg = reinterpret_cast<void*>(counter);
         void* owners_arg = reinterpret_cast<void*>(owners);
@@ -346,6 +360,7 @@ class CudaBackend final : public core::Backend {
         report.registers_capped = ran.register_cap > 0;
         report.register_cap = unsigned(ran.register_cap);
         report.trace_inlined = ran.trace_inlined;
+        report.lanes_refilled = ran.lanes_refilled && !m_tiles_shared;
         if (!m_fixed_shape && m_indices > 0)
             m_tuning.at(m_tuning_key).record(m_shape, kernel_ms / double(m_indices));
 
@@ -491,6 +506,7 @@ class CudaBackend final : public core::Backend {
             return;
         m_variants.clear();
         std::vector<CompileRequest> requests;
+        const bool refill = lane_refill_enabled();
         for (size_t i = 0; i < m_kernels.size(); ++i) {
             int registers = 0;
             m_driver.cuFuncGetAttribute(&registers, CU_FUNC_ATTRIBUTE_NUM_REGS,
@@ -501,8 +517,9 @@ class CudaBackend final : public core::Backend {
                 std::vector<std::string> extra;
                 if (capped_blocks > 0) extra.push_back(capped_option(capped_blocks));
                 if (inlined) extra.push_back(kInlineTraceOption);
+                if (inlined && refill) extra.push_back(kLaneRefillOption);
                 requests.push_back(std::move(unit_requests(kernel, m_sm, {i}, extra).at(0)));
-                m_variants.push_back({i, capped_blocks, inlined});
+                m_variants.push_back({i, capped_blocks, inlined, inlined && refill});
             };
             if (cap) add(kCappedBlocksPerSm, false);
             if (inline_trace) add(0, true);
@@ -548,6 +565,7 @@ class CudaBackend final : public core::Backend {
             KernelCode code = load_code(binaries[j].cubin, v.kernel);
             code.register_cap = v.capped_blocks > 0 ? capped_registers(v.capped_blocks) : 0;
             code.trace_inlined = v.trace_inlined;
+            code.lanes_refilled = v.lanes_refilled;
             std::vector<LaunchShape> shapes = launch_shapes(code.function, nullptr);
             for (LaunchShape& shape : shapes) {
                 shape.variant = int(k.codes.size());
@@ -658,6 +676,7 @@ class CudaBackend final : public core::Backend {
         size_t kernel = 0;
         int capped_blocks = 0;  // __launch_bounds__' blocks per SM (0: none)
         bool trace_inlined = false;
+        bool lanes_refilled = false;
     };
     std::future<std::vector<CompileResult>> m_variants_compiling;
     std::vector<Variant> m_variants;  // what m_variants_compiling compiles, in its order
@@ -672,6 +691,7 @@ class CudaBackend final : public core::Backend {
     std::unique_ptr<GpuScene> m_scene;
     std::unique_ptr<DisplayEncoder> m_display;  // made by the first display_frame
     bool m_fixed_shape = false;
+    bool m_tiles_shared = false;  // this launch took tiles from a counter other GPUs share
     std::map<std::pair<unsigned, uint64_t>, ShapeTuning> m_tuning;  // by entry, launch count
     const core::CompiledScene* m_last_scene = nullptr;
     uint64_t m_last_generation = 0;

@@ -46,6 +46,9 @@
 #ifndef LUCENT_GPU_INLINE_TRACE
 #define LUCENT_GPU_INLINE_TRACE 0  // 1: trace() inlined into the ray-generation program (trace.cuh)
 #endif
+#ifndef LUCENT_GPU_LANE_REFILL
+#define LUCENT_GPU_LANE_REFILL 0  // 1: lanes take new launch indices alone (lane_refill.cuh)
+#endif
 #ifndef LUCENT_GPU_SELECTORS
 #define LUCENT_GPU_SELECTORS 1
 #endif
@@ -223,6 +226,10 @@ struct ThreadState {
     Frame* frame;
     unsigned print_here;
     ProgramContext context;  // outside any trace
+#if LUCENT_GPU_LANE_REFILL
+    unsigned refill;    // this lane takes part in lane refill (lane_refill.cuh)
+    unsigned meetings;  // the warp meetings this lane has been to
+#endif
 };
 
 __shared__ ThreadState g_threads[LUCENT_GPU_BLOCK];

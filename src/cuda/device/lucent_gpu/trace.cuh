@@ -6,6 +6,7 @@
 #pragma once
 
 #include "lucent/device/triangle_intersect.h"
+#include "lucent_gpu/lane_refill.cuh"
 #include "lucent_gpu/runtime.cuh"
 #include "runtime/trace_rules.h"
 
@@ -91,7 +92,14 @@ __device__ __forceinline__ void geometry_group(Frame& f, const GpuGeometryAccel&
 #endif
         GpuHit hit;
         if (closest_only) {
-            if (gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit)) {
+#if LUCENT_GPU_LANE_REFILL
+            const bool found =
+                gpu_bvh_closest_refilled(ga.triangles, origin, direction, tmin, f.closest, hit);
+#else
+            const bool found =
+                gpu_bvh_closest(ga.triangles, origin, direction, tmin, f.closest, hit);
+#endif
+            if (found) {
                 unsigned k = locate(ga, hit.prim);
                 unsigned local = hit.prim - params.accel_prim_first[ga.prim_first_offset + k];
                 triangle_candidate(f, params.accel_instances[ga.instance_offset + k], local, hit.t,
@@ -410,6 +418,103 @@ __device__ __forceinline__ bool occluded(Handle root, const Ray& ray, Occlusion 
 }  // namespace lucent
 
 namespace lucent::gpu {
+/// Runs the ray-generation program at launch index (x, y, z), then the exception program if
+/// it raised an enabled exception.
+template <class RunRayGeneration>
+__device__ __forceinline__ void run_launch_index(RunRayGeneration& run_ray_generation, unsigned x,
+                                                 unsigned y, unsigned z) {
+    ThreadState& s = self();
+    const LaunchParams& p = params;
+    const unsigned long long linear =
+        (unsigned long long)(z * p.launch_size.y + y) * p.launch_size.x + x;
+    s.launch_index = make_uint3(x, y, z);
+    s.depth = 0;
+    s.exception_code = 0;
+    s.frame = nullptr;
+    s.context = ProgramContext::kRayGeneration;
+#if LUCENT_GPU_PRINT
+    s.print_here = p.print_enabled && (p.print_index.x < 0 || unsigned(p.print_index.x) == x) &&
+                   (p.print_index.y < 0 || unsigned(p.print_index.y) == y) &&
+                   (p.print_index.z < 0 || unsigned(p.print_index.z) == z);
+#else
+    s.print_here = 0;
+#endif
+    run_ray_generation(record(p.ray_generation));
+    if (s.exception_code) {
+        int code = s.exception_code;
+        count_exception(code, linear);
+        bool enabled = code >= kUserExceptionBase ? (p.exception_mask >> 31) & 1u
+                                                  : (p.exception_mask >> code) & 1u;
+        if (enabled && p.exception.id >= 0) {
+            s.exception_code = 0;  // the exception program runs normally
+            s.depth = 0;
+            s.frame = nullptr;
+            s.context = ProgramContext::kException;
+            ExceptionInfo info{code, s.launch_index, s.exception_detail};
+            dispatch_exception(p.exception.id, record(p.exception), info);
+            if (s.exception_code) count_exception(s.exception_code, linear);
+        }
+    }
+}
+
+/// The launch indices of one piece of a launch, counted from 0 by the piece's counter.
+struct LaunchPiece {
+    unsigned long long first, last;  // linear indices [first, last)
+    unsigned long long first_row, end_row;
+    unsigned tiles_x;
+    bool tiled, one_dimension;
+    unsigned long long work;  // the counter's end: indices, or 32 a tile when tiled
+
+    __device__ __forceinline__ LaunchPiece(unsigned long long piece_first,
+                                           unsigned long long piece_last) {
+        const LaunchParams& p = params;
+        first = piece_first;
+        last = piece_last;
+#if LUCENT_GPU_TILES
+        // Launches of several rows: a warp takes an 8x4 tile of launch indices, so
+        // neighbouring rays, and their secondary rays, run together (less divergence than a
+        // row of 32).
+        tiled = p.launch_size.y > 1 || p.launch_size.z > 1;
+#else
+        tiled = false;
+#endif
+        one_dimension = p.launch_size.y == 1 && p.launch_size.z == 1;
+        first_row = piece_first / p.launch_size.x;
+        end_row = piece_last / p.launch_size.x;
+        tiles_x = (p.launch_size.x + 7) / 8;
+        work = tiled ? 32ull * tiles_x * ((end_row - first_row + 3) / 4) : piece_last - piece_first;
+    }
+
+    /// The launch index of counter value `i` (< work); false for a tile's place outside the
+    /// launch.
+    __device__ __forceinline__ bool coordinates(unsigned long long i, unsigned& x, unsigned& y,
+                                                unsigned& z) const {
+        const LaunchParams& p = params;
+        if (tiled) {
+            const unsigned long long tile = i / 32;
+            const unsigned place = unsigned(i & 31u);
+            x = unsigned(tile % tiles_x) * 8 + (place & 7u);
+            const unsigned long long row = first_row + (tile / tiles_x) * 4 + (place >> 3);
+            if (x >= p.launch_size.x || row >= end_row) return false;
+            y = unsigned(row % p.launch_size.y);
+            z = unsigned(row / p.launch_size.y);
+            return true;
+        }
+        const unsigned long long index = first + i;
+        if (index >= last) return false;
+        if (one_dimension) {  // no divisions (two 64-bit ones below)
+            x = unsigned(index);
+            y = z = 0;
+            return true;
+        }
+        x = unsigned(index % p.launch_size.x);
+        const unsigned long long rest = index / p.launch_size.x;
+        y = unsigned(rest % p.launch_size.y);
+        z = unsigned(rest / p.launch_size.y);
+        return true;
+    }
+};
+
 /// The megakernel's body: persistent threads take launch indices from a global counter, a
 /// warp's worth at a time (Aila and Laine 2009), and run the ray-generation program on each.
 /// One kernel runs one piece of the launch: linear indices [piece_first, piece_last), whole
@@ -417,6 +522,8 @@ namespace lucent::gpu {
 /// `counter` (pieces may run at once, one filling the SMs another's tail leaves idle).
 /// Several GPUs may share one counter (peer atomics): each then writes `device` into
 /// `owners[tile]` for the tiles it takes, so each can gather the others' tiles (gather.cuh).
+/// On one GPU, with LUCENT_GPU_LANE_REFILL, each lane takes its own indices instead
+/// (lane_refill.cuh).
 ///
 /// `run_ray_generation(record)` calls one ray-generation program directly: the generator
 /// makes one kernel per bound ray-generation program (LUCENT_GPU_RAY_GENERATION_KERNEL
@@ -430,81 +537,32 @@ __device__ __forceinline__ void run_launch(RunRayGeneration run_ray_generation,
                                            unsigned long long piece_last,
                                            unsigned long long* counter, unsigned char* owners,
                                            unsigned device) {
+    const LaunchPiece piece(piece_first, piece_last);
+    unsigned x, y, z;
+#if LUCENT_GPU_LANE_REFILL
     ThreadState& s = self();
-    const LaunchParams& p = params;
-    const unsigned lane = threadIdx.x & 31u;
-#if LUCENT_GPU_TILES
-    // Launches of several rows: a warp takes an 8x4 tile of launch indices, so neighbouring
-    // rays, and their secondary rays, run together (less divergence than a row of 32).
-    const bool tiled = p.launch_size.y > 1 || p.launch_size.z > 1;
-#else
-    const bool tiled = false;
+    if (!owners) {  // a tile must not be split between GPUs: refill on one GPU only
+        refill_open(s);
+        for (;;) {
+            const unsigned long long i = refill_claim(counter);
+            if (i >= piece.work) break;
+            if (piece.coordinates(i, x, y, z)) run_launch_index(run_ray_generation, x, y, z);
+        }
+        refill_retire(s);
+        return;
+    }
+    s.refill = 0;
 #endif
-    const bool one_dimension = p.launch_size.y == 1 && p.launch_size.z == 1;
-    const unsigned long long first_row = piece_first / p.launch_size.x;
-    const unsigned long long end_row = piece_last / p.launch_size.x;
-    const unsigned tiles_x = (p.launch_size.x + 7) / 8;
-    const unsigned long long work =
-        tiled ? 32ull * tiles_x * ((end_row - first_row + 3) / 4) : piece_last - piece_first;
+    const unsigned lane = threadIdx.x & 31u;
     for (;;) {
         unsigned long long base = 0;
         if (lane == 0) {
             base = atomicAdd(counter, 32ull);
-            if (owners && base < work) owners[base / 32] = (unsigned char)device;
+            if (owners && base < piece.work) owners[base / 32] = (unsigned char)device;
         }
         base = __shfl_sync(0xffffffffu, base, 0);
-        if (base >= work) return;
-        unsigned x, y, z;
-        if (tiled) {
-            const unsigned long long tile = base / 32;
-            x = unsigned(tile % tiles_x) * 8 + (lane & 7u);
-            const unsigned long long row = first_row + (tile / tiles_x) * 4 + (lane >> 3);
-            if (x >= p.launch_size.x || row >= end_row) continue;
-            y = unsigned(row % p.launch_size.y);
-            z = unsigned(row / p.launch_size.y);
-        } else if (one_dimension) {  // no divisions (two 64-bit ones below)
-            const unsigned long long index = piece_first + base + lane;
-            if (index >= piece_last) continue;
-            x = unsigned(index);
-            y = z = 0;
-        } else {
-            unsigned long long index = piece_first + base + lane;
-            if (index >= piece_last) continue;
-            x = unsigned(index % p.launch_size.x);
-            unsigned long long rest = index / p.launch_size.x;
-            y = unsigned(rest % p.launch_size.y);
-            z = unsigned(rest / p.launch_size.y);
-        }
-        const unsigned long long linear =
-            (unsigned long long)(z * p.launch_size.y + y) * p.launch_size.x + x;
-        s.launch_index = make_uint3(x, y, z);
-        s.depth = 0;
-        s.exception_code = 0;
-        s.frame = nullptr;
-        s.context = ProgramContext::kRayGeneration;
-#if LUCENT_GPU_PRINT
-        s.print_here = p.print_enabled && (p.print_index.x < 0 || unsigned(p.print_index.x) == x) &&
-                       (p.print_index.y < 0 || unsigned(p.print_index.y) == y) &&
-                       (p.print_index.z < 0 || unsigned(p.print_index.z) == z);
-#else
-        s.print_here = 0;
-#endif
-        run_ray_generation(record(p.ray_generation));
-        if (s.exception_code) {
-            int code = s.exception_code;
-            count_exception(code, linear);
-            bool enabled = code >= kUserExceptionBase ? (p.exception_mask >> 31) & 1u
-                                                      : (p.exception_mask >> code) & 1u;
-            if (enabled && p.exception.id >= 0) {
-                s.exception_code = 0;  // the exception program runs normally
-                s.depth = 0;
-                s.frame = nullptr;
-                s.context = ProgramContext::kException;
-                ExceptionInfo info{code, s.launch_index, s.exception_detail};
-                dispatch_exception(p.exception.id, record(p.exception), info);
-                if (s.exception_code) count_exception(s.exception_code, linear);
-            }
-        }
+        if (base >= piece.work) return;
+        if (piece.coordinates(base + lane, x, y, z)) run_launch_index(run_ray_generation, x, y, z);
     }
 }
 }  // namespace lucent::gpu

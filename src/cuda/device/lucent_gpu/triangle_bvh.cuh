@@ -148,6 +148,8 @@ LUCENT_HD inline bool gpu_intersect_triangle(const float4* tris, unsigned i,
 
 struct GpuNoFilter {
     LUCENT_HD int operator()(const GpuHit&) const { return kGpuAccept; }
+    /// With kDynamicFetch, run() returns once fewer lanes than this are traversing.
+    LUCENT_HD int yield_below() const { return LUCENT_GPU_DYNAMIC_FETCH_THRESHOLD; }
 };
 
 // ---- traversal ---------------------------------------------------------------------
@@ -226,7 +228,8 @@ struct GpuBvhTraversal {
         t_far = fminf(fminf(fx, fy), fminf(fz, r.tmax)) * kGpuFarScale;
     }
 
-    /// Traverses until done, or (kDynamicFetch) until too few lanes of the warp are busy.
+    /// Traverses until done, or (kDynamicFetch) until fewer lanes of the warp than
+    /// filter.yield_below() are busy.
     template <int kQuery, bool kDynamicFetch, class Filter>
     LUCENT_HD void run(const GpuTriangleBvhView& bvh, Filter& filter, GpuBvhStack& stack_memory) {
         int* const stack = stack_memory.entries;
@@ -310,7 +313,7 @@ struct GpuBvhTraversal {
             }
 
             if constexpr (kDynamicFetch) {
-                if (gpu_active_lanes() < LUCENT_GPU_DYNAMIC_FETCH_THRESHOLD) return;
+                if (gpu_active_lanes() < filter.yield_below()) return;
             }
         }
     }
