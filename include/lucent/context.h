@@ -144,8 +144,9 @@ struct LaunchReport {
     bool trace_inlined = false;
     /// CUDA: this launch's kernel refilled lanes: a lane whose closest-hit trace was done
     /// took its next launch index alone and met the lanes still tracing, so traversal ran
-    /// with more lanes of a warp busy (the inline-trace variants, on one GPU; the
-    /// environment variable LUCENT_GPU_LANE_REFILL=off leaves it out).
+    /// with more lanes of a warp busy (two of the inline-trace variants, one more shape the
+    /// tuning times; not over a tile queue several GPUs share; the environment variable
+    /// LUCENT_GPU_LANE_REFILL=off leaves them out).
     bool lanes_refilled = false;
     /// CUDA: triangle trees (TreeUpgrades) this launch traced for the first time, in place of
     /// the GPU-built trees it replaced; the launch-shape tuning starts again after them.

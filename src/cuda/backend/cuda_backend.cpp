@@ -54,12 +54,14 @@ constexpr int kCappedRegisters = capped_registers(kCappedBlocksPerSm);
 // The inline-trace variant (megakernel_compiler.h, can_inline_trace): trace() inlined into
 // the ray-generation program where no program a trace runs traces again.
 const std::string kInlineTraceOption = "-DLUCENT_GPU_INLINE_TRACE=1";
-// The inline-trace variants also refill lanes (lane_refill.cuh): a lane whose closest-hit
-// trace is done takes its next launch index alone and meets the lanes still tracing. On
-// bench rays --programs' diffuse rays it is worth 30-50 % (docs/performance.md, session 33).
-// Only there: a kernel whose traces recurse would meet inside nested traces, and one that
-// never calls trace() never meets, so its lanes, once apart, would stay apart.
-// LUCENT_GPU_LANE_REFILL=off leaves it out, for measurements.
+// Two of the inline-trace variants also come with lane refill (lane_refill.cuh): a lane
+// whose closest-hit trace is done takes its next launch index alone and meets the lanes
+// still tracing. On an H100 it ran bench rays --programs' diffuse rays 30-50 % faster and
+// cost the direct sample on Sibenik 6 % and IGI's interleaved passes 3-10 % (coherent rays,
+// docs/performance.md, session 33): more variants for the tuning to time, beside the
+// inline-trace ones without it. Only with trace() inlined: a kernel whose traces recurse
+// would meet inside nested traces, and one that never calls trace() never meets, so its
+// lanes, once apart, would stay apart. LUCENT_GPU_LANE_REFILL=off leaves them out.
 const std::string kLaneRefillOption = "-DLUCENT_GPU_LANE_REFILL=1";
 bool lane_refill_enabled() {
     const char* v = std::getenv("LUCENT_GPU_LANE_REFILL");
@@ -513,18 +515,20 @@ class CudaBackend final : public core::Backend {
                                         m_kernels[i].codes[0].function);
             const bool cap = registers > kCappedRegisters;
             const bool inline_trace = can_inline_trace(kernel.binaries.at(i));
-            auto add = [&](int capped_blocks, bool inlined) {
+            auto add = [&](int capped_blocks, bool inlined, bool refilled) {
                 std::vector<std::string> extra;
                 if (capped_blocks > 0) extra.push_back(capped_option(capped_blocks));
                 if (inlined) extra.push_back(kInlineTraceOption);
-                if (inlined && refill) extra.push_back(kLaneRefillOption);
+                if (refilled) extra.push_back(kLaneRefillOption);
                 requests.push_back(std::move(unit_requests(kernel, m_sm, {i}, extra).at(0)));
-                m_variants.push_back({i, capped_blocks, inlined, inlined && refill});
+                m_variants.push_back({i, capped_blocks, inlined, refilled});
             };
-            if (cap) add(kCappedBlocksPerSm, false);
-            if (inline_trace) add(0, true);
-            if (cap && inline_trace) add(kCappedBlocksPerSm, true);
-            if (inline_trace) add(kTightCappedBlocksPerSm, true);
+            if (cap) add(kCappedBlocksPerSm, false, false);
+            if (inline_trace) add(0, true, false);
+            if (inline_trace && refill) add(0, true, true);
+            if (cap && inline_trace) add(kCappedBlocksPerSm, true, false);
+            if (inline_trace) add(kTightCappedBlocksPerSm, true, false);
+            if (inline_trace && refill) add(kTightCappedBlocksPerSm, true, true);
         }
         if (m_variants.empty()) return;
         if (mode == "sync") {
