@@ -9,19 +9,24 @@
 
 namespace {
 
+/// Renders `sample` at 8x8 on the CPU with its megakernel also compiled for sm_90.
+lucent::samples::RenderResult render_with_jit_check(const lucent::samples::Sample& sample) {
+    lucent::samples::RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.backend = lucent::BackendKind::kCpu;
+    settings.jit_check_sm = 90;
+    return sample.render(settings);
+}
+
 TEST(jit, EverySampleMegakernelCompilesForSm90) {
 #if !LUCENT_HAVE_CUDA
     GTEST_SKIP() << "built without the CUDA toolkit: no megakernel to compile";
 #else
     ::setenv("LUCENT_CACHE_DIR", "off", 1);  // a real NVRTC compile, not a cache hit
     for (const lucent::samples::Sample* sample : lucent::samples::all_samples()) {
-        lucent::samples::RenderSettings settings;
-        settings.width = 8;
-        settings.height = 8;
-        settings.backend = lucent::BackendKind::kCpu;
-        settings.jit_check_sm = 90;
         lucent::samples::RenderResult result;
-        ASSERT_NO_THROW(result = sample->render(settings)) << sample->name;
+        ASSERT_NO_THROW(result = render_with_jit_check(*sample)) << sample->name;
         EXPECT_GT(result.report.jit_ms, 0.0) << sample->name << ": no megakernel was compiled";
         EXPECT_FALSE(result.report.jit_cached) << sample->name;
     }
@@ -41,13 +46,8 @@ TEST(jit, TheLaneRefillVariantCompilesForSm90) {
     for (const lucent::samples::Sample* sample : lucent::samples::all_samples()) {
         if (sample->name != std::string("direct") && sample->name != std::string("pathtracer"))
             continue;
-        lucent::samples::RenderSettings settings;
-        settings.width = 8;
-        settings.height = 8;
-        settings.backend = lucent::BackendKind::kCpu;
-        settings.jit_check_sm = 90;
         lucent::samples::RenderResult result;
-        ASSERT_NO_THROW(result = sample->render(settings)) << sample->name;
+        ASSERT_NO_THROW(result = render_with_jit_check(*sample)) << sample->name;
         EXPECT_GT(result.report.jit_ms, 0.0) << sample->name;
         ++compiled;
     }

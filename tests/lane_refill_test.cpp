@@ -10,7 +10,6 @@
 #include <cstring>
 #include <random>
 
-#include "lucent/device/triangle_intersect.h"
 #include "tests/mesh_fixtures.h"
 #include "tests/programs/lane_refill_programs.h"
 #include "tests/test_support.h"
@@ -68,15 +67,7 @@ RefillCase make_case(const test_meshes::Mesh& mesh, unsigned indices, uint32_t s
             }
             d = normalize(d);
             c.rays.push_back({o, d, 40.0f});
-            const WatertightRay wt = make_watertight_ray(o, d);
-            float nearest = INFINITY;
-            for (const uint3 tri : mesh.indices) {
-                float t, b1, b2;
-                if (intersect_triangle_watertight(wt, mesh.positions[tri.x], mesh.positions[tri.y],
-                                                  mesh.positions[tri.z], 1e-4f, 40.0f, t, b1, b2))
-                    nearest = std::min(nearest, t);
-            }
-            c.t.push_back(nearest);
+            c.t.push_back(test_meshes::nearest_hit(mesh, o, d, 1e-4f, 40.0f));
         }
     }
     return c;

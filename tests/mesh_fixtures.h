@@ -2,10 +2,13 @@
 // layout's, the engine's), so that a case written once reads the same everywhere.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
 
+#include "lucent/device/triangle_intersect.h"
 #include "lucent/device/vector_math.h"
 
 namespace lucent::test_meshes {
@@ -34,6 +37,20 @@ inline Mesh floor_and_clutter(uint32_t seed, int count) {
         m.indices.push_back(make_uint3(base, base + 1, base + 2));
     }
     return m;
+}
+
+/// Brute force's nearest hit of the ray o + t d with t in (tmin, tmax) among the mesh's
+/// triangles (the watertight test the engine uses), or infinity.
+inline float nearest_hit(const Mesh& mesh, float3 o, float3 d, float tmin, float tmax) {
+    const WatertightRay wt = make_watertight_ray(o, d);
+    float nearest = INFINITY;
+    for (const uint3 tri : mesh.indices) {
+        float t, b1, b2;
+        if (intersect_triangle_watertight(wt, mesh.positions[tri.x], mesh.positions[tri.y],
+                                          mesh.positions[tri.z], tmin, tmax, t, b1, b2))
+            nearest = std::min(nearest, t);
+    }
+    return nearest;
 }
 
 }  // namespace lucent::test_meshes

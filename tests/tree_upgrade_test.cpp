@@ -8,7 +8,6 @@
 #include <cmath>
 #include <random>
 
-#include "lucent/device/triangle_intersect.h"
 #include "tests/mesh_fixtures.h"
 #include "tests/programs/occlusion_programs.h"
 #include "tests/test_support.h"
@@ -35,15 +34,7 @@ RaysAndHits rays_and_hits(const test_meshes::Mesh& mesh) {
         const float3 to = make_float3(10 * uni(rng), 10 * uni(rng), -0.5f);
         const float3 d = normalize(to - o);
         r.queries.push_back({o, d, 10.0f, 0});
-        const WatertightRay wt = make_watertight_ray(o, d);
-        float nearest = INFINITY;
-        for (const uint3 tri : mesh.indices) {
-            float t, b1, b2;
-            if (intersect_triangle_watertight(wt, mesh.positions[tri.x], mesh.positions[tri.y],
-                                              mesh.positions[tri.z], 1e-4f, 10.0f, t, b1, b2))
-                nearest = std::min(nearest, t);
-        }
-        r.t.push_back(nearest);
+        r.t.push_back(test_meshes::nearest_hit(mesh, o, d, 1e-4f, 10.0f));
     }
     return r;
 }
