@@ -199,7 +199,9 @@ class Traverser {
     void locate_triangle(const CompiledNode& n, unsigned global, unsigned& instance,
                          unsigned& local) const {
         const core::GeometryAccel& ga = *n.geometry;
-        const size_t k = ga.tri_instance[global];
+        // One instance (the common case) needs no lookup: tri_instance[global] is a load
+        // from a per-triangle array that a diffuse ray's random triangle misses in cache.
+        const size_t k = n.instances.size() == 1 ? 0 : ga.tri_instance[global];
         instance = n.instances[k];
         local = global - ga.prim_first[k];
     }
