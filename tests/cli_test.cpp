@@ -425,10 +425,10 @@ TEST(CliBenchIgi, RunsEveryConfigurationForEveryVplCount) {
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const nlohmann::json result = nlohmann::json::parse(run.output);
     const nlohmann::json& rows = result.at("rows");
-    ASSERT_EQ(rows.size(), 10u) << run.output;
+    ASSERT_EQ(rows.size(), 12u) << run.output;
     size_t row = 0;
-    for (const char* c : {"canonical", "imperfect, box graph", "+imperfect visibility",
-                          "+downsampling", "+interleaving"})
+    for (const char* c : {"canonical", "imperfect, box graph", "imperfect, maps",
+                          "+imperfect visibility", "+downsampling", "+interleaving"})
         for (unsigned v : {4u, 8u}) {
             EXPECT_EQ(rows[row].at("configuration"), c) << run.output;
             EXPECT_EQ(rows[row].at("vpls"), v) << run.output;
@@ -436,7 +436,7 @@ TEST(CliBenchIgi, RunsEveryConfigurationForEveryVplCount) {
         }
     // Interleaving adds the discontinuity filter; the canonical frame has none.
     EXPECT_FALSE(rows[0].at("stage_ms").contains("discontinuity filter")) << run.output;
-    EXPECT_TRUE(rows[8].at("stage_ms").contains("discontinuity filter")) << run.output;
+    EXPECT_TRUE(rows[10].at("stage_ms").contains("discontinuity filter")) << run.output;
 }
 
 TEST(CliBenchIgi, BadVplCountNamesTheFlagAndRange) {

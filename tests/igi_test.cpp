@@ -132,15 +132,55 @@ TEST(Igi, IndirectAgreesWithABruteForceReference) {
 TEST(Igi, ImperfectVisibilityStaysCloseToCanonical) {
     // Seed §4.1: VPL shadow rays against boxes: 1, the scene BVH's leaf boxes
     // (Occlusion::kLeafBoxes); 2, the paper's second graph of one box per triangle (a second
-    // root and ray type).
+    // root and ray type); or 3, no shadow rays but a depth map per VPL.
     const RenderResult exact = render({{"imperfect_visibility", "0"}});
-    for (const char* form : {"1", "2"}) {
+    for (const char* form : {"1", "2", "3"}) {
         const RenderResult boxes = render({{"imperfect_visibility", form}});
         EXPECT_EQ(boxes.report.exception_count(), 0u) << form;
         EXPECT_GT(brightness(boxes, 0.6f, 0.85f), 0.0f) << "VPL light still arrives; " << form;
         EXPECT_LT(relative_rms(exact.image, boxes.image), 0.03) << form;
         EXPECT_NE(sum(exact.image), sum(boxes.image)) << "the boxes change something; " << form;
     }
+}
+
+TEST(Igi, VisibilityMapTexelsAndLookupsAgree) {
+    // A map's texel (i, j) is traced in vpl_map_direction; a lookup towards that direction
+    // lands on the texel's centre, so it reads that texel alone, whatever the VPL's normal.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    constexpr unsigned kSize = 16;
+    for (int trial = 0; trial < 20; ++trial) {
+        const float3 n = normalize(make_float3(unit(rng), unit(rng), unit(rng)));
+        const igi::VplFrame f = igi::vpl_frame(n);
+        EXPECT_NEAR(dot(f.t, f.b), 0.0f, 1e-5f);
+        EXPECT_NEAR(dot(f.t, n), 0.0f, 1e-5f);
+        EXPECT_NEAR(dot(cross(f.t, f.b), n), 1.0f, 1e-5f) << "right-handed";
+        for (unsigned j = 0; j < kSize; ++j)
+            for (unsigned i = 0; i < kSize; ++i) {
+                const float3 w = igi::vpl_map_direction(f, i, j, kSize);
+                EXPECT_NEAR(length(w), 1.0f, 1e-5f);
+                EXPECT_GE(dot(w, n), -1e-6f) << "in the VPL's hemisphere";
+                const float u = 2.0f * (i + 0.5f) / kSize - 1.0f;
+                const float v = 2.0f * (j + 0.5f) / kSize - 1.0f;
+                if (u * u + v * v > 1.0f) continue;  // outside the disc: the rim's direction
+                const float s = 1.0f / (1.0f + dot(w, n));
+                EXPECT_NEAR(dot(w, f.t) * s, u, 1e-5f) << i << "," << j;
+                EXPECT_NEAR(dot(w, f.b) * s, v, 1e-5f) << i << "," << j;
+            }
+    }
+}
+
+TEST(Igi, VisibilityMapsCastShadowsThatSharpenWithResolution) {
+    // The maps stand in for shadow rays: at 64 texels square the image is near the exact
+    // one, and further from it at 4, so the lookups do shadow (a lookup that saw everything
+    // would give both the same image).
+    const RenderResult exact = render({{"imperfect_visibility", "0"}});
+    const RenderResult fine = render({{"imperfect_visibility", "3"}, {"visibility_map", "64"}});
+    const RenderResult coarse = render({{"imperfect_visibility", "3"}, {"visibility_map", "4"}});
+    const double fine_error = relative_rms(exact.image, fine.image);
+    const double coarse_error = relative_rms(exact.image, coarse.image);
+    EXPECT_LT(fine_error, 0.01);
+    EXPECT_GT(coarse_error, 2.0 * fine_error);
 }
 
 TEST(Igi, DownsamplingStaysCloseToCanonical) {

@@ -23,16 +23,19 @@ namespace {
 
 struct Configuration {
     const char* name;
-    unsigned imperfect;  // the sample's imperfect_visibility: 0 exact, 1 leaf boxes, 2 box graph
+    unsigned imperfect;  // the sample's imperfect_visibility: 0 exact, 1 leaf boxes, 2 box
+                         // graph, 3 visibility maps
     bool downsample, interleave;
 };
 
 // Cumulative, as the paper adds them (Fig. 5): each row keeps the accelerations above it.
-// The paper's own form of imperfect visibility, a second graph of triangle boxes, is the
-// row after canonical, beside the leaf boxes Lucent uses for it.
+// The paper's own form of imperfect visibility, a second graph of triangle boxes, and the
+// visibility maps of its reference [3] are the rows after canonical, beside the leaf boxes
+// that the cumulative rows use.
 constexpr Configuration kConfigurations[] = {
     {"canonical", 0, false, false},
     {"imperfect, box graph", 2, false, false},
+    {"imperfect, maps", 3, false, false},
     {"+imperfect visibility", 1, false, false},
     {"+downsampling", 1, true, false},
     {"+interleaving", 1, true, true},

@@ -115,6 +115,8 @@ struct IgiOptions {
         config.downsample = unsigned(v.integer("downsample"));
         config.interleave = unsigned(v.integer("interleave"));
         config.layers = v.on("reflection_layer") ? 2u : 1u;
+        if (imperfect == igi::kVisibilityMapVisibility)
+            config.visibility_map = unsigned(v.integer("visibility_map"));
         config.width = settings.width;
         config.height = settings.height;
         const int slices = v.integer("vpl_slices");
@@ -153,8 +155,13 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
     auto path_buffer = ctx.create_buffer<igi::LightPath>(BufferType::kInput, unsigned(paths.size()));
     path_buffer->upload(paths);
     ctx["light_paths"] = path_buffer;
-    ctx["vpls"] =
-        ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, config.paths * config.bounces);
+    const unsigned vpls = config.paths * config.bounces;
+    ctx["vpls"] = ctx.create_buffer<igi::Vpl>(BufferType::kInputOutput, vpls);
+    // Each VPL's visibility map (imperfect_visibility=3); one texel when there are none, so
+    // that the variable is bound.
+    const unsigned map = config.visibility_map;
+    ctx["vpl_maps"] = map > 0 ? ctx.create_buffer<float>(BufferType::kInputOutput, map, map, vpls)
+                              : ctx.create_buffer<float>(BufferType::kInputOutput, 1, 1, 1);
 }
 
 /// The scene's triangles ("top_object", traced by radiance and particle rays) and, for the
@@ -164,6 +171,7 @@ void add_lights(Context& ctx, const std::vector<igi::PointEmitter>& lights, cons
 void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPasses* aovs) {
     auto surface = ctx.create_program(LUCENT_PROGRAM(igi::igi_surface));
     auto particle = ctx.create_program(LUCENT_PROGRAM(igi::igi_particle_hit));
+    auto depth = ctx.create_program(LUCENT_PROGRAM(igi::igi_depth_hit));
     DiffuseTextures texture_for(ctx, &input);
     std::vector<std::shared_ptr<Material>> materials;
     for (const auto& m : input.materials) {
@@ -171,6 +179,7 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPass
         material->set_name(m.name);
         material->set_closest_hit(igi::kRadianceRay, surface);
         material->set_closest_hit(igi::kParticleRay, particle);
+        material->set_closest_hit(igi::kVplDepthRay, depth);
         // Glass is the specular tree's refraction and reflection only (igi::dielectric):
         // neither diffuse nor a mirror, and particles stop at it (no VPL: no albedo).
         const bool glass = m.kind == scene::MaterialKind::kDielectric;
@@ -208,6 +217,7 @@ void add_graphs(Context& ctx, const scene::Scene& input, bool box_graph, AovPass
     // Radiance and particle rays trace the scene; the boxes need none of their programs.
     ctx.set_ray_type<igi::RadiancePayload>(igi::kRadianceRay, "radiance", true, {top});
     ctx.set_ray_type<igi::ParticlePayload>(igi::kParticleRay, "particle", true, {top});
+    ctx.set_ray_type<igi::DepthPayload>(igi::kVplDepthRay, "vpl depth", true, {top});
     if (aovs) aovs->add_to(materials, {top});  // G-buffer rays trace the scene, not the boxes
 }
 
@@ -240,6 +250,8 @@ void add_passes(Context& ctx, const IgiConfig& config, const IgiImages& images,
     ctx.set_ray_generation_program(igi::kUpsampleEntry, upsample);
     ctx.set_ray_generation_program(igi::kComposeEntry, compose);
     ctx.set_ray_generation_program(igi::kIndirectSumEntry, indirect_sum);
+    ctx.set_ray_generation_program(igi::kVplMapEntry,
+                                   ctx.create_program(LUCENT_PROGRAM(igi::igi_vpl_maps)));
     ctx.set_miss_program(igi::kRadianceRay, ctx.create_program(LUCENT_PROGRAM(igi::igi_miss)));
 }
 
@@ -329,10 +341,14 @@ class IgiSample final : public Sample {
                       "max_depth", 4, 1, 16,
                       "deepest specular tree (mirrors; glass reflects and refracts)"),
                   SampleOption::integer(
-                      "imperfect_visibility", 0, 0, 2,
-                      "VPL shadow rays (IGI paper §4.1) against 0: the triangles; 1: the boxes "
-                      "of the scene BVH's leaves; 2: the paper's second graph of one box per "
-                      "triangle"),
+                      "imperfect_visibility", 0, 0, 3,
+                      "VPL visibility (IGI paper §4.1): shadow rays against 0: the triangles; "
+                      "1: the boxes of the scene BVH's leaves; 2: the paper's second graph of "
+                      "one box per triangle; or 3: a depth map per VPL, no shadow rays"),
+                  SampleOption::integer(
+                      "visibility_map", 64, 4, 1024,
+                      "imperfect_visibility=3: each VPL's depth map is this many texels "
+                      "square (one ray each)"),
                   SampleOption::integer(
                       "downsample", 1, 1, 16,
                       "N: indirect light at 1/N of the resolution, joint bilateral upsampling"),
@@ -368,7 +384,7 @@ class IgiSample final : public Sample {
         RenderResult out = result_for(ctx);
         CameraBuffer camera(ctx);
         // The G-buffer's ray type and entry points come after the sample's own.
-        AovPasses aovs(ctx, settings, igi::kVplShadowRay + 1, igi::kEntryCount, camera.buffer());
+        AovPasses aovs(ctx, settings, igi::kVplDepthRay + 1, igi::kEntryCount, camera.buffer());
         const IgiScene scene(ctx, settings, options, camera, &aovs);
         aovs.set_colour(scene.images.output);
         const sample_common::PinholeCamera pinhole =

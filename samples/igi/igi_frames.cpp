@@ -81,6 +81,10 @@ LaunchReport launch_frame(Context& ctx, const IgiConfig& config,
         ms[stage] += report.launch_ms;
     };
     run(0, igi::kVplEntry, config.paths, 1);
+    // The maps are part of the VPLs: made once per frame, as they are.
+    if (config.visibility_map > 0)
+        run(0, igi::kVplMapEntry, config.visibility_map, config.visibility_map,
+            config.paths * config.bounces);
     run(1, igi::kDirectEntry, config.width, config.height);
     run(2, igi::kIndirectEntry, config.low_width(), config.low_height(),
         config.layers * config.slices);

@@ -17,6 +17,7 @@ struct IgiConfig {
     unsigned interleave = 1;  // interleave x interleave VPL subsets
     unsigned layers = 1;      // G-buffer layers: 1, or 2 with the reflection layer
     unsigned slices = 1;      // each pixel's VPLs split over this many threads (indirect pass)
+    unsigned visibility_map = 0;  // > 0: each VPL's visibility map is this many texels square
 
     unsigned low_width() const { return (width + downsample - 1) / downsample; }
     unsigned low_height() const { return (height + downsample - 1) / downsample; }
@@ -52,7 +53,8 @@ inline constexpr std::array<const char*, 6> kIgiStageNames = {
     "VPL generation",       "direct + specular", "indirect",
     "discontinuity filter", "upsampling",        "composition"};
 
-/// Renders settings.repeat frames (at least one), each: VPL generation, direct + specular,
+/// Renders settings.repeat frames (at least one), each: VPL generation (and the VPLs'
+/// visibility maps when config.visibility_map > 0), direct + specular,
 /// indirect (and the sum of its slices), the discontinuity filter (interleave > 1), upsampling (downsample > 1),
 /// composition. Appends to result.stages: compile + accel, megakernel JIT (when it ran),
 /// each stage (the median over the frames after the first when there are several, with its

@@ -23,7 +23,13 @@ namespace igi {
 /// The module of this sample's programs (lucent/device/module.h).
 LUCENT_MODULE(igi, lucent::kUsesOccluded)
 
-enum : unsigned { kRadianceRay = 0, kShadowRay = 1, kParticleRay = 2, kVplShadowRay = 3 };
+enum : unsigned {
+    kRadianceRay = 0,
+    kShadowRay = 1,
+    kParticleRay = 2,
+    kVplShadowRay = 3,
+    kVplDepthRay = 4,  // from a VPL to the first surface: its visibility map's texels
+};
 
 /// The passes of a frame, one entry point each (IGI paper, Fig. 3).
 enum : unsigned {
@@ -34,7 +40,8 @@ enum : unsigned {
     kUpsampleEntry = 4,       // joint bilateral upsampling, Eq. (2) (IGI paper §4.2)
     kComposeEntry = 5,        // direct + rho / pi x indirect irradiance
     kIndirectSumEntry = 6,    // adds up the indirect pass's VPL slices
-    kEntryCount = 7
+    kVplMapEntry = 7,         // imperfect visibility by maps: each VPL's depth map
+    kEntryCount = 8
 };
 
 /// A light the particles start from and the direct stage samples. Isotropic when `normal`
@@ -104,6 +111,10 @@ struct RadiancePayload {
 struct ShadowPayload {
     float visible;
 };
+/// The depth ray's payload: the distance to the first surface (a large number on a miss).
+struct DepthPayload {
+    float distance;
+};
 struct ParticlePayload {
     bool hit;
     float3 position, normal, albedo;
@@ -165,8 +176,9 @@ struct IndirectParams {
     float min_d;  // Eq. (1)'s bounding distance
     float scene_size;  // of its bounds: sample_common::offset_ray_origin
     lucent::Handle top_object;
-    unsigned imperfect_visibility;  // kExactVisibility, kLeafBoxVisibility or kBoxGraphVisibility
+    unsigned imperfect_visibility;  // kExactVisibility ... kVisibilityMapVisibility
     lucent::Handle vpl_shadow_object;
+    lucent::BufferView<const float> vpl_maps;  // size x size x VPLs (kVisibilityMapVisibility)
 };
 
 struct SurfaceRecord {
@@ -181,10 +193,11 @@ struct SurfaceRecord {
     lucent::Handle top_object;
     unsigned imperfect_visibility;
     lucent::Handle vpl_shadow_object;
+    lucent::BufferView<const float> vpl_maps;
     unsigned reflection_layer;  // 1: the first reflected hit is G-buffer layer 1
 };
 LUCENT_RECORD(SurfaceRecord, Kd, Ks, Ke, diffuse_map, ior, lights, vpls, min_d, max_depth, scene_size, top_object,
-              imperfect_visibility, vpl_shadow_object, reflection_layer)
+              imperfect_visibility, vpl_shadow_object, vpl_maps, reflection_layer)
 
 // The passes below run over launch_index().z, the G-buffer layer; their images have as many.
 // The indirect pass alone splits each layer's VPLs into `slices` (its z is layer x slices +
@@ -200,10 +213,20 @@ struct IndirectRecord {
     lucent::Handle top_object;
     unsigned imperfect_visibility;
     lucent::Handle vpl_shadow_object;
+    lucent::BufferView<const float> vpl_maps;
 };
 LUCENT_RECORD(IndirectRecord, gbuffer_position, gbuffer_normal, indirect, vpls, downsample,
               interleave, slices, min_d, scene_size, top_object, imperfect_visibility,
-              vpl_shadow_object)
+              vpl_shadow_object, vpl_maps)
+
+/// The visibility maps of imperfect visibility by maps: for each VPL, the distance from it
+/// to the first surface in each texel's direction of its hemisphere (vpl_map_direction).
+struct VplMapRecord {
+    lucent::BufferView<const Vpl> vpls;
+    lucent::BufferView<float> vpl_maps;  // size x size x VPLs
+    lucent::Handle top_object;
+};
+LUCENT_RECORD(VplMapRecord, vpls, vpl_maps, top_object)
 
 struct IndirectSumRecord {
     lucent::BufferView<const float4> indirect_slices;  // layers x slices deep
@@ -260,7 +283,8 @@ LUCENT_HD inline IndirectParams indirect_params(const Record& rec) {
                           rec.scene_size,
                           rec.top_object,
                           rec.imperfect_visibility,
-                          rec.vpl_shadow_object};
+                          rec.vpl_shadow_object,
+                          rec.vpl_maps};
 }
 
 /// Nothing opaque between `from` and just short of `to`, both off their surfaces
@@ -276,17 +300,97 @@ enum : unsigned {
     kExactVisibility = 0,  // the triangles
     kLeafBoxVisibility = 1,  // the boxes of the scene BVH's leaves (Occlusion::kLeafBoxes)
     kBoxGraphVisibility = 2,  // the paper's form: a second graph of one box per triangle
+    kVisibilityMapVisibility = 3,  // a depth map per VPL (Ritschel et al. 2008), no shadow rays
 };
 
-/// V(x, yk) of Eq. (1): against the scene, or, with imperfect visibility (IGI paper §4.1),
-/// against boxes: the scene's own BVH leaf boxes, or the paper's second graph of the
-/// triangles' bounding boxes (a different root and ray type).
-LUCENT_HD inline bool vpl_visible(const IndirectParams& p, float3 from, float3 to) {
+// ---- visibility maps ---------------------------------------------------------------------
+// The crude scene representation of the IGI paper's reference [3], imperfect shadow maps
+// (Ritschel et al. 2008): each VPL keeps a small depth map of its hemisphere, and V(x, yk)
+// is a lookup instead of a shadow ray. Ritschel et al. splat a point sample of the scene into
+// each map; here each texel is one ray traced from the VPL (kVplEntry's maps pass), so a map
+// is exact at its texels and only its resolution is imperfect. The hemisphere is stored as a
+// paraboloid map (Heidrich and Seidel 1998; Brabec et al. 2002), the projection ISMs use too:
+// a direction w with w.z >= 0 in the VPL's frame lands at (w.x, w.y) / (1 + w.z) in the unit
+// disc, and the texel's angle is (1 + w.z) times its width in the disc.
+
+/// An orthonormal frame around the unit normal n (Duff et al. 2017, "Building an
+/// orthonormal basis, revisited"): continuous everywhere but at n.z = -0 vs +0.
+struct VplFrame {
+    float3 t, b, n;
+};
+LUCENT_HD inline VplFrame vpl_frame(float3 n) {
+    const float sign = n.z >= 0.0f ? 1.0f : -1.0f;
+    const float a = -1.0f / (sign + n.z), c = n.x * n.y * a;
+    return VplFrame{make_float3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x),
+                    make_float3(c, sign + n.y * n.y * a, -n.y), n};
+}
+
+/// The world direction of texel (i, j) of a size x size map around frame f. Texels outside
+/// the unit disc (its corners; bilinear lookups at the rim read them) take the direction of
+/// the rim: along the VPL's surface.
+LUCENT_HD inline float3 vpl_map_direction(const VplFrame& f, unsigned i, unsigned j,
+                                          unsigned size) {
+    float u = 2.0f * (float(i) + 0.5f) / float(size) - 1.0f;
+    float v = 2.0f * (float(j) + 0.5f) / float(size) - 1.0f;
+    const float r2 = u * u + v * v;
+    if (r2 > 1.0f) {
+        const float inv = 1.0f / sqrtf(r2);
+        u *= inv;
+        v *= inv;
+    }
+    const float q = u * u + v * v, k = 1.0f / (1.0f + q);
+    return f.t * (2.0f * u * k) + f.b * (2.0f * v * k) + f.n * ((1.0f - q) * k);
+}
+
+/// V(x, yk) from VPL k's map, in [0, 1]: the four texels nearest the direction from the VPL
+/// to x, each 1 where its depth reaches x, weighted bilinearly (percentage-closer filtering,
+/// Reeves et al. 1987). x is at distance d from the VPL and sees it at cosine cos_x. A texel
+/// whose ray meets x's own surface a little nearer than x (its direction is up to a texel
+/// off) must not shadow x: the tolerance is that texel's footprint on the surface, one and a
+/// half texel angles times d times tan of x's angle, plus the thousandth of the way that the
+/// shadow ray leaves out too (sample_common::kSegmentStart).
+LUCENT_HD inline float map_visibility(const IndirectParams& p, unsigned k, const Vpl& vpl,
+                                      float3 x, float d, float cos_x) {
+    const unsigned size = p.vpl_maps.size.x;
+    const VplFrame f = vpl_frame(vpl.normal);
+    const float3 w = (x - vpl.position) * (1.0f / d);
+    const float wz = lc_max(0.0f, dot(w, f.n)), s = 1.0f / (1.0f + wz);
+    const float u = dot(w, f.t) * s, v = dot(w, f.b) * s;
+    const float fx = (u + 1.0f) * 0.5f * float(size) - 0.5f;
+    const float fy = (v + 1.0f) * 0.5f * float(size) - 0.5f;
+    const float x0 = floorf(fx), y0 = floorf(fy), ax = fx - x0, ay = fy - y0;
+    const float texel_angle = 2.0f * (1.0f + wz) / float(size);
+    const float tan_x = lc_min(8.0f, sqrtf(lc_max(0.0f, 1.0f - cos_x * cos_x)) / cos_x);
+    const float reach = d * (1.0f - sample_common::kSegmentStart - 1.5f * texel_angle * tan_x);
+    const int last = int(size) - 1;
+    float visibility = 0.0f;
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            const int tx = lc_min(last, lc_max(0, int(x0) + i));
+            const int ty = lc_min(last, lc_max(0, int(y0) + j));
+            const float weight = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
+            if (p.vpl_maps[make_uint3(unsigned(tx), unsigned(ty), k)] >= reach)
+                visibility += weight;
+        }
+    return visibility;
+}
+
+/// V(x, yk) of Eq. (1), in [0, 1]: against the scene, or, with imperfect visibility (IGI
+/// paper §4.1), against boxes (the scene's own BVH leaf boxes, or the paper's second graph
+/// of the triangles' bounding boxes: a different root and ray type) or from VPL k's
+/// visibility map. x is at distance d from the VPL, at cosine cos_x.
+LUCENT_HD inline float vpl_visibility(const IndirectParams& p, unsigned k, const Vpl& vpl,
+                                      float3 x, float d, float cos_x) {
+    if (p.imperfect_visibility == kVisibilityMapVisibility)
+        return map_visibility(p, k, vpl, x, d, cos_x);
+    bool seen;
     if (p.imperfect_visibility == kLeafBoxVisibility)
-        return visible(p.top_object, kShadowRay, from, to, lucent::Occlusion::kLeafBoxes);
-    if (p.imperfect_visibility == kBoxGraphVisibility)
-        return visible(p.vpl_shadow_object, kVplShadowRay, from, to);
-    return visible(p.top_object, kShadowRay, from, to);
+        seen = visible(p.top_object, kShadowRay, x, vpl.position, lucent::Occlusion::kLeafBoxes);
+    else if (p.imperfect_visibility == kBoxGraphVisibility)
+        seen = visible(p.vpl_shadow_object, kVplShadowRay, x, vpl.position);
+    else
+        seen = visible(p.top_object, kShadowRay, x, vpl.position);
+    return seen ? 1.0f : 0.0f;
 }
 
 /// Eq. (1) at x with normal n over the VPLs first, first + stride, ...: the sum of
@@ -303,7 +407,9 @@ LUCENT_HD inline float3 indirect(const IndirectParams& p, float3 x, float3 n, un
         const float cos_x = dot(n, to) / d, cos_y = -dot(vpl.normal, to) / d;
         if (cos_x <= 0.0f || cos_y <= 0.0f) continue;
         const float g = cos_x * cos_y / d2 * smoothing(0.8f * p.min_d, 1.2f * p.min_d, d);
-        if (g > 0.0f && vpl_visible(p, x, vpl.position)) sum += vpl.radiance * g;
+        if (g <= 0.0f) continue;
+        const float v = vpl_visibility(p, k, vpl, x, d, cos_x);
+        if (v > 0.0f) sum += vpl.radiance * (g * v);
     }
     return sum;
 }
@@ -414,6 +520,26 @@ LUCENT_HD inline float3 dielectric(const SurfaceRecord& rec, int depth, float3 x
                  inline_branch(rec, depth, sample_common::offset_ray_origin(x, -n, rec.scene_size),
                                t);
     return color;
+}
+
+// ---- visibility maps: one depth ray per texel of each VPL's map -----------------------------
+// Launched over size x size x VPLs after VPL generation, with imperfect_visibility=3.
+LUCENT_RAY_GENERATION(igi_vpl_maps, igi::VplMapRecord) {
+    const uint3 i = lucent::launch_index(), n = lucent::launch_size();
+    const igi::Vpl vpl = rec.vpls[i.z];
+    igi::DepthPayload depth{0.0f};  // an unused VPL's map is never read
+    if (max_component(vpl.radiance) > 0.0f) {
+        depth.distance = 3.0e38f;  // a miss: nothing in the way at any distance
+        const float3 w = igi::vpl_map_direction(igi::vpl_frame(vpl.normal), i.x, i.y, n.x);
+        lucent::trace(rec.top_object, lucent::make_ray(vpl.position, w, igi::kVplDepthRay, 0.0f),
+                      depth);
+    }
+    rec.vpl_maps[i] = depth.distance;
+}
+
+// Every surface stops a depth ray, as every triangle blocks a shadow ray (occluded()).
+LUCENT_CLOSEST_HIT(igi_depth_hit, lucent::NoRecord, igi::DepthPayload, igi::HitAttributes) {
+    prd.distance = lucent::t_hit();
 }
 
 // ---- the direct stage: direct light, the specular tree, the G-buffer -----------------------
