@@ -11,6 +11,7 @@
 #include "samples/sample.h"
 #include "samples/igi/igi_frames.h"
 #include "samples/igi/igi_programs.h"
+#include "samples/settings_error.h"
 #include "scene/scene.h"
 #include "tests/reference_tracer.h"
 #include "tests/test_support.h"
@@ -296,6 +297,18 @@ TEST(Igi, BadOptionValuesNameTheRange) {
     } catch (const std::exception& e) {
         EXPECT_NE(std::string(e.what()).find("downsample=0"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("[1, 16]"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Igi, VisibilityMapsTooLargeForMemoryAreAClearError) {
+    // 4096 VPLs x 1024^2 texels would be 16 GiB of maps: refused before anything is made.
+    try {
+        render({{"imperfect_visibility", "3"}, {"visibility_map", "1024"}, {"vpls", "4096"}}, 8);
+        ADD_FAILURE() << "no error";
+    } catch (const lucent::samples::SettingsError& e) {
+        EXPECT_NE(std::string(e.what()).find("visibility_map=1024"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("16384 MiB"), std::string::npos) << e.what();
     }
 }
 

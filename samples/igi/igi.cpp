@@ -96,6 +96,22 @@ std::shared_ptr<Buffer> triangle_boxes(Context& ctx, const scene::Mesh& mesh) {
     return buffer;
 }
 
+/// The most texels the VPLs' visibility maps may take together (4 bytes each: 1 GiB).
+constexpr unsigned long long kMaxMapTexels = 1ull << 28;
+
+/// Each VPL's visibility map is a buffer of its own texels: refuses what would not fit.
+void check_map_memory(const IgiConfig& config) {
+    const unsigned long long side = config.visibility_map;
+    const unsigned long long texels = side * side * config.paths * config.bounces;
+    if (texels > kMaxMapTexels)
+        throw SettingsError("--set visibility_map=" + std::to_string(side) + ": " +
+                            std::to_string(config.paths * config.bounces) + " VPLs' maps of " +
+                            std::to_string(side) + "x" + std::to_string(side) + " texels need " +
+                            std::to_string(texels * 4 >> 20) +
+                            " MiB, over the 1024 MiB allowed; use a smaller visibility_map, "
+                            "or fewer vpls or bounces");
+}
+
 /// The sample's --set options, checked: the frame's configuration and the variables.
 struct IgiOptions {
     IgiConfig config;
@@ -115,8 +131,10 @@ struct IgiOptions {
         config.downsample = unsigned(v.integer("downsample"));
         config.interleave = unsigned(v.integer("interleave"));
         config.layers = v.on("reflection_layer") ? 2u : 1u;
-        if (imperfect == igi::kVisibilityMapVisibility)
+        if (imperfect == igi::kVisibilityMapVisibility) {
             config.visibility_map = unsigned(v.integer("visibility_map"));
+            check_map_memory(config);
+        }
         config.width = settings.width;
         config.height = settings.height;
         const int slices = v.integer("vpl_slices");
