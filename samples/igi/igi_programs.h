@@ -353,15 +353,16 @@ LUCENT_HD inline float map_visibility(const IndirectParams& p, unsigned k, const
                                       float3 x, float d, float cos_x) {
     const unsigned size = p.vpl_maps.size.x;
     const VplFrame f = vpl_frame(vpl.normal);
-    const float3 w = (x - vpl.position) * (1.0f / d);
-    const float wz = lc_max(0.0f, dot(w, f.n)), s = 1.0f / (1.0f + wz);
-    const float u = dot(w, f.t) * s, v = dot(w, f.b) * s;
-    const float fx = (u + 1.0f) * 0.5f * float(size) - 0.5f;
-    const float fy = (v + 1.0f) * 0.5f * float(size) - 0.5f;
+    // The paraboloid coordinates of w = v / d are (v.t, v.b) / (d + v.n): one division.
+    const float3 v = x - vpl.position;
+    const float vz = lc_max(0.0f, dot(v, f.n)), s = 1.0f / (d + vz);
+    const float fx = (dot(v, f.t) * s + 1.0f) * 0.5f * float(size) - 0.5f;
+    const float fy = (dot(v, f.b) * s + 1.0f) * 0.5f * float(size) - 0.5f;
     const float x0 = floorf(fx), y0 = floorf(fy), ax = fx - x0, ay = fy - y0;
-    const float texel_angle = 2.0f * (1.0f + wz) / float(size);
+    // d times the texel's angle, 2 (1 + w.z) / size, is 2 (d + v.n) / size.
     const float tan_x = lc_min(8.0f, sqrtf(lc_max(0.0f, 1.0f - cos_x * cos_x)) / cos_x);
-    const float reach = d * (1.0f - sample_common::kSegmentStart - 1.5f * texel_angle * tan_x);
+    const float reach = d * (1.0f - sample_common::kSegmentStart) -
+                        1.5f * (2.0f * (d + vz) / float(size)) * tan_x;
     const int last = int(size) - 1;
     float visibility = 0.0f;
     for (int j = 0; j < 2; ++j)
