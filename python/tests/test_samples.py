@@ -26,6 +26,7 @@ CASES = [
     ("direct", (48, 48), 0, {}),
     ("igi", (64, 64), 0, {"vpls": 16}),
     ("igi", (64, 64), 0, {"vpls": 16, "downsample": 2, "interleave": 3, "imperfect_visibility": True}),
+    ("igi", (64, 64), 0, {"vpls": 16, "imperfect_visibility": 3, "visibility_map": 32}),
     ("radiosity", (48, 48), 0, {}),
     ("pathtracer", (32, 32), 4, {}),
     ("hair", (48, 27), 2, {"strands": 500, "curve_type": "catmull-rom", "light_linking": False}),
