@@ -307,7 +307,7 @@ enum : unsigned {
 // The crude scene representation of the IGI paper's reference [3], imperfect shadow maps
 // (Ritschel et al. 2008): each VPL keeps a small depth map of its hemisphere, and V(x, yk)
 // is a lookup instead of a shadow ray. Ritschel et al. splat a point sample of the scene into
-// each map; here each texel is one ray traced from the VPL (kVplEntry's maps pass), so a map
+// each map; here each texel is one ray traced from the VPL (the kVplMapEntry pass), so a map
 // is exact at its texels and only its resolution is imperfect. The hemisphere is stored as a
 // paraboloid map (Heidrich and Seidel 1998; Brabec et al. 2002), the projection ISMs use too:
 // a direction w with w.z >= 0 in the VPL's frame lands at (w.x, w.y) / (1 + w.z) in the unit
