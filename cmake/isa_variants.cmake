@@ -1,6 +1,7 @@
-# Run-time dispatch of the CPU triangle traversal. src/accel/triangle_traverse.cpp is the
-# only hot loop that gains much from instruction sets beyond the portable baseline, so it
-# is compiled once per variant below, each copy's entry points in namespace
+# Run-time dispatch of the CPU triangle traversal. src/accel/triangle_traverse.cpp (single
+# rays) and src/accel/triangle_stream.cpp (ray streams) are the only hot loops that gain
+# much from instruction sets beyond the portable baseline, so they are compiled once per
+# variant below, each copy's entry points in namespace
 # lucent::accel::isa_<variant> (LUCENT_ISA_VARIANT), and src/accel/cpu_isa.cpp picks the
 # best one the CPU runs at the first query (LUCENT_CPU_ISA=scalar|avx2|avx512 overrides it).
 #
@@ -23,8 +24,9 @@
 # the instruction set), and each copy defines no external symbol but its entry points:
 # the test accel_isa_symbols checks that with nm.
 
-set(LUCENT_TRAVERSE_SOURCE ${CMAKE_CURRENT_SOURCE_DIR}/src/accel/triangle_traverse.cpp)
-list(REMOVE_ITEM LUCENT_CORE_SOURCES ${LUCENT_TRAVERSE_SOURCE})
+set(LUCENT_TRAVERSE_SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/src/accel/triangle_traverse.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/accel/triangle_stream.cpp)
+list(REMOVE_ITEM LUCENT_CORE_SOURCES ${LUCENT_TRAVERSE_SOURCES})
 
 set(LUCENT_ISA_VARIANTS scalar)
 set(LUCENT_ISA_OPTIONS_scalar "")
@@ -38,7 +40,7 @@ if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
 endif()
 
 foreach(isa ${LUCENT_ISA_VARIANTS})
-  add_library(lucent_isa_${isa} OBJECT ${LUCENT_TRAVERSE_SOURCE})
+  add_library(lucent_isa_${isa} OBJECT ${LUCENT_TRAVERSE_SOURCES})
   # As the library's own sources are compiled, then the variant's flags (a later -march
   # wins over LUCENT_NATIVE's -march=native or the baseline's).
   target_include_directories(lucent_isa_${isa} PRIVATE

@@ -20,6 +20,7 @@
 
 #include "accel/bvh.h"
 #include "accel/cpu_isa.h"
+#include "accel/ray_stream.h"
 #include "accel/triangle_accel.h"
 #include "accel/triangle_traverse.h"
 #include "lucent/device/triangle_intersect.h"
@@ -416,6 +417,102 @@ TEST(TriangleAccel, LeavesOfFiveToEightTrianglesEqualBruteForce) {
         EXPECT_EQ(accel.occluded(r.o, r.d, r.tmin, r.tmax),
                   brute_force(m, r.o, r.d, r.tmin, r.tmax).hit);
     }
+}
+
+// ---- ray streams (ray_stream.h) ---------------------------------------------------------
+
+/// The stream queries' answers for `rays` against the single-ray queries': the same
+/// triangles found at the same t (a tie may name the other triangle, which must then be hit
+/// at that t), the same barycentrics for the same triangle, the same occlusion.
+void expect_streams_equal_single_rays(const Mesh& m, const TriangleAccel& accel,
+                                      const std::vector<TestRay>& rays,
+                                      RayStreamWorkspace& workspace) {
+    std::vector<StreamRay> stream;
+    for (const TestRay& r : rays) stream.push_back(StreamRay{r.o, r.tmin, r.d, r.tmax});
+    std::vector<StreamHit> hits(rays.size());
+    std::vector<uint8_t> blocked(rays.size(), 7);
+    accel.intersect_stream(stream, hits, workspace);
+    accel.occluded_stream(stream, blocked, workspace);
+    size_t found = 0, occluded = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const TestRay& r = rays[i];
+        TriangleHit hit;
+        const bool single = accel.intersect(r.o, r.d, r.tmin, r.tmax, hit);
+        ASSERT_EQ(hits[i].prim != kStreamMiss, single) << "ray " << i;
+        EXPECT_EQ(blocked[i], accel.occluded(r.o, r.d, r.tmin, r.tmax) ? 1 : 0) << "ray " << i;
+        occluded += blocked[i];
+        if (!single) continue;
+        ++found;
+        EXPECT_EQ(hits[i].t, hit.t) << "ray " << i;
+        EXPECT_EQ(triangle_t(m, hits[i].prim, r.o, r.d), hits[i].t) << "ray " << i;
+        if (hits[i].prim == hit.prim) {
+            EXPECT_EQ(hits[i].u, hit.u) << "ray " << i;
+            EXPECT_EQ(hits[i].v, hit.v) << "ray " << i;
+        }
+    }
+    // Both kinds of answer occur, so neither comparison is vacuous.
+    EXPECT_GT(found, rays.size() / 10);
+    EXPECT_LT(found, rays.size());
+    EXPECT_GT(occluded, 0u);
+}
+
+TEST(TriangleAccel, StreamQueriesEqualSingleRayQueries) {
+    RayStreamWorkspace workspace;  // one for all meshes: it grows with the deepest tree
+    for (uint32_t seed : {21u, 22u}) {
+        Mesh m = random_soup(seed, 3000);
+        TriangleAccel accel;
+        accel.build(m.positions, m.indices);
+        expect_streams_equal_single_rays(m, accel, random_rays(seed * 5, 5000), workspace);
+        // A few rays, fewer than a vector's sixteen lanes, and a stream of one.
+        expect_streams_equal_single_rays(m, accel, random_rays(seed * 3, 13), workspace);
+    }
+}
+
+TEST(TriangleAccel, StreamQueriesCrossBatchesAndLargeLeaves) {
+    // More rays than one batch takes, through a tree with leaves of 5 to 8 triangles.
+    Mesh m = random_soup(41, 20000);
+    TriangleAccel accel;
+    BuildStats stats;
+    accel.build(m.positions, m.indices, {}, &stats);
+    EXPECT_GT(stats.large_leaf_count, 0u);
+    RayStreamWorkspace workspace;
+    expect_streams_equal_single_rays(m, accel, random_rays(43, int(kStreamBatch) + 1500),
+                                     workspace);
+}
+
+TEST(TriangleAccel, StreamQueriesOnAnEmptyAccelMissEverything) {
+    TriangleAccel accel;
+    accel.build({}, {});
+    RayStreamWorkspace workspace;
+    const std::vector<StreamRay> rays(40, StreamRay{make_float3(0, 0, 0), 0.0f,
+                                                    make_float3(0, 0, 1), kInfinity});
+    std::vector<StreamHit> hits(rays.size());
+    std::vector<uint8_t> blocked(rays.size(), 1);
+    accel.intersect_stream(rays, hits, workspace);
+    accel.occluded_stream(rays, blocked, workspace);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        EXPECT_EQ(hits[i].prim, kStreamMiss);
+        EXPECT_EQ(blocked[i], 0);
+    }
+}
+
+TEST(TriangleAccel, StreamQueriesNameMismatchedSpans) {
+    Mesh m = random_soup(3, 50);
+    TriangleAccel accel;
+    accel.build(m.positions, m.indices);
+    RayStreamWorkspace workspace;
+    const std::vector<StreamRay> rays(5, StreamRay{make_float3(0, 0, 0), 0.0f,
+                                                   make_float3(0, 0, 1), kInfinity});
+    std::vector<StreamHit> hits(4);
+    std::vector<uint8_t> blocked(6);
+    try {
+        accel.intersect_stream(rays, hits, workspace);
+        ADD_FAILURE() << "no error for 5 rays and 4 hits";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("5 rays but room for 4 hits"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW(accel.occluded_stream(rays, blocked, workspace), Error);
 }
 
 TEST(TriangleAccel, NonIndexedInputAndSmallMeshes) {

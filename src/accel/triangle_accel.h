@@ -8,6 +8,7 @@
 #include <span>
 
 #include "accel/bvh.h"
+#include "accel/ray_stream.h"
 
 namespace lucent::accel {
 
@@ -63,6 +64,15 @@ class TriangleAccel {
     /// leaving before tmax. A leaf box that holds either end does not count, or a surface
     /// would shadow itself. Triangles are never tested: inner nodes only.
     bool occluded_leaf_boxes(float3 origin, float3 direction, float tmin, float tmax) const;
+    /// Closest hits of many rays traced together as ray streams (ray_stream.h): hits[i] is
+    /// intersect()'s answer for rays[i] (only a tie between two triangles at the same t
+    /// may name the other one). For many incoherent rays at once, such as a wavefront of
+    /// diffuse bounces. Throws lucent::Error when the spans' sizes differ.
+    void intersect_stream(std::span<const StreamRay> rays, std::span<StreamHit> hits,
+                          RayStreamWorkspace& workspace) const;
+    /// occluded() for many rays at once: blocked[i] is 1 when rays[i] is blocked, else 0.
+    void occluded_stream(std::span<const StreamRay> rays, std::span<uint8_t> blocked,
+                         RayStreamWorkspace& workspace) const;
     /// The boxes of the tree's leaves (for tests of occluded_leaf_boxes).
     std::vector<Aabb> leaf_boxes() const;
 

@@ -745,11 +745,19 @@ bool intersect_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 
     return traverse<Query::kFiltered>(accel, origin, direction, tmin, tmax, &hit, thunk, filter);
 }
 
+// The stream queries (triangle_stream.cpp, the same variant).
+void intersect_stream(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                      StreamHit* hits, StreamBuffers& buffers);
+void occluded_stream(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                     uint8_t* blocked, StreamBuffers& buffers);
+
 extern const TraverseVariant kTraverse = {
     intersect,
     occluded,
     occluded_leaf_boxes,
     intersect_filtered,
+    intersect_stream,
+    occluded_stream,
 #if !LUCENT_ACCEL_SIMD
     "scalar",
 #elif defined(__AVX512VL__)

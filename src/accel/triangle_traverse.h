@@ -4,6 +4,7 @@
 // one the CPU runs (cpu_isa.h).
 #pragma once
 
+#include "accel/ray_stream.h"
 #include "accel/triangle_accel.h"
 
 namespace lucent::accel {
@@ -22,6 +23,11 @@ struct TraverseVariant {
     bool (*intersect_filtered)(const TriangleAccel::Impl& accel, float3 origin, float3 direction,
                                float tmin, float tmax, TriangleHit& hit, FilterThunk thunk,
                                void* filter);
+    /// A batch of at most kStreamBatch rays (triangle_stream.cpp), in buffers reserved for it.
+    void (*intersect_stream)(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                             StreamHit* hits, StreamBuffers& buffers);
+    void (*occluded_stream)(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                            uint8_t* blocked, StreamBuffers& buffers);
     /// The code paths the variant's flags compiled in: "scalar", "avx2 fma" or
     /// "avx2 fma avx512vl" (the tests check each variant got what its name promises).
     const char* paths;

@@ -6,11 +6,15 @@
 // at kResolve, whose functions pick the variant at the first query, store it and forward.
 // A function-local static instead put a guard check on every query, and around its
 // initializing call GCC saved and restored all the query's arguments each time.
+#include <algorithm>
 #include <atomic>
+#include <string>
 
 #include "accel/cpu_isa.h"
 #include "accel/triangle_accel.h"
 #include "accel/triangle_traverse.h"
+#include "accel/wide_bvh.h"
+#include "lucent/error.h"
 
 namespace lucent::accel {
 
@@ -44,8 +48,18 @@ bool resolve_filtered(const TriangleAccel::Impl& accel, float3 origin, float3 di
     return resolve().intersect_filtered(accel, origin, direction, tmin, tmax, hit, thunk, filter);
 }
 
-constexpr TraverseVariant kResolve = {resolve_intersect, resolve_occluded,
-                                      resolve_occluded_leaf_boxes, resolve_filtered, "unresolved"};
+void resolve_intersect_stream(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                              StreamHit* hits, StreamBuffers& buffers) {
+    resolve().intersect_stream(accel, rays, count, hits, buffers);
+}
+void resolve_occluded_stream(const TriangleAccel::Impl& accel, const StreamRay* rays, size_t count,
+                             uint8_t* blocked, StreamBuffers& buffers) {
+    resolve().occluded_stream(accel, rays, count, blocked, buffers);
+}
+constexpr TraverseVariant kResolve = {resolve_intersect,        resolve_occluded,
+                                      resolve_occluded_leaf_boxes, resolve_filtered,
+                                      resolve_intersect_stream, resolve_occluded_stream,
+                                      "unresolved"};
 
 const TraverseVariant& active() {
     return *g_active.load(std::memory_order_relaxed);
@@ -71,6 +85,34 @@ bool TriangleAccel::intersect_filtered_impl(float3 origin, float3 direction, flo
                                             TriangleHit& hit, FilterThunk thunk,
                                             void* filter) const {
     return active().intersect_filtered(*m_impl, origin, direction, tmin, tmax, hit, thunk, filter);
+}
+
+void TriangleAccel::intersect_stream(std::span<const StreamRay> rays, std::span<StreamHit> hits,
+                                     RayStreamWorkspace& workspace) const {
+    if (hits.size() != rays.size())
+        throw Error("TriangleAccel::intersect_stream: " + std::to_string(rays.size()) +
+                    " rays but room for " + std::to_string(hits.size()) +
+                    " hits; pass one StreamHit per ray");
+    for (size_t begin = 0; begin < rays.size(); begin += kStreamBatch) {
+        const size_t count = std::min(kStreamBatch, rays.size() - begin);
+        StreamBuffers& buffers = workspace.reserve(count, m_impl->wide_depth);
+        active().intersect_stream(*m_impl, rays.data() + begin, count, hits.data() + begin,
+                                  buffers);
+    }
+}
+
+void TriangleAccel::occluded_stream(std::span<const StreamRay> rays, std::span<uint8_t> blocked,
+                                    RayStreamWorkspace& workspace) const {
+    if (blocked.size() != rays.size())
+        throw Error("TriangleAccel::occluded_stream: " + std::to_string(rays.size()) +
+                    " rays but room for " + std::to_string(blocked.size()) +
+                    " answers; pass one byte per ray");
+    for (size_t begin = 0; begin < rays.size(); begin += kStreamBatch) {
+        const size_t count = std::min(kStreamBatch, rays.size() - begin);
+        StreamBuffers& buffers = workspace.reserve(count, m_impl->wide_depth);
+        active().occluded_stream(*m_impl, rays.data() + begin, count, blocked.data() + begin,
+                                 buffers);
+    }
 }
 
 }  // namespace lucent::accel
