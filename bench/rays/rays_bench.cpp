@@ -24,6 +24,7 @@
 #include "bench/rays/programs_bench.h"
 #include "bench/rays/ray_sets.h"
 #include "bench/rays/rays_bench.h"
+#include "bench/rays/stream_passes.h"
 #include "lucent/error.h"
 #include "scene/obj_mesh.h"
 #ifdef LUCENT_HAVE_CUDA
@@ -129,25 +130,25 @@ struct PairedRates {
     double ratio = 0;  // a's Mrays/s over b's
 };
 
-/// Times body_a(i) and body_b(i) over every ray: one untimed warm-up pass each, then
-/// `repeat` timed passes each, in the order A B, B A, A B, ... The machines this runs on
-/// slow down for seconds at a time (other tenants), so two engines timed one after the
-/// other can see different machines; alternating passes lets both see the same one, and
-/// each ratio compares two neighbouring passes. Without a peer (with_b false) only A runs.
-template <class BodyA, class BodyB>
-PairedRates timed_pair(size_t count, unsigned threads, int repeat, BodyA&& body_a, BodyB&& body_b,
-                       bool with_b) {
+/// Times two engines' passes over the same `count` rays, each pass given as a callable
+/// returning its seconds: one untimed warm-up pass each, then `repeat` timed passes each, in
+/// the order A B, B A, A B, ... The machines this runs on slow down for seconds at a time
+/// (other tenants), so two engines timed one after the other can see different machines;
+/// alternating passes lets both see the same one, and each ratio compares two neighbouring
+/// passes. Without a peer (with_b false) only A runs.
+template <class PassA, class PassB>
+PairedRates timed_pair(size_t count, int repeat, PassA&& pass_a, PassB&& pass_b, bool with_b) {
     std::vector<double> mrays_a, mrays_b, ratios;
-    timed_pass(count, threads, body_a);
-    if (with_b) timed_pass(count, threads, body_b);
+    pass_a();
+    if (with_b) pass_b();
     for (int run = 0; run < repeat; ++run) {
         double seconds_a = 0, seconds_b = 0;
         if (run % 2 == 0 || !with_b) {
-            seconds_a = timed_pass(count, threads, body_a);
-            if (with_b) seconds_b = timed_pass(count, threads, body_b);
+            seconds_a = pass_a();
+            if (with_b) seconds_b = pass_b();
         } else {
-            seconds_b = timed_pass(count, threads, body_b);
-            seconds_a = timed_pass(count, threads, body_a);
+            seconds_b = pass_b();
+            seconds_a = pass_a();
         }
         mrays_a.push_back(count / seconds_a * 1e-6);
         if (with_b) {
@@ -158,60 +159,114 @@ PairedRates timed_pair(size_t count, unsigned threads, int repeat, BodyA&& body_
     return PairedRates{rate_of(mrays_a), rate_of(mrays_b), median_of(ratios)};
 }
 
+/// timed_pair for two engines' per-ray bodies: body(i) traces ray i (timed_pass).
+template <class BodyA, class BodyB>
+PairedRates timed_pair_of_bodies(size_t count, unsigned threads, int repeat, const BodyA& body_a,
+                                 const BodyB& body_b, bool with_b) {
+    return timed_pair(
+        count, repeat, [&] { return timed_pass(count, threads, body_a); },
+        [&] { return timed_pass(count, threads, body_b); }, with_b);
+}
+
 /// One engine's figures and checksums for the three ray kinds.
 struct EngineResult : RayChecksums {
     Rate primary, shadow, diffuse;
 };
 
-/// Lucent's figures, the peer's, and Lucent's rate over the peer's per ray kind.
+/// Lucent's figures, the peer's, and Lucent's rate over the peer's per ray kind; with
+/// streams, the figures of Lucent's stream queries and their rate over the peer's.
 struct BenchResult {
     EngineResult lucent, peer;
     double primary_ratio = 0, shadow_ratio = 0, diffuse_ratio = 0;
+    bool with_streams = false;
+    EngineResult streams;
+    double stream_primary_ratio = 0, stream_shadow_ratio = 0, stream_diffuse_ratio = 0;
 };
 
 /// Traces the three ray sets with Lucent and, when `with_peer`, with the peer, each engine
 /// given as closest(o, d, tmax, t&, prim&) and any(o, d, tmax). Both trace the shadow and
 /// diffuse rays that start at Lucent's primary hits, so their checksums compare line by
-/// line.
+/// line. With `streams`, each set is traced again by Lucent's stream queries, paired with
+/// the peer's passes of its own.
 template <class LucentClosest, class LucentAny, class PeerClosest, class PeerAny>
 BenchResult run_engines(const RaySet& primary, const scene::ObjMesh& mesh, float3 light,
                         unsigned threads, int repeat, LucentClosest&& lucent_closest,
                         LucentAny&& lucent_any, PeerClosest&& peer_closest, PeerAny&& peer_any,
-                        bool with_peer) {
+                        bool with_peer, StreamPasses* streams = nullptr) {
     BenchResult res;
+    res.with_streams = streams != nullptr;
     auto sum_hits = [](const Hits& hits, size_t& count, double& sum_t) {
         for (float t : hits.t)
             if (t >= 0.0f) ++count, sum_t += t;
     };
+    auto sum_stream_hits = [](const std::vector<accel::StreamHit>& hits, size_t& count,
+                              double& sum_t) {
+        for (const accel::StreamHit& h : hits)
+            if (h.prim != accel::kStreamMiss) ++count, sum_t += h.t;
+    };
+    // The stream engine against the peer on one closest-hit set; the peer's answers are
+    // already checked against the kernels', so they are not kept.
+    auto stream_closest_pair = [&](const RaySet& rays, std::vector<accel::StreamHit>& hits) {
+        const std::vector<accel::StreamRay> stream = stream_rays(rays);
+        Hits peer_hits = hits_for(rays);
+        const auto peer_body = closest_body(peer_closest, rays, peer_hits);
+        return timed_pair(
+            rays.size(), repeat, [&] { return streams->closest(stream, hits); },
+            [&] { return timed_pass(rays.size(), threads, peer_body); }, with_peer);
+    };
 
     Hits lucent_hits = hits_for(primary), peer_hits = hits_for(primary);
-    PairedRates p = timed_pair(primary.size(), threads, repeat,
-                               closest_body(lucent_closest, primary, lucent_hits),
-                               closest_body(peer_closest, primary, peer_hits), with_peer);
+    PairedRates p = timed_pair_of_bodies(primary.size(), threads, repeat,
+                                         closest_body(lucent_closest, primary, lucent_hits),
+                                         closest_body(peer_closest, primary, peer_hits), with_peer);
     res.lucent.primary = p.a, res.peer.primary = p.b, res.primary_ratio = p.ratio;
     sum_hits(lucent_hits, res.lucent.primary_hits, res.lucent.primary_sum_t);
     sum_hits(peer_hits, res.peer.primary_hits, res.peer.primary_sum_t);
+    if (streams) {
+        std::vector<accel::StreamHit> hits(primary.size());
+        p = stream_closest_pair(primary, hits);
+        res.streams.primary = p.a, res.stream_primary_ratio = p.ratio;
+        sum_stream_hits(hits, res.streams.primary_hits, res.streams.primary_sum_t);
+    }
 
     RaySet shadow, diffuse;
     secondary_rays(primary, lucent_hits.t.data(), lucent_hits.prim.data(), mesh, light, shadow,
                    diffuse);
     ResultVector<unsigned char> lucent_blocked(shadow.size()), peer_blocked(shadow.size());
-    p = timed_pair(shadow.size(), threads, repeat,
-                   occlusion_body(lucent_any, shadow, lucent_blocked),
-                   occlusion_body(peer_any, shadow, peer_blocked), with_peer);
+    p = timed_pair_of_bodies(shadow.size(), threads, repeat,
+                             occlusion_body(lucent_any, shadow, lucent_blocked),
+                             occlusion_body(peer_any, shadow, peer_blocked), with_peer);
     res.lucent.shadow = p.a, res.peer.shadow = p.b, res.shadow_ratio = p.ratio;
     res.lucent.shadow_rays = res.peer.shadow_rays = shadow.size();
     for (unsigned char b : lucent_blocked) res.lucent.occluded += b;
     for (unsigned char b : peer_blocked) res.peer.occluded += b;
+    if (streams) {
+        const std::vector<accel::StreamRay> stream = stream_rays(shadow);
+        std::vector<uint8_t> blocked(shadow.size());
+        const auto peer_body = occlusion_body(peer_any, shadow, peer_blocked);
+        p = timed_pair(
+            shadow.size(), repeat, [&] { return streams->occluded(stream, blocked); },
+            [&] { return timed_pass(shadow.size(), threads, peer_body); }, with_peer);
+        res.streams.shadow = p.a, res.stream_shadow_ratio = p.ratio;
+        res.streams.shadow_rays = shadow.size();
+        for (uint8_t b : blocked) res.streams.occluded += b;
+    }
 
     Hits lucent_bounce = hits_for(diffuse), peer_bounce = hits_for(diffuse);
-    p = timed_pair(diffuse.size(), threads, repeat,
-                   closest_body(lucent_closest, diffuse, lucent_bounce),
-                   closest_body(peer_closest, diffuse, peer_bounce), with_peer);
+    p = timed_pair_of_bodies(diffuse.size(), threads, repeat,
+                             closest_body(lucent_closest, diffuse, lucent_bounce),
+                             closest_body(peer_closest, diffuse, peer_bounce), with_peer);
     res.lucent.diffuse = p.a, res.peer.diffuse = p.b, res.diffuse_ratio = p.ratio;
     res.lucent.diffuse_rays = res.peer.diffuse_rays = diffuse.size();
     sum_hits(lucent_bounce, res.lucent.diffuse_hits, res.lucent.diffuse_sum_t);
     sum_hits(peer_bounce, res.peer.diffuse_hits, res.peer.diffuse_sum_t);
+    if (streams) {
+        std::vector<accel::StreamHit> hits(diffuse.size());
+        p = stream_closest_pair(diffuse, hits);
+        res.streams.diffuse = p.a, res.stream_diffuse_ratio = p.ratio;
+        res.streams.diffuse_rays = diffuse.size();
+        sum_stream_hits(hits, res.streams.diffuse_hits, res.streams.diffuse_sum_t);
+    }
     return res;
 }
 
@@ -262,6 +317,7 @@ struct RaysResult {
     bool peer = false;  // the peer ran
     double embree_build_ms = 0;
     std::string differences;  // of the checksums, lucent against embree ("" when they agree)
+    std::string stream_differences;  // the stream queries' checksums against the kernels'
     // --programs: the ray sets through rays_programs.h, and its checksums against the kernels'.
     bool programs = false;
     ProgramsResult program_figures;
@@ -354,10 +410,37 @@ Json to_json(const RaysResult& r) {
                           {"diffuse", rounded(r.engines.diffuse_ratio, 4)}};
         j["checksums_agree"] = r.differences.empty();
     }
+    if (r.engines.with_streams) {
+        Json streams = json_engine(r.engines.streams);
+        if (r.peer) {
+            streams["ratio_to_embree"] = Json{{"primary", rounded(r.engines.stream_primary_ratio, 4)},
+                                              {"shadow", rounded(r.engines.stream_shadow_ratio, 4)},
+                                              {"diffuse", rounded(r.engines.stream_diffuse_ratio, 4)}};
+        }
+        streams["checksums_agree_with_kernels"] = r.stream_differences.empty();
+        j["streams"] = streams;
+    }
     if (r.programs)
         j["programs"] = programs_json(r.program_figures, r.engines.lucent,
                                       r.peer ? &r.engines.peer : nullptr, r.program_differences);
     return j;
+}
+
+/// The stream queries' lines: figures, ratios to Embree, checksums against the kernels'.
+void print_streams(const RaysResult& r) {
+    if (!r.engines.with_streams) return;
+    std::printf("streams (TriangleAccel's stream queries, batches of up to %zu rays a thread)\n",
+                accel::kStreamBatch);
+    print_engine("streams ", r.engines.streams);
+    if (r.peer)
+        std::printf("ratio streams/embree primary %.2fx, shadow %.2fx, diffuse %.2fx\n",
+                    r.engines.stream_primary_ratio, r.engines.stream_shadow_ratio,
+                    r.engines.stream_diffuse_ratio);
+    if (r.stream_differences.empty())
+        std::printf("streams' checksums agree with the kernels\n");
+    else
+        std::printf("streams' checksums differ from the kernels: %s\n",
+                    r.stream_differences.c_str());
 }
 
 void print_text(const RaysResult& r) {
@@ -373,6 +456,7 @@ void print_text(const RaysResult& r) {
     print_engine("", r.engines.lucent);
     if (!r.peer) {
         if (o.peer) std::printf("embree: not built in, no peer figures\n");
+        print_streams(r);
         if (r.programs)
             print_programs(r.program_figures, r.engines.lucent, nullptr, r.program_differences);
         return;
@@ -387,6 +471,7 @@ void print_text(const RaysResult& r) {
         std::printf("checksums agree with embree\n");
     else
         std::printf("checksums differ from embree: %s\n", r.differences.c_str());
+    print_streams(r);
     if (r.programs)
         print_programs(r.program_figures, r.engines.lucent, &r.engines.peer, r.program_differences);
 }
@@ -493,6 +578,7 @@ int run_bench_rays(const RaysOptions& options) {
     result.embree_build_ms = peer ? embree_peer->build_ms() : 0.0;
 
     const RaySet primary = primary_rays(cam, options.width, options.height);
+    StreamPasses streams(accel, threads);
     result.engines = run_engines(
         primary, mesh, cam.light, threads, options.repeat, closest_query(accel),
         occluded_query(accel),
@@ -500,7 +586,9 @@ int run_bench_rays(const RaysOptions& options) {
             return embree_peer->intersect(o, d, 0.0f, tmax, t, prim);
         },
         [&](float3 o, float3 d, float tmax) { return embree_peer->occluded(o, d, 0.0f, tmax); },
-        peer);
+        peer, &streams);
+    result.stream_differences =
+        checksum_differences(result.engines.streams, result.engines.lucent, "streams", "kernels");
     result.cpu_isa = accel::cpu_isa_name(accel::active_cpu_isa());
     if (options.programs) {
         ProgramsInput in;

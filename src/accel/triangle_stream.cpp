@@ -60,29 +60,34 @@ constexpr float kFarScale = 1.0f + 0x1p-21f;
 constexpr int kRecordFloats = sizeof(StreamNodeRay) / sizeof(float);
 static_assert(kRecordFloats == 8 && sizeof(StreamLeafRay) == sizeof(StreamNodeRay));
 
-/// The batch's records: what the node test and the triangle test read of each ray.
+/// The batch's records: what the node test and the triangle test read of each ray. The
+/// divisions go three to an instruction, as in the single-ray test's set-up (the same
+/// correctly rounded quotients as one at a time): one at a time they were a sixth of a
+/// diffuse stream's time.
 void set_up_rays(const StreamRay* rays, uint32_t count, StreamBuffers& b) {
+    const __m128 one = _mm_set1_ps(1.0f);
+    const __m128 sign_bit = _mm_set1_ps(-0.0f);
     for (uint32_t i = 0; i < count; ++i) {
         const StreamRay& ray = rays[i];
+        const __m128 o = _mm_setr_ps(ray.origin.x, ray.origin.y, ray.origin.z, 0.0f);
+        const __m128 d = _mm_setr_ps(ray.direction.x, ray.direction.y, ray.direction.z, 1.0f);
+        const __m128 limit = _mm_min_ps(
+            _mm_set1_ps(kMaxInverse),
+            _mm_div_ps(_mm_set1_ps(kMaxOverInverse), _mm_max_ps(_mm_andnot_ps(sign_bit, o), one)));
+        const __m128 inverse =
+            _mm_max_ps(_mm_min_ps(_mm_div_ps(one, d), limit), _mm_xor_ps(limit, sign_bit));
+        float* node = reinterpret_cast<float*>(&b.node_rays[i]);
+        _mm_store_ps(node, _mm_insert_ps(o, _mm_set_ss(ray.tmax), 0x30));
+        _mm_store_ps(node + 4, _mm_insert_ps(inverse, _mm_set_ss(ray.tmin), 0x30));
+
+        const WatertightAxes a = watertight_axes(ray.direction);
         const float org[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
         const float dir[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-        float inverse[3];
-        for (int k = 0; k < 3; ++k) {
-            const float limit =
-                std::fmin(kMaxInverse, kMaxOverInverse / std::fmax(std::fabs(org[k]), 1.0f));
-            inverse[k] = std::fmax(std::fmin(1.0f / dir[k], limit), -limit);
-        }
-        b.node_rays[i] = StreamNodeRay{org[0],     org[1],     org[2],     ray.tmax,
-                                       inverse[0], inverse[1], inverse[2], ray.tmin};
-        const WatertightAxes a = watertight_axes(ray.direction);
-        b.leaf_rays[i] = StreamLeafRay{org[a.kx],
-                                       org[a.ky],
-                                       org[a.kz],
-                                       a.kx | a.ky << 2 | a.kz << 4,
-                                       dir[a.kx] / dir[a.kz],
-                                       dir[a.ky] / dir[a.kz],
-                                       1.0f / dir[a.kz],
-                                       0.0f};
+        alignas(16) float shear[4];
+        _mm_store_ps(shear, _mm_div_ps(_mm_setr_ps(dir[a.kx], dir[a.ky], 1.0f, 0.0f),
+                                       _mm_set1_ps(dir[a.kz])));
+        b.leaf_rays[i] = StreamLeafRay{org[a.kx], org[a.ky], org[a.kz], a.kx | a.ky << 2 | a.kz << 4,
+                                       shear[0],  shear[1],  shear[2],  0.0f};
         b.prim[i] = kStreamMiss;
     }
 }
