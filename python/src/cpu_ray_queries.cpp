@@ -37,7 +37,8 @@ CpuRayQueries::CpuRayQueries(const float* vertices, size_t vertex_count, const u
                  reinterpret_cast<const float3*>(vertices) + vertex_count),
       m_indices(reinterpret_cast<const uint3*>(indices),
                 reinterpret_cast<const uint3*>(indices) + triangle_count),
-      m_pool(threads) {}
+      m_pool(threads),
+      m_workers(m_pool.size()) {}
 
 void CpuRayQueries::update(const float* vertices, bool rebuild) {
     std::memcpy(m_vertices.data(), vertices, m_vertices.size() * sizeof(float3));
@@ -63,59 +64,77 @@ void CpuRayQueries::prepare() {
     m_report.recompiled = true;
 }
 
-template <class Answer>
-void CpuRayQueries::for_each_ray(size_t count, const Answer& answer) {
-    // Chunks as small as the CPU backend's 1D tiles keep both workers busy to the end.
-    constexpr size_t kChunk = 64;
-    const size_t chunks = (count + kChunk - 1) / kChunk;
+template <class Trace>
+void CpuRayQueries::for_each_batch(const RayArrays& rays, const Trace& trace) {
+    // Two batches a worker at least, so that the workers finish together, and no more than
+    // a stream query takes at once. A batch of many rays is what makes streams pay: the
+    // nodes near the leaves still see several rays each.
+    const size_t count = rays.count;
+    const size_t workers = m_pool.size();
+    const size_t batch = std::clamp<size_t>((count + 2 * workers - 1) / (2 * workers), 1024,
+                                            accel::kStreamBatch);
+    const size_t batches = (count + batch - 1) / batch;
+    const bool no_triangles = m_indices.empty();
     std::atomic<size_t> next{0};
     const auto start = Clock::now();
     m_pool.run(
-        [&](unsigned) {
-            for (size_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) {
-                const size_t end = std::min(count, (c + 1) * kChunk);
-                for (size_t i = c * kChunk; i < end; ++i) answer(i);
+        [&](unsigned w) {
+            StreamWorker& worker = m_workers[w];
+            for (size_t b; (b = next.fetch_add(1, std::memory_order_relaxed)) < batches;) {
+                const size_t begin = b * batch, n = std::min(count, begin + batch) - begin;
+                worker.rays.resize(n);
+                for (size_t k = 0; k < n; ++k) {
+                    Ray ray;
+                    if (!no_triangles && batch_ray(rays, begin + k, ray))
+                        worker.rays[k] = accel::StreamRay{ray.origin, ray.tmin, ray.direction,
+                                                          ray.tmax};
+                    else  // an empty interval: no node or triangle passes it
+                        worker.rays[k] = accel::StreamRay{make_float3(0, 0, 0), kInfinity,
+                                                          make_float3(0, 0, 1), -kInfinity};
+                }
+                trace(begin, n, worker);
             }
         },
-        unsigned(std::min<size_t>(chunks, ~0u)));  // no more workers than chunks
+        unsigned(std::min<size_t>(batches, ~0u)));  // no more workers than batches
     m_report.launch_ms = ms_since(start);
 }
 
 void CpuRayQueries::intersect(const RayArrays& rays, const HitArrays& out) {
     prepare();
-    const bool no_triangles = m_indices.empty();
-    for_each_ray(rays.count, [&](size_t i) {
-        // What the query module's closest_hits, record_hit and record_miss write.
-        float t = lucent_python::positive_infinity();
-        int32_t prim = -1;
-        runtime::AttributeBytes<sizeof(TriangleAttributes)> attr{};
-        Ray ray;
-        accel::TriangleHit hit;
-        if (!no_triangles && batch_ray(rays, i, ray) &&
-            m_accel.intersect(ray.origin, ray.direction, ray.tmin, ray.tmax, hit)) {
-            t = hit.t;
-            prim = int32_t(hit.prim);
-            float3 p0, p1, p2;
-            accel::hit_vertices(hit, p0, p1, p2);
-            runtime::builtin_triangle_attributes(make_float2(hit.u, hit.v), p0, p1, p2, attr);
+    for_each_batch(rays, [&](size_t begin, size_t n, StreamWorker& worker) {
+        worker.hits.resize(n);
+        m_accel.intersect_stream(worker.rays, worker.hits, worker.workspace);
+        for (size_t k = 0; k < n; ++k) {
+            // What the query module's closest_hits, record_hit and record_miss write.
+            const accel::StreamHit& hit = worker.hits[k];
+            const size_t i = begin + k;
+            float t = lucent_python::positive_infinity();
+            int32_t prim = -1;
+            runtime::AttributeBytes<sizeof(TriangleAttributes)> attr{};
+            if (hit.prim != accel::kStreamMiss) {
+                t = hit.t;
+                prim = int32_t(hit.prim);
+                // The vertices the BVH was built or refitted with, as the leaf holds them.
+                const uint3 tri = m_indices[hit.prim];
+                runtime::builtin_triangle_attributes(make_float2(hit.u, hit.v),
+                                                     m_vertices[tri.x], m_vertices[tri.y],
+                                                     m_vertices[tri.z], attr);
+            }
+            out.t[i] = t;
+            out.prim[i] = prim;
+            std::memcpy(out.uv + 2 * i, attr.bytes + offsetof(TriangleAttributes, barycentrics),
+                        2 * sizeof(float));
+            std::memcpy(out.normal + 3 * i,
+                        attr.bytes + offsetof(TriangleAttributes, geometric_normal),
+                        3 * sizeof(float));
         }
-        out.t[i] = t;
-        out.prim[i] = prim;
-        std::memcpy(out.uv + 2 * i, attr.bytes + offsetof(TriangleAttributes, barycentrics),
-                    2 * sizeof(float));
-        std::memcpy(out.normal + 3 * i,
-                    attr.bytes + offsetof(TriangleAttributes, geometric_normal),
-                    3 * sizeof(float));
     });
 }
 
 void CpuRayQueries::occluded(const RayArrays& rays, uint8_t* out) {
     prepare();
-    const bool no_triangles = m_indices.empty();
-    for_each_ray(rays.count, [&](size_t i) {
-        Ray ray;
-        out[i] = !no_triangles && batch_ray(rays, i, ray) &&
-                 m_accel.occluded(ray.origin, ray.direction, ray.tmin, ray.tmax);
+    for_each_batch(rays, [&](size_t begin, size_t n, StreamWorker& worker) {
+        m_accel.occluded_stream(worker.rays, std::span<uint8_t>(out + begin, n), worker.workspace);
     });
 }
 

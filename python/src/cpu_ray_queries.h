@@ -1,8 +1,9 @@
 // The CPU side of lucent.TriangleMesh: the rays of a batch go straight to the triangle BVH
 // the engine builds for a GeometryGroup of triangles (accel::TriangleAccel, the same build
-// and the same watertight test), on a pool of worker threads, reading the caller's arrays
-// and writing the answers into the caller's arrays: no copies, and no programs around the
-// traversal. The answers are those of the query module (ray_query_programs.h) on the CPU
+// and the same watertight test), on a pool of worker threads, as ray streams
+// (accel/ray_stream.h): each worker takes batches of the caller's rays and traces each
+// batch node by node, then writes the answers into the caller's arrays. No programs around
+// the traversal. The answers are those of the query module (ray_query_programs.h) on the CPU
 // backend, bit for bit: the same rules for what a ray is (ray_query_rules.h) and the same
 // attribute formula (runtime::builtin_triangle_attributes).
 #pragma once
@@ -40,15 +41,25 @@ class CpuRayQueries {
     enum class BvhState { kCurrent, kBuild, kRefit };
     /// Builds or refits the BVH if the vertices changed; starts m_report.
     void prepare();
-    /// Runs answer(i) for every ray i in [0, count), in chunks taken by the workers.
-    template <class Answer>
-    void for_each_ray(size_t count, const Answer& answer);
+    /// What a worker keeps from query to query: its stream workspace and one batch's rays
+    /// and answers.
+    struct StreamWorker {
+        accel::RayStreamWorkspace workspace;
+        std::vector<accel::StreamRay> rays;
+        std::vector<accel::StreamHit> hits;
+    };
+    /// Runs trace(begin, count, worker) over the rays [0, count) in batches taken by the
+    /// workers, each batch's rays already in worker.rays (a ray that is not one, by
+    /// ray_query_rules.h, made one that hits nothing).
+    template <class Trace>
+    void for_each_batch(const RayArrays& rays, const Trace& trace);
 
     std::vector<float3> m_vertices;
     std::vector<uint3> m_indices;
     accel::TriangleAccel m_accel;
     BvhState m_bvh = BvhState::kBuild;
     cpu::ThreadPool m_pool;
+    std::vector<StreamWorker> m_workers;  // one per worker of m_pool
     LaunchReport m_report;
 };
 
