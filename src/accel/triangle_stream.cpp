@@ -2,8 +2,10 @@
 // occlusion for a batch of rays, node by node. Compiled once per instruction-set variant
 // beside triangle_traverse.cpp (cmake/isa_variants.cmake); the AVX-512 variant runs the
 // stream, sixteen rays to an instruction, and the others trace the batch's rays one by one
-// with their single-ray loop (the stream's gathers and compressions have no cheap AVX2
-// form), so every variant gives the same answers.
+// with their single-ray loop, so every variant gives the same answers. An eight-lane AVX2
+// stream (AVX2's gathers, a permutation table for the compress, the scatters one lane at a
+// time) was measured in session 37 and lost to the AVX2 single-ray loop on primary and
+// shadow rays and tied it on diffuse rays (docs/performance.md, Session 37).
 //
 // The answers equal the single-ray queries': the same watertight test with the same
 // arithmetic gives the same t, u and v for a triangle. Only which of two triangles hit at
@@ -260,10 +262,10 @@ void test_leaf_stream(const TriangleBlock<kLanes>& block, uint32_t triangles, co
 
 /// The stream walk: a stack of nodes and leaves, each with its stream of rays. A node
 /// splits its stream into its children's; for closest hits the children are pushed far to
-/// near along the direction most of the stream's rays share (Barringer and Akenine-Möller
-/// §4: one order for the whole stream), so that the nearer children's hits shorten the rays
-/// before the farther children test them. Each child's stream lies above its parent's, in
-/// the region the parent reserved, so the buffer is used as a stack of regions.
+/// near along the direction most of the stream's rays share (one order for the whole
+/// stream), so that the nearer children's hits shorten the rays before the farther children
+/// test them. Each child's stream lies above its parent's, in the region the parent
+/// reserved, so the buffer is used as a stack of regions.
 template <StreamQuery kQuery>
 void traverse_stream(const TriangleAccel::Impl& accel, uint32_t count, StreamBuffers& b) {
     uint32_t* ids = b.ids;
