@@ -5,7 +5,8 @@
 // batch node by node, then writes the answers into the caller's arrays. No programs around
 // the traversal. The answers are those of the query module (ray_query_programs.h) on the CPU
 // backend, bit for bit: the same rules for what a ray is (ray_query_rules.h) and the same
-// attribute formula (runtime::builtin_triangle_attributes).
+// attribute formula (runtime::builtin_triangle_attributes). Only a tie, two triangles hit at
+// exactly the same t, may name the other triangle, as the stream meets them in another order.
 #pragma once
 
 #include <cstddef>
