@@ -135,7 +135,7 @@ void test_node_stream(const WideNode& node, const uint32_t* ids, uint32_t count,
                 unsigned(_mm512_movepi32_mask(_mm512_castps_si512(inverse[k])) & valid));
         for (int j = 0; j < child_count; ++j) {
             const int c = children[j];
-            __m512 t_near = t_start, t_far = _mm512_set1_ps(kInfinity);
+            __m512 t_near = t_start, t_far = _mm512_set1_ps(HUGE_VALF);
             for (int k = 0; k < 3; ++k) {
                 const __m512 t0 = _mm512_mul_ps(
                     _mm512_sub_ps(_mm512_set1_ps(node.planes[k][0][c]), o[k]), inverse[k]);
@@ -241,7 +241,7 @@ void test_leaf_stream(const TriangleBlock<kLanes>& block, uint32_t triangles, co
                 best_e2 = _mm512_mask_mov_ps(best_e2, hit, e2);
                 best_det = _mm512_mask_mov_ps(best_det, hit, det);
             } else {
-                t_end = _mm512_mask_mov_ps(t_end, hit, _mm512_set1_ps(-kInfinity));
+                t_end = _mm512_mask_mov_ps(t_end, hit, _mm512_set1_ps(-HUGE_VALF));
             }
             found |= hit;
         }
