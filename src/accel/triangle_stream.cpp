@@ -13,6 +13,7 @@
 #include <bit>
 #include <cmath>
 
+#include "accel/inverse_direction.h"
 #include "accel/ray_stream.h"
 #include "accel/triangle_accel.h"
 #include "accel/triangle_traverse.h"
@@ -50,10 +51,6 @@ enum class StreamQuery { kClosest, kAny };
 
 #if LUCENT_STREAM_SIMD
 
-// The clamps of 1/d, as the single-ray test's (triangle_traverse.cpp): |1/d| and |o/d| stay
-// finite wherever the origin is.
-constexpr float kMaxInverse = 1e20f;
-constexpr float kMaxOverInverse = 1e37f;
 // The slab distances here are (plane - o) * (1/d): three roundings, so a computed distance
 // is within a factor (1 +- gamma(3)) of the true one. Scaling the far distance by
 // 1 + 2 gamma(3) keeps every box the ray touches (Ize 2013, "Robust BVH ray traversal";

@@ -16,6 +16,7 @@
 #include <bit>
 #include <cmath>
 
+#include "accel/inverse_direction.h"
 #include "accel/triangle_accel.h"
 #include "accel/triangle_traverse.h"
 #include "accel/wide_bvh.h"
@@ -58,10 +59,8 @@ inline void store_barycentrics(TriangleHit& hit, float e1, float e2, float det) 
 // 1 + 8u leaves room. Scaling 1/d at setup keeps a multiply out of every node's test.
 constexpr float kFarScale = 1.0f + 0x1p-21f;
 constexpr int kStackSize = 512;  // 7 pushes per level; wide depth <= binary depth <= 60
-// The largest |1/d| of the fused slab test, and the largest |o * (1/d)|: 1/d is clamped to
-// both, so o/d stays finite wherever the origin is (far beyond any t a ray asks about).
-constexpr float kMaxInverse = 1e20f;
-constexpr float kMaxOverInverse = 1e37f;
+// 1/d is clamped as inverse_direction.h says (kMaxInverse, kMaxOverInverse), as the
+// streams clamp it.
 
 /// Everything a ray needs in the inner loops, computed once per query.
 struct RayState {

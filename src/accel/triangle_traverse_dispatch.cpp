@@ -65,6 +65,17 @@ const TraverseVariant& active() {
     return *g_active.load(std::memory_order_relaxed);
 }
 
+/// Hands trace(begin, count, buffers) the rays [0, total) in batches of at most
+/// kStreamBatch, with the workspace's buffers reserved for each.
+template <class Trace>
+void for_each_stream_batch(size_t total, unsigned depth, RayStreamWorkspace& workspace,
+                           const Trace& trace) {
+    for (size_t begin = 0; begin < total; begin += kStreamBatch) {
+        const size_t count = std::min(kStreamBatch, total - begin);
+        trace(begin, count, workspace.reserve(count, depth));
+    }
+}
+
 }  // namespace
 
 bool TriangleAccel::intersect(float3 origin, float3 direction, float tmin, float tmax,
@@ -93,12 +104,11 @@ void TriangleAccel::intersect_stream(std::span<const StreamRay> rays, std::span<
         throw Error("TriangleAccel::intersect_stream: " + std::to_string(rays.size()) +
                     " rays but room for " + std::to_string(hits.size()) +
                     " hits; pass one StreamHit per ray");
-    for (size_t begin = 0; begin < rays.size(); begin += kStreamBatch) {
-        const size_t count = std::min(kStreamBatch, rays.size() - begin);
-        StreamBuffers& buffers = workspace.reserve(count, m_impl->wide_depth);
-        active().intersect_stream(*m_impl, rays.data() + begin, count, hits.data() + begin,
-                                  buffers);
-    }
+    for_each_stream_batch(rays.size(), m_impl->wide_depth, workspace,
+                          [&](size_t begin, size_t count, StreamBuffers& buffers) {
+                              active().intersect_stream(*m_impl, rays.data() + begin, count,
+                                                        hits.data() + begin, buffers);
+                          });
 }
 
 void TriangleAccel::occluded_stream(std::span<const StreamRay> rays, std::span<uint8_t> blocked,
@@ -107,12 +117,11 @@ void TriangleAccel::occluded_stream(std::span<const StreamRay> rays, std::span<u
         throw Error("TriangleAccel::occluded_stream: " + std::to_string(rays.size()) +
                     " rays but room for " + std::to_string(blocked.size()) +
                     " answers; pass one byte per ray");
-    for (size_t begin = 0; begin < rays.size(); begin += kStreamBatch) {
-        const size_t count = std::min(kStreamBatch, rays.size() - begin);
-        StreamBuffers& buffers = workspace.reserve(count, m_impl->wide_depth);
-        active().occluded_stream(*m_impl, rays.data() + begin, count, blocked.data() + begin,
-                                 buffers);
-    }
+    for_each_stream_batch(rays.size(), m_impl->wide_depth, workspace,
+                          [&](size_t begin, size_t count, StreamBuffers& buffers) {
+                              active().occluded_stream(*m_impl, rays.data() + begin, count,
+                                                       blocked.data() + begin, buffers);
+                          });
 }
 
 }  // namespace lucent::accel
