@@ -575,6 +575,16 @@ TEST(CliBenchJson, RaysKeepsTheRecordedFieldNames) {
     std::set<std::string> now = key_paths(result);
     std::set<std::string> recorded = key_paths(recorded_result("rays-cpu-bunny.json"));
     recorded.insert("/cpu_isa");  // added after that record was made
+    // The stream queries' figures were added after that record too. They take the kernels'
+    // ("lucent") fields, plus their own ratio to the peer and their checksums' verdict.
+    ASSERT_TRUE(result.contains("streams")) << run.output;
+    for (const std::string& key : key_paths(result["lucent"])) recorded.insert("/streams" + key);
+    recorded.insert("/streams");
+    recorded.insert("/streams/checksums_agree_with_kernels");
+    if (result.contains("embree")) {
+        for (const char* set : {"", "/primary", "/shadow", "/diffuse"})
+            recorded.insert(std::string("/streams/ratio_to_embree") + set);
+    }
     EXPECT_EQ(missing_from(now, recorded), "") << run.output;
     if (result.contains("embree"))  // a build with the peer gives every recorded field
         EXPECT_EQ(missing_from(recorded, now), "") << run.output;
