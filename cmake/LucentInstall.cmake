@@ -1,7 +1,8 @@
 # Installs Lucent as a relocatable CMake package: the libraries, the public and device
 # headers, the `lucent` CLI, the module embedding tool, lucent_add_programs, and
 # LucentConfig.cmake / LucentConfigVersion.cmake with the targets Lucent::lucent,
-# Lucent::scene and Lucent::lucent_embed_module. Every path in the package is relative to
+# Lucent::scene, Lucent::samples (the samples' objects and their modules' objects, linked
+# whole) and Lucent::lucent_embed_module. Every path in the package is relative to
 # its prefix, so an installed tree may be moved.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -21,8 +22,10 @@ if(LUCENT_CUDA_INCLUDES)
   set(LUCENT_PACKAGE_HAS_CUDA ON)
 endif()
 
-install(TARGETS lucent lucent_scene lucent_embed_module EXPORT LucentTargets
+install(TARGETS lucent lucent_scene lucent_embed_module lucent_samples lucent_sample_programs
+                lucent_samples_package EXPORT LucentTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  OBJECTS DESTINATION ${CMAKE_INSTALL_LIBDIR}/lucent-objects
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
@@ -32,6 +35,9 @@ install(TARGETS lucent_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY include/lucent DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h")
 install(DIRECTORY scene DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  FILES_MATCHING PATTERN "*.h")
+# The samples' headers (samples/sample.h is their API) and their program modules' text.
+install(DIRECTORY samples DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h")
 
 install(EXPORT LucentTargets NAMESPACE Lucent:: DESTINATION ${LUCENT_CMAKE_DIR})

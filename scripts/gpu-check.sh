@@ -57,7 +57,7 @@ examples)
     # (programs-at-run-time is not run here: this machine's g++ builds modules for its own
     # C library, newer than the Debian one the bundle's programs run with. The Python step
     # runs modules compiled at run time on the GPU, through an extension linked here.)
-    for e in first-program ambient-occlusion; do
+    for e in first-program ambient-occlusion render-sample; do
         echo "== example $e: cuda (cold JIT), cuda (cached), cpu"
         $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"
         $R $B/bin/example-$e --backend cuda --out "$out/${e}_cuda.png"

@@ -148,6 +148,23 @@ check_output() {
       [ "$lines" -eq $((vt + ht + 3)) ] 2>/dev/null ||
         fail "$name: $out has $lines lines, expected $((vt + ht + 3))"
       ;;
+    render-sample)
+      # The README's main job (IGI, 64 VPLs, the Cornell box, 512x512) through
+      # Lucent::samples: the same image, byte for byte, as the installed CLI renders.
+      size=$(png_size "$out") || { fail "$name: $out is not a PNG"; return; }
+      [ "$size" = 512x512 ] || fail "$name: $out is $size, expected 512x512"
+      local cli_out=${out%.png}-cli.png
+      if "$prefix/bin/lucent" render --sample igi --scene cornell --size 512x512 --set vpls=64 \
+           --backend cpu --out "$cli_out" > "$work/logs/$name-cli.log" 2>&1; then
+        cmp -s "$out" "$cli_out" || fail "$name: its image differs from \`lucent render\`'s ($cli_out)"
+      else
+        fail "$name: the installed lucent render failed (log: $work/logs/$name-cli.log)"
+      fi
+      "$bin" --sample igi --set vpls=0 --out "$work/out/$name-bad.png" > /dev/null 2>&1
+      local rc=$?
+      [ $rc -eq 2 ] || fail "$name --set vpls=0: exit $rc, expected 2 (out of the option's range)"
+      [ ! -e "$work/out/$name-bad.png" ] || fail "$name --set vpls=0 wrote an image"
+      ;;
     ambient-occlusion)
       size=$(png_size "$out") || { fail "$name: $out is not a PNG"; return; }
       [ "$size" = 640x480 ] || fail "$name: $out is $size, expected 640x480"
