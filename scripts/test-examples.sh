@@ -147,6 +147,12 @@ check_output() {
       lines=$(wc -l < "$out" 2>/dev/null || echo 0)
       [ "$lines" -eq $((vt + ht + 3)) ] 2>/dev/null ||
         fail "$name: $out has $lines lines, expected $((vt + ht + 3))"
+      # scene::TriangleMesh, the same queries as arrays: every answer the programs' answer.
+      local same
+      same=$(grep -o '): [0-9]* of [0-9]* answers the same' "$log" | awk '{ print $2, $4 }')
+      read -r s st <<< "$same"
+      [ -n "${s:-}" ] && [ "$s" = "$st" ] && [ "$st" = $((vt + ht)) ] ||
+        fail "$name: TriangleMesh gave '$same' (same of total) answers, expected all $((vt + ht))"
       ;;
     render-sample)
       # The README's main job (IGI, 64 VPLs, the Cornell box, 512x512) through

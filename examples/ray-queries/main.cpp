@@ -1,7 +1,8 @@
 // Ray queries without an image: line of sight between many pairs of points, and the
 // distance to the first surface along many rays (collision and proximity), against a
 // triangle mesh. The queries go in as input buffers, one launch answers a whole batch, and
-// the answers come back in output buffers.
+// the answers come back in output buffers. Then the same queries through
+// scene::TriangleMesh, which takes arrays of rays and needs no programs.
 //
 //   ray-queries [MESH.obj] [--backend cpu|cuda|auto] [--jit-check SM] [--out FILE.txt]
 //
@@ -20,6 +21,7 @@
 #include "lucent/lucent.h"
 #include "ray_queries.h"
 #include "scene/obj_mesh.h"
+#include "scene/triangle_mesh.h"
 
 namespace {
 
@@ -218,6 +220,35 @@ int main(int argc, char** argv) {
         std::printf(
             "time: line of sight %.1f ms, distance %.1f ms (with the first launch's setup)\n",
             sight_ms, distance_ms);
+
+        // The same queries without writing programs: scene::TriangleMesh takes the rays as
+        // arrays (on the CPU it traces them as ray streams, straight through the BVH; on the
+        // GPU it launches its own query module). Its answers are the programs' answers.
+        lucent::scene::TriangleMesh queries(mesh.positions, mesh.indices, args.options);
+        std::vector<float3> segment(kPairs);
+        for (unsigned i = 0; i < kPairs; ++i) segment[i] = to[i] - from[i];
+        const std::vector<float> up_to_one{1.0f};  // tmax 1: the segment from `from` to `to`
+        std::vector<uint8_t> blocked(kPairs);
+        start = std::chrono::steady_clock::now();
+        queries.occluded({from, segment, {}, up_to_one}, blocked);
+        const double mesh_sight_ms = ms_since(start);
+        std::vector<float> mesh_t(kRays);
+        std::vector<int32_t> mesh_prim(kRays);
+        std::vector<float2> mesh_uv(kRays);  // barycentrics and normals come with each hit
+        std::vector<float3> mesh_normal(kRays);
+        start = std::chrono::steady_clock::now();
+        queries.intersect({origin, direction, {}, {}}, {mesh_t, mesh_prim, mesh_uv, mesh_normal});
+        const double mesh_distance_ms = ms_since(start);
+        unsigned same = 0;
+        for (unsigned i = 0; i < kPairs; ++i) same += (blocked[i] == 0) == (v[i] == 1);
+        for (unsigned i = 0; i < kRays; ++i) {
+            const bool hit = t[i] >= 0;
+            same += hit ? mesh_t[i] == t[i] : mesh_prim[i] < 0;
+        }
+        std::printf("TriangleMesh (%s): %u of %u answers the same; line of sight %.1f ms, "
+                    "distance %.1f ms (with its BVH build)\n",
+                    queries.backend_name().c_str(), same, kPairs + kRays, mesh_sight_ms,
+                    mesh_distance_ms);
 
         if (!args.out.empty()) {
             std::ofstream file(args.out);

@@ -1,21 +1,31 @@
-// lucent.TriangleMesh: ray queries on numpy arrays (the shape trimesh users know), built on
-// the engine through ray_query_mesh.h. The arrays are checked here, with the GIL held;
-// the copies in and out and the launch run without it.
+// lucent.TriangleMesh: ray queries on numpy arrays (the shape trimesh users know), through
+// the C++ package's scene::TriangleMesh (scene/triangle_mesh.h). The arrays are checked here,
+// with the GIL held; the copies in and out and the launch run without it.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "array_args.h"
 #include "bindings.h"
-#include "ray_query_mesh.h"
+#include "scene/triangle_mesh.h"
 
 namespace lucent::python {
 
 namespace {
+
+static_assert(sizeof(float3) == 3 * sizeof(float) && sizeof(float2) == 2 * sizeof(float) &&
+                  sizeof(uint3) == 3 * sizeof(uint32_t),
+              "(N, 3) and (N, 2) arrays are read as float3, float2 and uint3");
+
+template <class T, class E>
+std::span<T> as_span(E* data, size_t count) {
+    return std::span<T>(reinterpret_cast<T*>(data), count);
+}
 
 /// What intersect() returns: one entry per ray.
 struct RayHits {
@@ -44,15 +54,17 @@ class PyTriangleMesh {
         const uint32_t* ip = i.data();
         const size_t triangles = size_t(i.shape(0));
         py::gil_scoped_release release;
-        m_mesh = std::make_unique<RayQueryMesh>(vp, size_t(n), ip, triangles, std::move(options));
+        m_mesh = std::make_unique<scene::TriangleMesh>(as_span<const float3>(vp, size_t(n)),
+                                                       as_span<const uint3>(ip, triangles),
+                                                       std::move(options));
     }
 
     static std::unique_ptr<PyTriangleMesh> load(const std::string& path, const std::string& backend,
                                                 unsigned threads, int jit_check_sm) {
-        MeshData data;
+        scene::MeshTriangles data;
         {
             py::gil_scoped_release release;
-            data = load_mesh(path);
+            data = scene::load_mesh_triangles(path);
         }
         py::array_t<float> v({py::ssize_t(data.positions.size()), py::ssize_t(3)},
                              reinterpret_cast<const float*>(data.positions.data()));
@@ -64,12 +76,14 @@ class PyTriangleMesh {
     RayHits intersect(const py::handle& origins, const py::handle& directions,
                       const py::handle& tmin, const py::handle& tmax) {
         Batch b = batch("TriangleMesh.intersect", origins, directions, tmin, tmax);
-        const py::ssize_t r = b.rays.count;
+        const py::ssize_t r = py::ssize_t(b.rays.origins.size());
         RayHits hits{py::array_t<float>(r), py::array_t<int32_t>(r),
                      py::array_t<float>({r, py::ssize_t(2)}),
                      py::array_t<float>({r, py::ssize_t(3)})};
-        const HitArrays out{hits.t.mutable_data(), hits.prim.mutable_data(),
-                            hits.uv.mutable_data(), hits.normal.mutable_data()};
+        const scene::MeshHits out{as_span<float>(hits.t.mutable_data(), size_t(r)),
+                                  as_span<int32_t>(hits.prim.mutable_data(), size_t(r)),
+                                  as_span<float2>(hits.uv.mutable_data(), size_t(r)),
+                                  as_span<float3>(hits.normal.mutable_data(), size_t(r))};
         py::gil_scoped_release release;
         m_mesh->intersect(b.rays, out);
         return hits;
@@ -78,9 +92,9 @@ class PyTriangleMesh {
     py::array_t<bool> occluded(const py::handle& origins, const py::handle& directions,
                                const py::handle& tmax, const py::handle& tmin) {
         Batch b = batch("TriangleMesh.occluded", origins, directions, tmin, tmax);
-        py::array_t<bool> blocked(b.rays.count);
+        py::array_t<bool> blocked(py::ssize_t(b.rays.origins.size()));
         static_assert(sizeof(bool) == 1, "numpy bools are one byte");
-        uint8_t* out = reinterpret_cast<uint8_t*>(blocked.mutable_data());
+        const std::span<uint8_t> out = as_span<uint8_t>(blocked.mutable_data(), b.rays.origins.size());
         py::gil_scoped_release release;
         m_mesh->occluded(b.rays, out);
         return blocked;
@@ -97,16 +111,16 @@ class PyTriangleMesh {
                                   " (make a new TriangleMesh for another vertex count)");
         const float* vp = v.data();
         py::gil_scoped_release release;
-        m_mesh->update(vp, size_t(n), rebuild);
+        m_mesh->update(as_span<const float3>(vp, size_t(n)), rebuild);
     }
 
-    RayQueryMesh& mesh() { return *m_mesh; }
+    scene::TriangleMesh& mesh() { return *m_mesh; }
 
   private:
     /// The checked arrays of one query, kept alive while the launch reads them.
     struct Batch {
         py::array_t<float> origins, directions, tmin, tmax;
-        RayArrays rays;
+        scene::MeshRays rays;
     };
 
     Batch batch(const char* where, const py::handle& origins, const py::handle& directions,
@@ -124,17 +138,14 @@ class PyTriangleMesh {
                                   " rays in one call; at most 4294967295 (split the batch)");
         b.tmin = interval_array(tmin, where, "tmin", r);
         b.tmax = interval_array(tmax, where, "tmax", r);
-        b.rays.origins = b.origins.data();
-        b.rays.directions = b.directions.data();
-        b.rays.tmin = b.tmin.data();
-        b.rays.tmin_count = size_t(b.tmin.size());
-        b.rays.tmax = b.tmax.data();
-        b.rays.tmax_count = size_t(b.tmax.size());
-        b.rays.count = size_t(r);
+        b.rays.origins = as_span<const float3>(b.origins.data(), size_t(r));
+        b.rays.directions = as_span<const float3>(b.directions.data(), size_t(r));
+        b.rays.tmin = std::span<const float>(b.tmin.data(), size_t(b.tmin.size()));
+        b.rays.tmax = std::span<const float>(b.tmax.data(), size_t(b.tmax.size()));
         return b;
     }
 
-    std::unique_ptr<RayQueryMesh> m_mesh;
+    std::unique_ptr<scene::TriangleMesh> m_mesh;
 };
 
 }  // namespace

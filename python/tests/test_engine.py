@@ -13,9 +13,9 @@ from reference import Reference, random_mesh, random_rays
 def test_version_and_modules():
     assert lucent.__version__.count(".") >= 1
     names = [m.name for m in lucent.modules()]
-    for expected in ("lucent_python_queries", "first_program", "whitted", "igi"):
+    for expected in ("lucent_mesh_queries", "first_program", "whitted", "igi"):
         assert expected in names
-    queries = next(m for m in lucent.modules() if m.name == "lucent_python_queries")
+    queries = next(m for m in lucent.modules() if m.name == "lucent_mesh_queries")
     assert queries.uses_occluded
     assert {"closest_hits", "any_hits", "record_hit", "record_miss"} <= set(queries.programs)
     assert "ray generation closest_hits" in queries.describe()
@@ -98,7 +98,7 @@ def test_variables_set_and_read():
 
 def build_query_scene(ctx, v, i):
     """The scene TriangleMesh builds, through the engine API."""
-    ctx.add_module("lucent_python_queries")
+    ctx.add_module("lucent_mesh_queries")
     miss = ctx.create_program("record_miss")
     ctx.set_ray_type(0, "query", payload=miss)
     ctx.set_miss_program(0, miss)
@@ -122,7 +122,7 @@ def build_query_scene(ctx, v, i):
 
 def test_a_launch_of_the_query_module_matches_triangle_mesh(rng):
     """The query module launched through the engine answers as TriangleMesh does, bit for
-    bit: on the CPU TriangleMesh calls the traversal directly (cpu_ray_queries.cpp), so this
+    bit: on the CPU TriangleMesh calls the traversal directly (cpu_mesh_queries.cpp), so this
     holds the two paths to the same answers, rays that are not rays included."""
     v, i = random_mesh(rng)
     o, d = random_rays(rng, 2000)

@@ -1,14 +1,14 @@
-#include "cpu_ray_queries.h"
+#include "scene/mesh_queries/cpu_mesh_queries.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 
-#include "ray_query_rules.h"
+#include "scene/mesh_queries/ray_query_rules.h"
 #include "runtime/trace_rules.h"
 
-namespace lucent::python {
+namespace lucent::scene::detail {
 
 namespace {
 
@@ -18,30 +18,29 @@ double ms_since(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-float3 element3(const float* values, size_t i) {
-    return make_float3(values[3 * i], values[3 * i + 1], values[3 * i + 2]);
+/// Entry i of a per-ray or one-for-all span, `fallback` when it is empty.
+float interval_value(std::span<const float> values, size_t i, float fallback) {
+    return values.empty() ? fallback : values[values.size() == 1 ? 0 : i];
 }
 
 /// The ray of batch entry i, or false when it is not a ray (ray_query_rules.h).
-bool batch_ray(const RayArrays& rays, size_t i, Ray& ray) {
-    return lucent_python::query_ray(element3(rays.origins, i), element3(rays.directions, i),
-                                    rays.tmin[rays.tmin_count == 1 ? 0 : i],
-                                    rays.tmax[rays.tmax_count == 1 ? 0 : i], ray);
+bool batch_ray(const MeshRays& rays, size_t i, Ray& ray) {
+    return lucent_mesh_queries::query_ray(rays.origins[i], rays.directions[i],
+                                          interval_value(rays.tmin, i, 0.0f),
+                                          interval_value(rays.tmax, i, kInfinity), ray);
 }
 
 }  // namespace
 
-CpuRayQueries::CpuRayQueries(const float* vertices, size_t vertex_count, const uint32_t* indices,
-                             size_t triangle_count, unsigned threads)
-    : m_vertices(reinterpret_cast<const float3*>(vertices),
-                 reinterpret_cast<const float3*>(vertices) + vertex_count),
-      m_indices(reinterpret_cast<const uint3*>(indices),
-                reinterpret_cast<const uint3*>(indices) + triangle_count),
+CpuMeshQueries::CpuMeshQueries(std::span<const float3> vertices,
+                               std::span<const uint3> triangles, unsigned threads)
+    : m_vertices(vertices.begin(), vertices.end()),
+      m_indices(triangles.begin(), triangles.end()),
       m_pool(threads),
       m_workers(m_pool.size()) {}
 
-void CpuRayQueries::update(const float* vertices, bool rebuild) {
-    std::memcpy(m_vertices.data(), vertices, m_vertices.size() * sizeof(float3));
+void CpuMeshQueries::update(std::span<const float3> vertices, bool rebuild) {
+    std::copy(vertices.begin(), vertices.end(), m_vertices.begin());
     // A refit keeps a BVH that was built: one not built yet is built from the new vertices.
     if (rebuild || m_bvh == BvhState::kBuild)
         m_bvh = BvhState::kBuild;
@@ -49,7 +48,7 @@ void CpuRayQueries::update(const float* vertices, bool rebuild) {
         m_bvh = BvhState::kRefit;
 }
 
-void CpuRayQueries::prepare() {
+void CpuMeshQueries::prepare() {
     m_report = LaunchReport{};
     if (m_bvh == BvhState::kCurrent) return;
     const auto start = Clock::now();
@@ -65,11 +64,11 @@ void CpuRayQueries::prepare() {
 }
 
 template <class Trace>
-void CpuRayQueries::for_each_batch(const RayArrays& rays, const Trace& trace) {
+void CpuMeshQueries::for_each_batch(const MeshRays& rays, const Trace& trace) {
     // Two batches a worker at least, so that the workers finish together, and no more than
     // a stream query takes at once. A batch of many rays is what makes streams pay: the
     // nodes near the leaves still see several rays each.
-    const size_t count = rays.count;
+    const size_t count = rays.origins.size();
     const size_t workers = m_pool.size();
     const size_t batch = std::clamp<size_t>((count + 2 * workers - 1) / (2 * workers), 1024,
                                             accel::kStreamBatch);
@@ -99,7 +98,7 @@ void CpuRayQueries::for_each_batch(const RayArrays& rays, const Trace& trace) {
     m_report.launch_ms = ms_since(start);
 }
 
-void CpuRayQueries::intersect(const RayArrays& rays, const HitArrays& out) {
+void CpuMeshQueries::intersect(const MeshRays& rays, const MeshHits& out) {
     prepare();
     for_each_batch(rays, [&](size_t begin, size_t n, StreamWorker& worker) {
         worker.hits.resize(n);
@@ -108,7 +107,7 @@ void CpuRayQueries::intersect(const RayArrays& rays, const HitArrays& out) {
             // What the query module's closest_hits, record_hit and record_miss write.
             const accel::StreamHit& hit = worker.hits[k];
             const size_t i = begin + k;
-            float t = lucent_python::positive_infinity();
+            float t = lucent_mesh_queries::positive_infinity();
             int32_t prim = -1;
             runtime::AttributeBytes<sizeof(TriangleAttributes)> attr{};
             if (hit.prim != accel::kStreamMiss) {
@@ -122,20 +121,20 @@ void CpuRayQueries::intersect(const RayArrays& rays, const HitArrays& out) {
             }
             out.t[i] = t;
             out.prim[i] = prim;
-            std::memcpy(out.uv + 2 * i, attr.bytes + offsetof(TriangleAttributes, barycentrics),
-                        2 * sizeof(float));
-            std::memcpy(out.normal + 3 * i,
+            std::memcpy(&out.uv[i], attr.bytes + offsetof(TriangleAttributes, barycentrics),
+                        sizeof(float2));
+            std::memcpy(&out.normal[i],
                         attr.bytes + offsetof(TriangleAttributes, geometric_normal),
-                        3 * sizeof(float));
+                        sizeof(float3));
         }
     });
 }
 
-void CpuRayQueries::occluded(const RayArrays& rays, uint8_t* out) {
+void CpuMeshQueries::occluded(const MeshRays& rays, std::span<uint8_t> out) {
     prepare();
     for_each_batch(rays, [&](size_t begin, size_t n, StreamWorker& worker) {
-        m_accel.occluded_stream(worker.rays, std::span<uint8_t>(out + begin, n), worker.workspace);
+        m_accel.occluded_stream(worker.rays, out.subspan(begin, n), worker.workspace);
     });
 }
 
-}  // namespace lucent::python
+}  // namespace lucent::scene::detail

@@ -1,9 +1,9 @@
-// The CPU side of lucent.TriangleMesh: the rays of a batch go straight to the triangle BVH
-// the engine builds for a GeometryGroup of triangles (accel::TriangleAccel, the same build
-// and the same watertight test), on a pool of worker threads, as ray streams
+// The CPU side of TriangleMesh (scene/triangle_mesh.h): the rays of a batch go straight to
+// the triangle BVH the engine builds for a GeometryGroup of triangles (accel::TriangleAccel,
+// the same build and the same watertight test), on a pool of worker threads, as ray streams
 // (accel/ray_stream.h): each worker takes batches of the caller's rays and traces each
 // batch node by node, then writes the answers into the caller's arrays. No programs around
-// the traversal. The answers are those of the query module (ray_query_programs.h) on the CPU
+// the traversal. The answers are those of the query module (mesh_query_programs.h) on the CPU
 // backend, bit for bit: the same rules for what a ray is (ray_query_rules.h) and the same
 // attribute formula (runtime::builtin_triangle_attributes). Only a tie, two triangles hit at
 // exactly the same t, may name the other triangle, as the stream meets them in another order.
@@ -16,23 +16,24 @@
 #include "accel/triangle_accel.h"
 #include "cpu/thread_pool.h"
 #include "lucent/context.h"
-#include "ray_query_arrays.h"
+#include "scene/triangle_mesh.h"
 
-namespace lucent::python {
+namespace lucent::scene::detail {
 
-class CpuRayQueries {
+class CpuMeshQueries {
   public:
-    /// vertices: vertex_count x 3 floats; indices: triangle_count x 3, each < vertex_count.
-    /// threads: workers counting the caller, 0 = one per core. The BVH is built at the first
-    /// query, as the engine builds it at the first launch.
-    CpuRayQueries(const float* vertices, size_t vertex_count, const uint32_t* indices,
-                  size_t triangle_count, unsigned threads);
+    /// Indices each below vertices.size() (the caller checks). threads: workers counting the
+    /// caller, 0 = one per core. The BVH is built at the first query, as the engine builds
+    /// it at the first launch.
+    CpuMeshQueries(std::span<const float3> vertices, std::span<const uint3> triangles,
+                   unsigned threads);
 
     /// New positions (same count): the BVH is refitted at the next query, or rebuilt.
-    void update(const float* vertices, bool rebuild);
+    void update(std::span<const float3> vertices, bool rebuild);
 
-    void intersect(const RayArrays& rays, const HitArrays& out);
-    void occluded(const RayArrays& rays, uint8_t* out);
+    /// Sizes checked by the caller (TriangleMesh).
+    void intersect(const MeshRays& rays, const MeshHits& out);
+    void occluded(const MeshRays& rays, std::span<uint8_t> out);
 
     unsigned threads() const { return m_pool.size(); }
     /// The last query's figures: accel_ms for a build or refit it made, launch_ms for the rays.
@@ -53,7 +54,7 @@ class CpuRayQueries {
     /// workers, each batch's rays already in worker.rays (a ray that is not one, by
     /// ray_query_rules.h, made one that hits nothing).
     template <class Trace>
-    void for_each_batch(const RayArrays& rays, const Trace& trace);
+    void for_each_batch(const MeshRays& rays, const Trace& trace);
 
     std::vector<float3> m_vertices;
     std::vector<uint3> m_indices;
@@ -64,4 +65,4 @@ class CpuRayQueries {
     LaunchReport m_report;
 };
 
-}  // namespace lucent::python
+}  // namespace lucent::scene::detail

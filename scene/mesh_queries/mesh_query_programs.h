@@ -1,7 +1,7 @@
-// ray_query_programs.h: the program module behind lucent.TriangleMesh (python/) on the GPU,
-// where it is compiled by NVRTC into the megakernel (on the CPU the queries call the
-// traversal directly, cpu_ray_queries.h; this module runs there when a mesh is asked for a
-// JIT check). Each launch index answers one ray of a batch the host copied from numpy
+// mesh_query_programs.h: the program module behind TriangleMesh (scene/triangle_mesh.h) on
+// the GPU, where it is compiled by NVRTC into the megakernel (on the CPU the queries call
+// the traversal directly, cpu_mesh_queries.h; this module runs there when a mesh is asked
+// for a JIT check or a device list). Each launch index answers one ray of a batch the host copied from numpy
 // arrays into input buffers, and writes its answer to output buffers.
 //   closest_hits: the first surface along each ray (t, triangle, barycentrics, unit normal)
 //   any_hits:     is anything on the ray in (tmin, tmax)? (occluded(): no hit program runs)
@@ -9,11 +9,11 @@
 #pragma once
 
 #include "lucent/device.h"
-#include "ray_query_rules.h"
+#include "ray_query_rules.h"  // beside this file
 
-namespace lucent_python {
+namespace lucent_mesh_queries {
 // any_hits calls occluded(), so the module declares it.
-LUCENT_MODULE(lucent_python_queries, lucent::kUsesOccluded)
+LUCENT_MODULE(lucent_mesh_queries, lucent::kUsesOccluded)
 
 using lucent::BufferView;
 using lucent::Handle;
@@ -92,4 +92,4 @@ LUCENT_RAY_GENERATION(any_hits, AnyHitsRecord) {
     rec.blocked[i] = blocked ? 1 : 0;
 }
 
-}  // namespace lucent_python
+}  // namespace lucent_mesh_queries

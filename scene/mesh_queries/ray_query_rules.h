@@ -1,6 +1,7 @@
-// ray_query_rules.h: what lucent.TriangleMesh takes for a ray, shared by the query module
-// (ray_query_programs.h, on the GPU and through the engine on the CPU) and the CPU's direct
-// queries (cpu_ray_queries.cpp), so every path answers the same rays the same way.
+// ray_query_rules.h: what TriangleMesh (scene/triangle_mesh.h) takes for a ray, shared by
+// the query module (mesh_query_programs.h, on the GPU and through the engine on the CPU) and
+// the CPU's direct queries (cpu_mesh_queries.cpp), so every path answers the same rays the
+// same way.
 // A ray with a NaN or infinite origin or direction component, a zero direction, or a NaN
 // tmin or tmax, is a miss by definition: it is not traced, so no backend's arithmetic
 // decides what it does. An infinite tmax is the engine's "no upper bound".
@@ -8,7 +9,7 @@
 
 #include "lucent/device/types.h"
 
-namespace lucent_python {
+namespace lucent_mesh_queries {
 
 constexpr unsigned kQueryRay = 0;  // the one ray type
 
@@ -48,4 +49,4 @@ LUCENT_HD inline bool query_ray(float3 o, float3 d, float tmin, float tmax, luce
     return true;
 }
 
-}  // namespace lucent_python
+}  // namespace lucent_mesh_queries
