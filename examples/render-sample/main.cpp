@@ -6,7 +6,8 @@
 //                 [--backend cpu|cuda|auto] [--jit-check SM] [--out FILE.png] [--list]
 //
 // The defaults are the README's main job: Instant Global Illumination with 64 VPLs on the
-// built-in Cornell box, 512x512. --list prints every sample with its options.
+// built-in Cornell box, 512x512; another --sample starts from its own scene and options.
+// --list prints every sample with its options.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -41,7 +42,7 @@ bool parse_args(int argc, char** argv, Arguments& a) {
     s.width = s.height = 512;
     s.scene = "cornell";
     s.sets["vpls"] = "64";
-    bool sets_given = false;
+    bool sets_given = false, scene_given = false;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--list") {
@@ -55,6 +56,7 @@ bool parse_args(int argc, char** argv, Arguments& a) {
             a.sample = value;
         } else if (flag == "--scene" && !value.empty()) {
             s.scene = value;
+            scene_given = true;
         } else if (flag == "--size" && std::sscanf(value.c_str(), "%ux%u%c", &w, &h, &end) == 2 &&
                    w > 0 && h > 0 && w <= 16384 && h <= 16384) {
             s.width = w, s.height = h;
@@ -78,8 +80,12 @@ bool parse_args(int argc, char** argv, Arguments& a) {
             return false;
         }
     }
-    // The main job's vpls=64 is IGI's option; another sample starts from its own defaults.
-    if (!sets_given && a.sample != "igi") s.sets.clear();
+    // The main job's Cornell box and vpls=64 are IGI's; another sample starts from its own
+    // scene and defaults.
+    if (a.sample != "igi") {
+        if (!sets_given) s.sets.clear();
+        if (!scene_given) s.scene.clear();
+    }
     return true;
 }
 
@@ -118,7 +124,8 @@ int main(int argc, char** argv) {
         double sum = 0;
         for (const float3& p : result.image.pixels) sum += (p.x + p.y + p.z) / 3.0;
         std::printf("backend: %s\n", result.backend.c_str());
-        std::printf("sample: %s on %s, %ux%u\n", sample.name.c_str(), a.settings.scene.c_str(),
+        std::printf("sample: %s on %s, %ux%u\n", sample.name.c_str(),
+                    a.settings.scene.empty() ? "its own scene" : a.settings.scene.c_str(),
                     result.image.width, result.image.height);
         std::printf("mean value %.4f\n", result.image.pixels.empty() ? 0.0 : sum / result.image.pixels.size());
         for (const lucent::samples::StageTiming& stage : result.stages)
