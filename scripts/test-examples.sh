@@ -166,6 +166,16 @@ check_output() {
       else
         fail "$name: the installed lucent render failed (log: $work/logs/$name-cli.log)"
       fi
+      # Another sample, from its own scene and defaults, as `lucent render` renders it.
+      if "$bin" --sample whitted --size 96x64 --backend cpu --out "$work/out/$name-whitted.png" \
+           > /dev/null 2>&1 &&
+         "$prefix/bin/lucent" render --sample whitted --size 96x64 --backend cpu \
+           --out "$work/out/$name-whitted-cli.png" > /dev/null 2>&1; then
+        cmp -s "$work/out/$name-whitted.png" "$work/out/$name-whitted-cli.png" ||
+          fail "$name --sample whitted: its image differs from \`lucent render --sample whitted\`'s"
+      else
+        fail "$name --sample whitted, or the installed lucent render of it, failed"
+      fi
       "$bin" --sample igi --set vpls=0 --out "$work/out/$name-bad.png" > /dev/null 2>&1
       local rc=$?
       [ $rc -eq 2 ] || fail "$name --set vpls=0: exit $rc, expected 2 (out of the option's range)"
