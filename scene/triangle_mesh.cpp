@@ -217,7 +217,8 @@ void TriangleMesh::Impl::load_rays(const MeshRays& rays) {
 
 TriangleMesh::Impl& TriangleMesh::impl(const char* where) const {
     if (!m_impl)
-        throw Error(std::string(where) + ": this TriangleMesh was moved from; use the one it "
+        throw Error(std::string(where) +
+                    ": this TriangleMesh was moved from; use the one it "
                     "was moved to");
     return *m_impl;
 }

@@ -35,10 +35,10 @@ struct MeshRays {
 
 /// Where TriangleMesh::intersect writes: each span one entry per ray.
 struct MeshHits {
-    std::span<float> t;         // +inf on a miss
-    std::span<int32_t> prim;    // the triangle's index; -1 on a miss
-    std::span<float2> uv;       // barycentrics of vertices 1 and 2; 0 on a miss
-    std::span<float3> normal;   // unit geometric normal, in the winding order; 0 on a miss
+    std::span<float> t;        // +inf on a miss
+    std::span<int32_t> prim;   // the triangle's index; -1 on a miss
+    std::span<float2> uv;      // barycentrics of vertices 1 and 2; 0 on a miss
+    std::span<float3> normal;  // unit geometric normal, in the winding order; 0 on a miss
 };
 
 /// A mesh's positions and triangles.

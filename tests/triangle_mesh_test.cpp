@@ -26,7 +26,8 @@ Soup random_soup(std::mt19937& rng, unsigned vertex_count = 300, unsigned triang
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::uniform_int_distribution<unsigned> pick(0, vertex_count - 1);
     Soup s;
-    for (unsigned i = 0; i < vertex_count; ++i) s.vertices.push_back(make_float3(u(rng), u(rng), u(rng)));
+    for (unsigned i = 0; i < vertex_count; ++i)
+        s.vertices.push_back(make_float3(u(rng), u(rng), u(rng)));
     while (s.triangles.size() < triangle_count) {
         const uint3 t = make_uint3(pick(rng), pick(rng), pick(rng));
         if (t.x != t.y && t.y != t.z && t.x != t.z) s.triangles.push_back(t);
@@ -101,20 +102,22 @@ TEST(TriangleMesh, CpuQueriesGiveTheBvhsSingleRayAnswers) {
         const float3 o = rays.origins[i], d = rays.directions[i];
         const bool hit = bvh.intersect(o, d, rays.tmin[i], rays.tmax[i], h);
         ASSERT_EQ(a.prim[i] >= 0, hit) << "ray " << i;
-        ASSERT_EQ(bool(a.blocked[i]), bvh.occluded(o, d, rays.tmin[i], rays.tmax[i])) << "ray " << i;
+        ASSERT_EQ(bool(a.blocked[i]), bvh.occluded(o, d, rays.tmin[i], rays.tmax[i]))
+            << "ray " << i;
         blocked += a.blocked[i];
         if (!hit) {
             EXPECT_TRUE(std::isinf(a.t[i]) && a.t[i] > 0) << "ray " << i;
             continue;
         }
         ++hits;
-        EXPECT_EQ(a.t[i], h.t) << "ray " << i;  // the same watertight test, bit for bit
+        EXPECT_EQ(a.t[i], h.t) << "ray " << i;        // the same watertight test, bit for bit
         if (uint32_t(a.prim[i]) != h.prim) continue;  // a tie: two triangles at the same t
         EXPECT_EQ(a.uv[i].x, h.u) << "ray " << i;
         EXPECT_EQ(a.uv[i].y, h.v) << "ray " << i;
         // The geometric normal: unit length, along the triangle's winding-order normal.
         const uint3 tri = soup.triangles[h.prim];
-        const float3 p0 = soup.vertices[tri.x], p1 = soup.vertices[tri.y], p2 = soup.vertices[tri.z];
+        const float3 p0 = soup.vertices[tri.x], p1 = soup.vertices[tri.y],
+                     p2 = soup.vertices[tri.z];
         const float3 n = normalize(cross(p1 - p0, p2 - p0));
         EXPECT_NEAR(length(a.normal[i]), 1.0f, 1e-5f) << "ray " << i;
         EXPECT_GT(dot(a.normal[i], n), 0.9999f) << "ray " << i;
@@ -155,7 +158,8 @@ TEST(TriangleMesh, TheEnginesPathAnswersAsTheDirectQueries) {
 }
 
 TEST(TriangleMesh, RaysThatAreNotRaysAreMisses) {
-    const std::vector<float3> v = {make_float3(-1, -1, 0), make_float3(1, -1, 0), make_float3(0, 1, 0)};
+    const std::vector<float3> v = {make_float3(-1, -1, 0), make_float3(1, -1, 0),
+                                   make_float3(0, 1, 0)};
     const std::vector<uint3> tri = {make_uint3(0, 1, 2)};
     TriangleMesh mesh(v, tri, cpu_options(1));
     const float nan = std::nanf("");
@@ -223,7 +227,8 @@ std::string error_of(Call call) {
 }
 
 TEST(TriangleMesh, MisuseIsAnErrorNamingTheArgumentAndTheFix) {
-    const std::vector<float3> v = {make_float3(-1, -1, 0), make_float3(1, -1, 0), make_float3(0, 1, 0)};
+    const std::vector<float3> v = {make_float3(-1, -1, 0), make_float3(1, -1, 0),
+                                   make_float3(0, 1, 0)};
     const std::vector<uint3> bad = {make_uint3(0, 1, 2), make_uint3(0, 1, 3)};
     std::string e = error_of([&] { TriangleMesh(v, bad, cpu_options()); });
     EXPECT_NE(e.find("triangle 1 is (0, 1, 3)"), std::string::npos) << e;
@@ -238,12 +243,14 @@ TEST(TriangleMesh, MisuseIsAnErrorNamingTheArgumentAndTheFix) {
     Answers a(2);
     e = error_of([&] { mesh.intersect(rays.view(), a.hits()); });
     EXPECT_NE(e.find("TriangleMesh::intersect: directions has 1 entries for 2 rays"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     rays.directions.push_back(make_float3(0, 0, -1));
     rays.tmax = {1, 2, 3};
     e = error_of([&] { mesh.occluded(rays.view(), a.blocked); });
     EXPECT_NE(e.find("tmax has 3 entries for 2 rays; give one per ray, one for every ray, or none"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     rays.tmax.clear();
     a.uv.resize(1);
     e = error_of([&] { mesh.intersect(rays.view(), a.hits()); });
@@ -257,7 +264,9 @@ TEST(TriangleMesh, MisuseIsAnErrorNamingTheArgumentAndTheFix) {
     TriangleMesh moved_to = std::move(mesh);
     e = error_of([&] { mesh.occluded(rays.view(), std::span<uint8_t>(blocked).first(2)); });
     EXPECT_NE(e.find("moved from"), std::string::npos) << e;
-    EXPECT_EQ(error_of([&] { moved_to.occluded(rays.view(), std::span<uint8_t>(blocked).first(2)); }), "");
+    EXPECT_EQ(
+        error_of([&] { moved_to.occluded(rays.view(), std::span<uint8_t>(blocked).first(2)); }),
+        "");
     EXPECT_EQ(blocked[0], 1);
     EXPECT_EQ(blocked[1], 1);
 }

@@ -60,8 +60,7 @@ bool parse_args(int argc, char** argv, Arguments& a) {
         } else if (flag == "--size" && std::sscanf(value.c_str(), "%ux%u%c", &w, &h, &end) == 2 &&
                    w > 0 && h > 0 && w <= 16384 && h <= 16384) {
             s.width = w, s.height = h;
-        } else if (flag == "--set" && value.find('=') != std::string::npos &&
-                   value.find('=') > 0) {
+        } else if (flag == "--set" && value.find('=') != std::string::npos && value.find('=') > 0) {
             if (!sets_given) s.sets.clear();  // the defaults' vpls=64 is the main job's only
             sets_given = true;
             s.sets[value.substr(0, value.find('='))] = value.substr(value.find('=') + 1);
@@ -127,7 +126,8 @@ int main(int argc, char** argv) {
         std::printf("sample: %s on %s, %ux%u\n", sample.name.c_str(),
                     a.settings.scene.empty() ? "its own scene" : a.settings.scene.c_str(),
                     result.image.width, result.image.height);
-        std::printf("mean value %.4f\n", result.image.pixels.empty() ? 0.0 : sum / result.image.pixels.size());
+        std::printf("mean value %.4f\n",
+                    result.image.pixels.empty() ? 0.0 : sum / result.image.pixels.size());
         for (const lucent::samples::StageTiming& stage : result.stages)
             std::printf("  %-24s %9.3f ms %s\n", stage.name.c_str(), stage.ms, stage.note.c_str());
         std::printf("render %.1f ms (with the scene's set-up)\n", ms);

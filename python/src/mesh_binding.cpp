@@ -94,7 +94,8 @@ class PyTriangleMesh {
         Batch b = batch("TriangleMesh.occluded", origins, directions, tmin, tmax);
         py::array_t<bool> blocked(py::ssize_t(b.rays.origins.size()));
         static_assert(sizeof(bool) == 1, "numpy bools are one byte");
-        const std::span<uint8_t> out = as_span<uint8_t>(blocked.mutable_data(), b.rays.origins.size());
+        const std::span<uint8_t> out =
+            as_span<uint8_t>(blocked.mutable_data(), b.rays.origins.size());
         py::gil_scoped_release release;
         m_mesh->occluded(b.rays, out);
         return blocked;
@@ -102,8 +103,8 @@ class PyTriangleMesh {
 
     void update(const py::handle& vertices, bool rebuild) {
         py::ssize_t n = 0;
-        py::array_t<float> v = float32_array(vertices, "TriangleMesh.update", "vertices", {-1, 3},
-                                             "N", n);
+        py::array_t<float> v =
+            float32_array(vertices, "TriangleMesh.update", "vertices", {-1, 3}, "N", n);
         if (size_t(n) != m_mesh->vertex_count())
             throw py::value_error("TriangleMesh.update: vertices must be (" +
                                   std::to_string(m_mesh->vertex_count()) +
@@ -166,9 +167,10 @@ void bind_triangle_mesh(py::module_& m) {
             "(R,) bool: the rays that hit")
         .def("__len__", [](const RayHits& h) { return h.t.size(); })
         .def("__repr__", [](const RayHits& h) {
-            const py::ssize_t hits = py::int_(h.prim.attr("__ge__")(0).attr("sum")()).cast<py::ssize_t>();
-            return "<lucent.RayHits: " + std::to_string(hits) + " of " + std::to_string(h.t.size()) +
-                   " rays hit>";
+            const py::ssize_t hits =
+                py::int_(h.prim.attr("__ge__")(0).attr("sum")()).cast<py::ssize_t>();
+            return "<lucent.RayHits: " + std::to_string(hits) + " of " +
+                   std::to_string(h.t.size()) + " rays hit>";
         });
 
     py::class_<PyTriangleMesh>(m, "TriangleMesh",
@@ -202,8 +204,9 @@ void bind_triangle_mesh(py::module_& m) {
                                [](PyTriangleMesh& m) { return m.mesh().vertex_count(); })
         .def_property_readonly("triangle_count",
                                [](PyTriangleMesh& m) { return m.mesh().triangle_count(); })
-        .def_property_readonly("backend", [](PyTriangleMesh& m) { return m.mesh().backend_name(); },
-                               "The backend that runs the queries: 'cpu (2 threads)', 'cuda (...)'")
+        .def_property_readonly(
+            "backend", [](PyTriangleMesh& m) { return m.mesh().backend_name(); },
+            "The backend that runs the queries: 'cpu (2 threads)', 'cuda (...)'")
         .def_property_readonly(
             "last_launch", [](PyTriangleMesh& m) { return m.mesh().last_launch(); },
             "The LaunchReport of the most recent query (timings; jit_ms with jit_check_sm)")

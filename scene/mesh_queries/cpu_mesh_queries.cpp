@@ -5,8 +5,8 @@
 #include <chrono>
 #include <cstring>
 
-#include "scene/mesh_queries/ray_query_rules.h"
 #include "runtime/trace_rules.h"
+#include "scene/mesh_queries/ray_query_rules.h"
 
 namespace lucent::scene::detail {
 
@@ -32,8 +32,8 @@ bool batch_ray(const MeshRays& rays, size_t i, Ray& ray) {
 
 }  // namespace
 
-CpuMeshQueries::CpuMeshQueries(std::span<const float3> vertices,
-                               std::span<const uint3> triangles, unsigned threads)
+CpuMeshQueries::CpuMeshQueries(std::span<const float3> vertices, std::span<const uint3> triangles,
+                               unsigned threads)
     : m_vertices(vertices.begin(), vertices.end()),
       m_indices(triangles.begin(), triangles.end()),
       m_pool(threads),
@@ -70,8 +70,8 @@ void CpuMeshQueries::for_each_batch(const MeshRays& rays, const Trace& trace) {
     // nodes near the leaves still see several rays each.
     const size_t count = rays.origins.size();
     const size_t workers = m_pool.size();
-    const size_t batch = std::clamp<size_t>((count + 2 * workers - 1) / (2 * workers), 1024,
-                                            accel::kStreamBatch);
+    const size_t batch =
+        std::clamp<size_t>((count + 2 * workers - 1) / (2 * workers), 1024, accel::kStreamBatch);
     const size_t batches = (count + batch - 1) / batch;
     const bool no_triangles = m_indices.empty();
     std::atomic<size_t> next{0};
@@ -85,8 +85,8 @@ void CpuMeshQueries::for_each_batch(const MeshRays& rays, const Trace& trace) {
                 for (size_t k = 0; k < n; ++k) {
                     Ray ray;
                     if (!no_triangles && batch_ray(rays, begin + k, ray))
-                        worker.rays[k] = accel::StreamRay{ray.origin, ray.tmin, ray.direction,
-                                                          ray.tmax};
+                        worker.rays[k] =
+                            accel::StreamRay{ray.origin, ray.tmin, ray.direction, ray.tmax};
                     else  // an empty interval: no node or triangle passes it
                         worker.rays[k] = accel::StreamRay{make_float3(0, 0, 0), kInfinity,
                                                           make_float3(0, 0, 1), -kInfinity};
@@ -115,16 +115,14 @@ void CpuMeshQueries::intersect(const MeshRays& rays, const MeshHits& out) {
                 prim = int32_t(hit.prim);
                 // The vertices the BVH was built or refitted with, as the leaf holds them.
                 const uint3 tri = m_indices[hit.prim];
-                runtime::builtin_triangle_attributes(make_float2(hit.u, hit.v),
-                                                     m_vertices[tri.x], m_vertices[tri.y],
-                                                     m_vertices[tri.z], attr);
+                runtime::builtin_triangle_attributes(make_float2(hit.u, hit.v), m_vertices[tri.x],
+                                                     m_vertices[tri.y], m_vertices[tri.z], attr);
             }
             out.t[i] = t;
             out.prim[i] = prim;
             std::memcpy(&out.uv[i], attr.bytes + offsetof(TriangleAttributes, barycentrics),
                         sizeof(float2));
-            std::memcpy(&out.normal[i],
-                        attr.bytes + offsetof(TriangleAttributes, geometric_normal),
+            std::memcpy(&out.normal[i], attr.bytes + offsetof(TriangleAttributes, geometric_normal),
                         sizeof(float3));
         }
     });

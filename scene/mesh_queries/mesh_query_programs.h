@@ -1,8 +1,9 @@
 // mesh_query_programs.h: the program module behind TriangleMesh (scene/triangle_mesh.h) on
 // the GPU, where it is compiled by NVRTC into the megakernel (on the CPU the queries call
 // the traversal directly, cpu_mesh_queries.h; this module runs there when a mesh is asked
-// for a JIT check or a device list). Each launch index answers one ray of a batch the host copied from numpy
-// arrays into input buffers, and writes its answer to output buffers.
+// for a JIT check or a device list). Each launch index answers one ray of a batch the host
+// copied from the caller's arrays into input buffers, and writes its answer to output
+// buffers.
 //   closest_hits: the first surface along each ray (t, triangle, barycentrics, unit normal)
 //   any_hits:     is anything on the ray in (tmin, tmax)? (occluded(): no hit program runs)
 // Which rays are rays: ray_query_rules.h.
