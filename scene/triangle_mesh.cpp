@@ -4,7 +4,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
-#include <tuple>
+#include <utility>
 
 #include "lucent/error.h"
 #include "scene/mesh_queries/cpu_mesh_queries.h"
@@ -46,9 +46,11 @@ void check_size(const char* where, const char* what, size_t size, size_t rays, b
                 (one_for_all ? "one per ray, one for every ray, or none" : "one per ray"));
 }
 
-/// The rays' sizes: directions as origins, tmin and tmax one per ray, one or none, and at
-/// most 2^32 - 1 rays (a launch's width).
-void check_rays(const char* where, const MeshRays& rays) {
+/// The rays after their sizes are checked (directions as origins, tmin and tmax one per ray,
+/// one or none, at most 2^32 - 1 rays: a launch's width), with an empty tmin or tmax given
+/// its default, so that both paths see one value for every ray or one per ray.
+MeshRays checked_rays(const char* where, const MeshRays& rays) {
+    static constexpr float kNoTmin = 0.0f, kNoTmax = kInfinity;
     const size_t n = rays.origins.size();
     check_size(where, "directions", rays.directions.size(), n, false);
     check_size(where, "tmin", rays.tmin.size(), n, true);
@@ -56,6 +58,10 @@ void check_rays(const char* where, const MeshRays& rays) {
     if (uint64_t(n) > 0xffffffffull)
         throw Error(std::string(where) + ": " + std::to_string(n) +
                     " rays in one call; at most 4294967295 (split the batch)");
+    MeshRays r = rays;
+    if (r.tmin.empty()) r.tmin = std::span<const float>(&kNoTmin, 1);
+    if (r.tmax.empty()) r.tmax = std::span<const float>(&kNoTmax, 1);
+    return r;
 }
 
 }  // namespace
@@ -202,12 +208,8 @@ void TriangleMesh::Impl::load_rays(const MeshRays& rays) {
     origins->unmap();
     std::copy(rays.directions.begin(), rays.directions.end(), directions->map<float3>());
     directions->unmap();
-    const float no_tmin = 0.0f, no_tmax = kInfinity;
-    for (auto [buffer, values, fallback] :
-         {std::tuple{&tmin, rays.tmin, std::span<const float>(&no_tmin, 1)},
-          std::tuple{&tmax, rays.tmax, std::span<const float>(&no_tmax, 1)}}) {
+    for (auto [buffer, v] : {std::pair{&tmin, rays.tmin}, std::pair{&tmax, rays.tmax}}) {
         // One value for all rays (size 1), or one per ray: a batch of one ray is both.
-        const std::span<const float> v = values.empty() ? fallback : values;
         Buffer& b = **buffer;
         if (b.count() != v.size()) b.resize(unsigned(v.size()));
         std::copy(v.begin(), v.end(), b.map<float>());
@@ -223,10 +225,10 @@ TriangleMesh::Impl& TriangleMesh::impl(const char* where) const {
     return *m_impl;
 }
 
-void TriangleMesh::intersect(const MeshRays& rays, const MeshHits& out) {
+void TriangleMesh::intersect(const MeshRays& given, const MeshHits& out) {
     const char* where = "TriangleMesh::intersect";
     Impl& m = impl(where);
-    check_rays(where, rays);
+    const MeshRays rays = checked_rays(where, given);  // empty intervals given defaults
     const size_t n = rays.origins.size();
     check_size(where, "out.t", out.t.size(), n, false);
     check_size(where, "out.prim", out.prim.size(), n, false);
@@ -243,10 +245,10 @@ void TriangleMesh::intersect(const MeshRays& rays, const MeshHits& out) {
     std::copy_n(m.normal->data<float3>(), n, out.normal.begin());
 }
 
-void TriangleMesh::occluded(const MeshRays& rays, std::span<uint8_t> blocked) {
+void TriangleMesh::occluded(const MeshRays& given, std::span<uint8_t> blocked) {
     const char* where = "TriangleMesh::occluded";
     Impl& m = impl(where);
-    check_rays(where, rays);
+    const MeshRays rays = checked_rays(where, given);  // empty intervals given defaults
     const size_t n = rays.origins.size();
     check_size(where, "blocked", blocked.size(), n, false);
     if (n == 0) return;

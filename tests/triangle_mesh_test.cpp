@@ -139,7 +139,10 @@ TEST(TriangleMesh, TheEnginesPathAnswersAsTheDirectQueries) {
     through_engine.devices = {DeviceSpec{DeviceSpec::Kind::kCpu, 0}};
     TriangleMesh engine(soup.vertices, soup.triangles, through_engine);
     const Answers a = answer(direct, rays), b = answer(engine, rays);
-    EXPECT_GT(engine.last_launch().launch_ms, 0.0);
+    // The engine's launch ran every ray on the listed device; the direct queries launch none.
+    ASSERT_EQ(engine.last_launch().devices.size(), 1u);
+    EXPECT_EQ(engine.last_launch().devices[0].indices, rays.origins.size());
+    EXPECT_TRUE(direct.last_launch().devices.empty());
     for (size_t i = 0; i < rays.origins.size(); ++i) {
         ASSERT_EQ(a.t[i], b.t[i]) << "ray " << i;
         ASSERT_EQ(a.blocked[i], b.blocked[i]) << "ray " << i;

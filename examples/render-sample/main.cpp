@@ -40,9 +40,6 @@ bool parse_args(int argc, char** argv, Arguments& a) {
     using lucent::BackendKind;
     lucent::samples::RenderSettings& s = a.settings;
     s.width = s.height = 512;
-    s.scene = "cornell";
-    s.sets["vpls"] = "64";
-    bool sets_given = false, scene_given = false;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
         if (flag == "--list") {
@@ -56,13 +53,10 @@ bool parse_args(int argc, char** argv, Arguments& a) {
             a.sample = value;
         } else if (flag == "--scene" && !value.empty()) {
             s.scene = value;
-            scene_given = true;
         } else if (flag == "--size" && std::sscanf(value.c_str(), "%ux%u%c", &w, &h, &end) == 2 &&
                    w > 0 && h > 0 && w <= 16384 && h <= 16384) {
             s.width = w, s.height = h;
         } else if (flag == "--set" && value.find('=') != std::string::npos && value.find('=') > 0) {
-            if (!sets_given) s.sets.clear();  // the defaults' vpls=64 is the main job's only
-            sets_given = true;
             s.sets[value.substr(0, value.find('='))] = value.substr(value.find('=') + 1);
         } else if (flag == "--backend" && (value == "cpu" || value == "cuda" || value == "auto")) {
             s.backend = value == "cpu"    ? BackendKind::kCpu
@@ -79,11 +73,11 @@ bool parse_args(int argc, char** argv, Arguments& a) {
             return false;
         }
     }
-    // The main job's Cornell box and vpls=64 are IGI's; another sample starts from its own
-    // scene and defaults.
-    if (a.sample != "igi") {
-        if (!sets_given) s.sets.clear();
-        if (!scene_given) s.scene.clear();
+    // The main job: IGI on the Cornell box with 64 VPLs unless told otherwise; another
+    // sample starts from its own scene and defaults.
+    if (a.sample == "igi") {
+        if (s.scene.empty()) s.scene = "cornell";
+        if (s.sets.empty()) s.sets["vpls"] = "64";
     }
     return true;
 }

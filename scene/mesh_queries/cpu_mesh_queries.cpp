@@ -18,16 +18,12 @@ double ms_since(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-/// Entry i of a per-ray or one-for-all span, `fallback` when it is empty.
-float interval_value(std::span<const float> values, size_t i, float fallback) {
-    return values.empty() ? fallback : values[values.size() == 1 ? 0 : i];
-}
-
-/// The ray of batch entry i, or false when it is not a ray (ray_query_rules.h).
+/// The ray of batch entry i, or false when it is not a ray (ray_query_rules.h). tmin and
+/// tmax hold one value for every ray or one per ray, as the query module reads them.
 bool batch_ray(const MeshRays& rays, size_t i, Ray& ray) {
     return lucent_mesh_queries::query_ray(rays.origins[i], rays.directions[i],
-                                          interval_value(rays.tmin, i, 0.0f),
-                                          interval_value(rays.tmax, i, kInfinity), ray);
+                                          rays.tmin[rays.tmin.size() == 1 ? 0 : i],
+                                          rays.tmax[rays.tmax.size() == 1 ? 0 : i], ray);
 }
 
 }  // namespace

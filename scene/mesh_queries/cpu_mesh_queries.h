@@ -31,7 +31,8 @@ class CpuMeshQueries {
     /// New positions (same count): the BVH is refitted at the next query, or rebuilt.
     void update(std::span<const float3> vertices, bool rebuild);
 
-    /// Sizes checked by the caller (TriangleMesh).
+    /// Sizes checked by the caller (TriangleMesh), and tmin and tmax never empty: one value
+    /// for every ray or one per ray.
     void intersect(const MeshRays& rays, const MeshHits& out);
     void occluded(const MeshRays& rays, std::span<uint8_t> out);
 
