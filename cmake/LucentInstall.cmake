@@ -2,7 +2,8 @@
 # headers, the `lucent` CLI, the module embedding tool, lucent_add_programs, and
 # LucentConfig.cmake / LucentConfigVersion.cmake with the targets Lucent::lucent,
 # Lucent::scene, Lucent::samples (the samples' objects and their modules' objects, linked
-# whole) and Lucent::lucent_embed_module. Every path in the package is relative to
+# whole), Lucent::bench (the benchmarks, their modules' objects linked whole) and
+# Lucent::lucent_embed_module. Every path in the package is relative to
 # its prefix, so an installed tree may be moved.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -17,13 +18,18 @@ if(TARGET OpenEXR::OpenEXR)
   set(LUCENT_PACKAGE_NEEDS_OPENEXR ON)
 endif()
 set(LUCENT_PACKAGE_NEEDS_MPI ${LUCENT_HAVE_MPI})
+set(LUCENT_PACKAGE_NEEDS_EMBREE OFF)  # Lucent::bench's peer
+if(embree_FOUND)
+  set(LUCENT_PACKAGE_NEEDS_EMBREE ON)
+endif()
 set(LUCENT_PACKAGE_HAS_CUDA OFF)
 if(LUCENT_CUDA_INCLUDES)
   set(LUCENT_PACKAGE_HAS_CUDA ON)
 endif()
 
 install(TARGETS lucent lucent_scene lucent_embed_module lucent_samples lucent_sample_programs
-                lucent_samples_package EXPORT LucentTargets
+                lucent_samples_package lucent_bench lucent_bench_programs lucent_bench_package
+                EXPORT LucentTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   OBJECTS DESTINATION ${CMAKE_INSTALL_LIBDIR}/lucent-objects
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
@@ -39,6 +45,9 @@ install(DIRECTORY scene DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
 # The samples' headers (samples/sample.h is their API) and their program modules' text.
 install(DIRECTORY samples DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h")
+# The benchmarks' headers (bench/rays/rays_bench.h: bench_rays_json), not their GPU kernels.
+install(DIRECTORY bench DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  FILES_MATCHING PATTERN "*.h" PATTERN "gpu" EXCLUDE PATTERN "scenes" EXCLUDE)
 
 install(EXPORT LucentTargets NAMESPACE Lucent:: DESTINATION ${LUCENT_CMAKE_DIR})
 configure_package_config_file(cmake/LucentConfig.cmake.in

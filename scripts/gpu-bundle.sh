@@ -50,7 +50,7 @@ if [ "$python" = 1 ]; then
   # these static libraries and objects, and the Debian libraries they load (not the C and
   # C++ runtimes: that machine's own, newer ones serve).
   mkdir -p "$out/python/lib" "$out/python/objects" "$out/python/so"
-  cp "$build"/liblucent.a "$build"/liblucent_scene.a "$out/python/lib/"
+  cp "$build"/liblucent.a "$build"/liblucent_scene.a "$build"/liblucent_bench.a "$out/python/lib/"
   # The samples are an object library (their registrars must be linked, not pulled from an
   # archive): the objects CMake lists for it travel, samples/igi/igi.cpp.o as
   # samples_igi_igi.cpp.o.
@@ -59,6 +59,7 @@ if [ "$python" = 1 ]; then
     cp "$o" "$out/python/objects/$(echo "$name" | tr / _)"
   done < "$build/lucent_samples_objects.txt"
   cp "$build"/CMakeFiles/lucent_sample_programs.dir/lucent_modules/*/*.o \
+     "$build"/CMakeFiles/lucent_bench_programs.dir/lucent_modules/*/*.o \
      "$build"/python/CMakeFiles/lucent_python.dir/lucent_modules/*/*.o "$out/python/objects/"
   for lib in $(ldd "$build"/python/lucent/_lucent*.so | awk '/=>/ {print $3}' |
                grep -vE '/(libc|libm|libstdc\+\+|libgcc_s|libpthread|libdl|librt)\.so'); do

@@ -181,6 +181,37 @@ check_output() {
       [ $rc -eq 2 ] || fail "$name --set vpls=0: exit $rc, expected 2 (out of the option's range)"
       [ ! -e "$work/out/$name-bad.png" ] || fail "$name --set vpls=0 wrote an image"
       ;;
+    bench-rays)
+      # `lucent bench rays --json` as a call (Lucent::bench): the installed CLI on the same
+      # scene and rays must count the same hits at the same distances (the checksums; the
+      # timings differ from run to run), and every engine agree.
+      local cli_json=$work/out/$name-cli.json
+      if "$prefix/bin/lucent" bench rays --scene "$root/examples/bench-rays/room.obj" \
+           --size 320x240 --repeat 1 --json > "$cli_json" 2> "$work/logs/$name-cli.log"; then
+        python3 - "$out" "$cli_json" <<'PY' || fail "$name: its document disagrees with the CLI's (above)"
+import json, sys
+mine, cli = (json.load(open(f)) for f in sys.argv[1:])
+wrong = []
+for kind, count in (("primary", "hits"), ("shadow", "occluded"), ("diffuse", "hits")):
+    for key in (count, "sum_t"):
+        if key in cli["lucent"][kind] and mine["lucent"][kind].get(key) != cli["lucent"][kind][key]:
+            wrong.append(f"{kind} {key}: {mine['lucent'][kind].get(key)} against the CLI's {cli['lucent'][kind][key]}")
+if mine.get("checksums_agree") is False:
+    wrong.append("Lucent's and Embree's checksums differ")
+if not mine.get("streams", {}).get("checksums_agree_with_kernels", False):
+    wrong.append("the streams' checksums differ from the kernels'")
+for w in wrong:
+    print("   ", w)
+sys.exit(1 if wrong else 0)
+PY
+      else
+        fail "$name: the installed lucent bench rays failed (log: $work/logs/$name-cli.log)"
+      fi
+      grep -q "^primary " "$log" || fail "$name: no primary row in its table"
+      "$bin" --scene "$work/out/no-such-scene.obj" > /dev/null 2>&1
+      local rc=$?
+      [ $rc -eq 1 ] || fail "$name --scene (missing file): exit $rc, expected 1"
+      ;;
     ambient-occlusion)
       size=$(png_size "$out") || { fail "$name: $out is not a PNG"; return; }
       [ "$size" = 640x480 ] || fail "$name: $out is $size, expected 640x480"
@@ -216,6 +247,7 @@ for dir in "$root"/examples/*/; do
 
   case "$name" in
     ray-queries) ext=txt ;;
+    bench-rays) ext=json ;;
     *) ext=png ;;
   esac
   out=$work/out/$name.$ext
@@ -242,7 +274,8 @@ for dir in "$root"/examples/*/; do
   rc=$?
   [ $rc -eq 2 ] || fail "$name --backend bogus: exit $rc, expected 2"
 
-  if [ "$jit_check" = 1 ]; then
+  # bench-rays times the CPU's traversal and launches no megakernel there: no JIT check.
+  if [ "$jit_check" = 1 ] && [ "$name" != bench-rays ]; then
     jit_out=$work/out/$name-jit.$ext
     if run "$name-jit-check" "$bin" --backend cpu --jit-check 90 --out "$jit_out"; then
       grep -q "jit-check: megakernel compiled for sm_90" "$log" ||

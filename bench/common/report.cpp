@@ -22,8 +22,23 @@ std::string json_text(const Json& document) {
     return document.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
+namespace {
+thread_local JsonCapture* t_capture = nullptr;  // the innermost living capture
+}  // namespace
+
+JsonCapture::JsonCapture() : m_outer(t_capture) {
+    t_capture = this;
+}
+JsonCapture::~JsonCapture() {
+    t_capture = m_outer;
+}
+
 void print_json(const Json& document) {
     const std::string text = json_text(document);
+    if (t_capture) {
+        t_capture->m_text = text;
+        return;
+    }
     std::fwrite(text.data(), 1, text.size(), stdout);
 }
 

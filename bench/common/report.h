@@ -25,8 +25,27 @@ Json rate_json(const Rate& rate);
 /// of a string that are not UTF-8 are written as U+FFFD.
 std::string json_text(const Json& document);
 
-/// Writes json_text(document) to stdout.
+/// Writes json_text(document) to stdout, or, while a JsonCapture lives on this thread, hands
+/// it to that capture instead.
 void print_json(const Json& document);
+
+/// While it lives, the documents print_json() would write on this thread come here instead
+/// of stdout: a benchmark's measurement returned to the program that ran it
+/// (bench_rays_json) rather than printed. Captures nest; the innermost takes the document.
+class JsonCapture {
+  public:
+    JsonCapture();
+    ~JsonCapture();
+    JsonCapture(const JsonCapture&) = delete;
+    JsonCapture& operator=(const JsonCapture&) = delete;
+    /// The last captured document's text (json_text's form); empty when none came.
+    const std::string& text() const { return m_text; }
+
+  private:
+    friend void print_json(const Json& document);
+    std::string m_text;
+    JsonCapture* m_outer;
+};
 
 /// Prints `result` as JSON (to_json(result), found by argument-dependent lookup) when `json`,
 /// else as text (print_text(result)).

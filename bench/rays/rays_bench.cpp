@@ -529,14 +529,48 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
 
 }  // namespace
 
-int run_bench_rays(const RaysOptions& options) {
+namespace {
+/// The checks of the options that the CLI's parser does not make for a C++ or Python caller
+/// (each names the option as both spell it).
+void check_options(const RaysOptions& options) {
+    if (options.scene.empty())
+        throw Error("bench rays: no scene (scene, --scene); give an OBJ file's path");
     if (options.width == 0 || options.height == 0)
-        throw Error("bench rays: the image size must be at least 1x1");
-    if (options.repeat < 1) throw Error("bench rays: --repeat must be at least 1");
+        throw Error("bench rays: the image size (size, --size) must be at least 1x1");
+    if (options.repeat < 1) throw Error("bench rays: repeat (--repeat) must be at least 1");
+    if (options.backend != "cpu" && options.backend != "cuda")
+        throw Error("bench rays: backend (--backend) is \"" + options.backend +
+                    "\"; use \"cpu\" or \"cuda\"");
+    if (!options.has_camera) return;
+    if (!(options.fov > 0.0f && options.fov < 180.0f))
+        throw Error("bench rays: fov (--fov) is " + std::to_string(options.fov) +
+                    " degrees; it must lie in (0, 180)");
+    const float3 points[] = {options.eye, options.look, options.up, options.light};
+    for (const float3& p : points)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            throw Error("bench rays: the camera (eye, look, up, light) has a value that is not "
+                        "a finite number");
+    const float3 view = options.look - options.eye;
+    if (dot(view, view) == 0.0f || dot(options.up, options.up) == 0.0f)
+        throw Error("bench rays: the camera's eye and look are the same point, or up is zero; "
+                    "give an eye apart from look and a nonzero up");
+}
+}  // namespace
+
+std::string bench_rays_json(RaysOptions options) {
+    options.json = true;
+    JsonCapture capture;
+    run_bench_rays(options);
+    return capture.text();
+}
+
+int run_bench_rays(const RaysOptions& options) {
+    check_options(options);
+    // The scene first: a missing or malformed file is named as such, before its cameras.txt.
+    const scene::ObjMesh mesh = scene::load_obj_mesh(options.scene);
     Camera cam = options.has_camera
                      ? Camera{options.eye, options.look, options.up, options.fov, options.light}
                      : find_camera(options.scene);
-    const scene::ObjMesh mesh = scene::load_obj_mesh(options.scene);
     const unsigned threads =
         options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     if (options.backend == "cuda") {

@@ -38,4 +38,11 @@ struct RaysOptions {
 /// for bad input (missing file, bad OBJ) with file:line.
 int run_bench_rays(const RaysOptions& options);
 
+/// What run_bench_rays measures, as the JSON document that `lucent bench rays --json` prints
+/// (its keys: docs/cli.md, "lucent bench rays"), returned instead of printed, whatever
+/// options.json says: `lucent bench rays` from a C++ program (Lucent::bench) and from Python
+/// (lucent.bench_rays). Nothing is written to stdout. Throws lucent::Error for a bad option
+/// (naming it and the fix) or a bad scene file (file:line).
+std::string bench_rays_json(RaysOptions options);
+
 }  // namespace lucent::bench

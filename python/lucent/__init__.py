@@ -10,6 +10,8 @@
   spread launches over the ranks of ``mpirun -np N python3 script.py``.
 - Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
   FLIP, as ``lucent compare``).
+- Speed: ``bench_rays("sponza.obj", programs=True)`` measures as ``lucent bench rays --json``
+  and returns its document as a dict.
 
 docs/python.md in the repository is the tutorial.
 """
@@ -62,6 +64,7 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     Transform,
     TriangleMesh,
     __version__,
+    bench_rays,
     compare,
     cuda_built,
     modules,

@@ -23,6 +23,7 @@ void bind_programs(py::module_& m);        // programs_binding.cpp
 void bind_triangle_mesh(py::module_& m);   // mesh_binding.cpp
 void bind_samples(py::module_& m);         // samples_binding.cpp
 void bind_images(py::module_& m);          // images_binding.cpp
+void bind_bench(py::module_& m);           // bench_binding.cpp
 
 /// The class lucent.RankError (module.cpp), for code that tells it from other errors.
 PyObject* rank_error_type();

@@ -72,4 +72,5 @@ PYBIND11_MODULE(_lucent, m) {
     bind_triangle_mesh(m);
     bind_samples(m);
     bind_images(m);
+    bind_bench(m);
 }
