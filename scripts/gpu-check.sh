@@ -367,7 +367,7 @@ python)
     echo "== the Python tests on the GPU (LUCENT_TEST_BACKEND=cuda)"
     LUCENT_TEST_BACKEND=cuda python3 -m pytest -q -p no:cacheprovider python/tests 2>&1 | tail -25
     echo "== TriangleMesh on the BENCH.md rays of sponza on the GPU, beside bench rays --backend cuda"
-    python3 examples/python/bench_rays.py --backend cuda --lucent $work/lucent-cli \
+    python3 examples/python/bench_rays.py --backend cuda \
         --scene /work/shared/scenes/sponza.obj --rounds 3
     ;;
 present)

@@ -548,8 +548,9 @@ void check_options(const RaysOptions& options) {
     const float3 points[] = {options.eye, options.look, options.up, options.light};
     for (const float3& p : points)
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            throw Error("bench rays: the camera (eye, look, up, light) has a value that is not "
-                        "a finite number");
+            throw Error(
+                "bench rays: the camera (eye, look, up, light) has a value that is not "
+                "a finite number");
     const float3 view = options.look - options.eye;
     if (dot(view, view) == 0.0f || dot(options.up, options.up) == 0.0f)
         throw Error("bench rays: the camera's eye and look are the same point, or up is zero; "

@@ -4,22 +4,20 @@
 Makes shared/BENCH.md's primary, shadow and diffuse rays for a scene's cameras.txt viewpoint
 in numpy (the formulas of bench/bench_rays.cpp, operation for operation in float32), times
 mesh.intersect / mesh.occluded on them (the median of --repeat passes after a warm-up, each
-pass the whole call: arrays in, engine launch, arrays out), and runs `lucent bench rays
---json` on the same scene, alternating the two --rounds times on the same machine. Prints
-both engines' Mrays/s, the ratio per ray kind (the median of the rounds' ratios) and both
-engines' checksums, which agree when the rays are the same.
+pass the whole call: arrays in, engine launch, arrays out), and runs `lucent bench rays`
+on the same scene through lucent.bench_rays, alternating the two --rounds times on the same
+machine. Prints both engines' Mrays/s, the ratio per ray kind (the median of the rounds'
+ratios) and both engines' checksums, which agree when the rays are the same.
 
-    bench_rays.py --scene ../shared/scenes/sponza.obj --lucent build/lucent [--backend cpu]
+    bench_rays.py --scene ../shared/scenes/sponza.obj [--backend cpu]
 
 With --backend cuda the Python figures include the copies to the GPU and back; `lucent
 bench rays --backend cuda` times its kernels alone (at its own 3840x2160; pass --size
 3840x2160 for the same rays).
 """
 import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -127,8 +125,6 @@ def timed(fn, count, repeat):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", default=os.path.join(os.environ.get("LUCENT_SCENES_DIR", "../shared/scenes"), "sponza.obj"))
-    parser.add_argument("--lucent", default=os.environ.get("LUCENT_CLI", "build/lucent"),
-                        help="the lucent CLI to run `bench rays` with")
     parser.add_argument("--backend", default="cpu", choices=["cpu", "cuda", "auto"])
     parser.add_argument("--size", default=None, help="WxH (default: 1024x768 on the CPU, 3840x2160 on the GPU)")
     parser.add_argument("--repeat", type=int, default=5)
@@ -153,12 +149,10 @@ def main():
     print(f"scene {args.scene}: {mesh.triangle_count} triangles, {w}x{h}, {mesh.backend}, "
           f"lucent {lucent.__version__} from {Path(lucent.__file__).parent}")
 
-    cli = [args.lucent, "bench", "rays", "--scene", args.scene, "--json", "--repeat", str(args.repeat),
-           "--size", size]
-    if args.backend != "cpu":
-        cli += ["--backend", "cuda"]
-    if args.threads:
-        cli += ["--threads", str(args.threads)]
+    # `lucent bench rays --json`'s document, measured in this process (Embree beside it).
+    def bench_rays():
+        return lucent.bench_rays(args.scene, size=(w, h), repeat=args.repeat, threads=args.threads,
+                                 backend="cpu" if args.backend == "cpu" else "cuda")
     rates = {k: [] for k in ("primary", "shadow", "diffuse")}
     bench = {k: [] for k in rates}
     embree = {k: [] for k in rates}
@@ -171,7 +165,7 @@ def main():
             rates[k].append(timed(call, count, args.repeat))
             if mesh.last_launch.kernel_ms > 0:
                 kernel[k].append(count / mesh.last_launch.kernel_ms * 1e-3)
-        result = json.loads(subprocess.run(cli, check=True, capture_output=True, text=True).stdout)
+        result = bench_rays()
         engine = result["lucent"]
         for k in rates:
             bench[k].append(engine[k]["mrays"])

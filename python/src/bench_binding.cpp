@@ -56,7 +56,8 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
                                                    {"fov", fov.has_value()},
                                                    {"light", !light.is_none()}};
     std::string given, missing;
-    for (const auto& [name, is_given] : camera) (is_given ? given : missing) += std::string(" ") + name;
+    for (const auto& [name, is_given] : camera)
+        (is_given ? given : missing) += std::string(" ") + name;
     if (!given.empty() && !missing.empty())
         throw py::value_error("bench_rays: the camera keywords go together: given" + given +
                               ", missing" + missing +
