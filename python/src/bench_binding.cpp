@@ -35,8 +35,17 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
                       const std::string& builder, const py::object& eye, const py::object& look,
                       const py::object& up, const std::optional<float>& fov,
                       const py::object& light) {
+    const py::module_ os = py::module_::import("os");
+    if (!py::isinstance<py::str>(scene) && !py::isinstance(scene, os.attr("PathLike")))
+        throw py::type_error(
+            "bench_rays: scene must be an OBJ file's path (str or os.PathLike); got " +
+            py::repr(scene).cast<std::string>());
+    const py::object path = os.attr("fspath")(scene);
+    if (!py::isinstance<py::str>(path))
+        throw py::type_error("bench_rays: scene must be a text path, not bytes; got " +
+                             py::repr(scene).cast<std::string>());
     bench::RaysOptions options;
-    options.scene = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
+    options.scene = path.cast<std::string>();
     options.width = size.first;
     options.height = size.second;
     options.repeat = repeat;

@@ -65,6 +65,12 @@ def test_bad_arguments_name_the_argument(kwargs, error, words):
     assert words in str(e.value)
 
 
+@pytest.mark.parametrize("scene", [3, b"room.obj", None])
+def test_a_scene_that_is_not_a_path_is_a_type_error(scene):
+    with pytest.raises(TypeError, match="bench_rays: scene must be"):
+        lucent.bench_rays(scene)
+
+
 def test_a_missing_scene_is_named(tmp_path):
     missing = tmp_path / "nothing.obj"
     with pytest.raises(lucent.Error, match="nothing.obj"):
