@@ -18,16 +18,7 @@ namespace {
 
 /// A camera keyword (eye, look, up, light): three numbers.
 float3 camera_point(const py::object& value, const char* name) {
-    std::vector<double> v;
-    try {
-        v = value.cast<std::vector<double>>();
-    } catch (const py::cast_error&) {
-    }
-    if (v.size() != 3)
-        throw py::value_error(std::string("bench_rays: ") + name +
-                              " must be three numbers (x, y, z); got " +
-                              py::repr(value).cast<std::string>());
-    return make_float3(float(v[0]), float(v[1]), float(v[2]));
+    return three_numbers(value, std::string("bench_rays: ") + name);
 }
 
 py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> size, int repeat,

@@ -32,6 +32,10 @@ PyObject* rank_error_type();
 /// naming `what` otherwise (ranks_binding.cpp).
 std::shared_ptr<Ranks> ranks_argument(const py::object& ranks, const char* what);
 
+/// A point or vector keyword (a camera's eye, look, up, light): three numbers; a ValueError
+/// "<what> must be three numbers (x, y, z); got ..." otherwise (samples_binding.cpp).
+float3 three_numbers(const py::handle& value, const std::string& what);
+
 /// "auto", "cpu" or "cuda"; a ValueError naming `what` otherwise.
 BackendKind backend_kind(const std::string& name, const char* what);
 

@@ -17,6 +17,18 @@
 
 namespace lucent::python {
 
+float3 three_numbers(const py::handle& value, const std::string& what) {
+    std::vector<double> v;
+    try {
+        v = value.cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+    }
+    if (v.size() != 3)
+        throw py::value_error(what + " must be three numbers (x, y, z); got " +
+                              py::repr(value).cast<std::string>());
+    return make_float3(float(v[0]), float(v[1]), float(v[2]));
+}
+
 namespace {
 
 std::string option_text(const py::handle& value) {
@@ -28,16 +40,7 @@ std::string option_text(const py::handle& value) {
 /// A camera keyword (eye, look, up): None, or three numbers.
 std::optional<float3> camera_point(const py::object& value, const char* name) {
     if (value.is_none()) return std::nullopt;
-    std::vector<double> v;
-    try {
-        v = value.cast<std::vector<double>>();
-    } catch (const py::cast_error&) {
-    }
-    if (v.size() != 3)
-        throw py::value_error(std::string("render: ") + name +
-                              " must be three numbers (x, y, z); got " +
-                              py::repr(value).cast<std::string>());
-    return make_float3(float(v[0]), float(v[1]), float(v[2]));
+    return three_numbers(value, std::string("render: ") + name);
 }
 
 py::object render(const std::string& name, const std::optional<std::string>& scene,
