@@ -208,6 +208,18 @@ PY
         fail "$name: the installed lucent bench rays failed (log: $work/logs/$name-cli.log)"
       fi
       grep -q "^primary " "$log" || fail "$name: no primary row in its table"
+      # Its build line (bench_build_json) against the installed `lucent bench build --json`:
+      # the same tree, so the same SAH cost and node count.
+      local build_json=$work/out/$name-build-cli.json
+      if "$prefix/bin/lucent" bench build --scene "$root/examples/bench-rays/room.obj" --repeat 1 \
+           --no-peer --json > "$build_json" 2> "$work/logs/$name-build-cli.log"; then
+        local expected
+        expected=$(python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print("sah_cost %s, %s wide nodes" % (d["sah_cost"], d["wide_nodes"]))' "$build_json")
+        grep -q "^build .*$expected" "$log" ||
+          fail "$name: its build line is not the CLI's tree ('$expected'): $(grep '^build' "$log")"
+      else
+        fail "$name: the installed lucent bench build failed (log: $work/logs/$name-build-cli.log)"
+      fi
       "$bin" --scene "$work/out/no-such-scene.obj" > /dev/null 2>&1
       local rc=$?
       [ $rc -eq 1 ] || fail "$name --scene (missing file): exit $rc, expected 1"

@@ -1,13 +1,16 @@
 // `lucent bench build`: TriangleAccel build time on an OBJ, beside Embree's on the same mesh.
 #include <algorithm>
 #include <cstdio>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "accel/triangle_accel.h"
 #include "bench/build/build_bench.h"
 #include "bench/common/bench_camera.h"
 #include "bench/common/embree_peer.h"
+#include "bench/common/option_checks.h"
 #include "bench/common/rate.h"
 #include "bench/common/report.h"
 #include "lucent/error.h"
@@ -89,10 +92,27 @@ void print_text(const BuildResult& r) {
     }
 }
 
+void check_options(const BuildBenchOptions& options) {
+    if (options.scene.empty())
+        throw Error("bench build: no scene (scene, --scene); give an OBJ file's path");
+    require_in_range("bench build", "repeat (--repeat)", options.repeat, 1, 1000);
+    require_in_range("bench build", "threads (--threads)", options.threads, 0, 4096);
+    // Each level makes four times the triangles: sponza at 5 has 269M.
+    require_in_range("bench build", "subdivide (--subdivide)", options.subdivide, 0, 5);
+    if (options.backend != "cpu" && options.backend != "cuda")
+        throw Error("bench build: backend (--backend) is \"" + options.backend +
+                    "\"; use \"cpu\" or \"cuda\"");
+    require_image_size("bench build", options.width, options.height);
+}
+
 }  // namespace
 
+std::string bench_build_json(BuildBenchOptions options) {
+    return captured_document("bench build", std::move(options), run_bench_build);
+}
+
 int run_bench_build(const BuildBenchOptions& options) {
-    if (options.repeat < 1) throw Error("bench build: --repeat must be at least 1");
+    check_options(options);
     const scene::ObjMesh mesh = subdivided(scene::load_obj_mesh(options.scene), options.subdivide);
     const unsigned threads =
         options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());

@@ -17,6 +17,12 @@ struct BuildBenchOptions {
     unsigned width = 3840, height = 2160;  // --backend cuda: the rays both trees trace
 };
 /// Prints build time (median), Mtris/s, SAH cost and node count, and the peer's build time.
+/// Throws lucent::Error for a bad option (naming it and the fix) or a bad scene (file:line).
 int run_bench_build(const BuildBenchOptions& options);
+
+/// What run_bench_build measures, as the JSON document `lucent bench build --json` prints
+/// (its keys: docs/cli.md, "lucent bench build"), returned instead of printed: `bench build`
+/// from a C++ program (Lucent::bench) and from Python (lucent.bench_build).
+std::string bench_build_json(BuildBenchOptions options);
 
 }  // namespace lucent::bench

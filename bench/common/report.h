@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "lucent/error.h"
+
 #include "bench/common/rate.h"
 
 namespace lucent::bench {
@@ -46,6 +48,20 @@ class JsonCapture {
     std::string m_text;
     JsonCapture* m_outer;
 };
+
+/// A benchmark as a call (bench_rays_json and the others): runs `run(options)` with
+/// options.json set and returns the document it would have printed, printing nothing. A
+/// benchmark reports a failure by throwing, so a run that printed no document is a fault in
+/// it, named by `command`.
+template <class Options, class Run>
+std::string captured_document(const char* command, Options options, Run run) {
+    options.json = true;
+    JsonCapture capture;
+    run(options);
+    if (capture.text().empty())
+        throw Error(std::string(command) + ": the benchmark finished without a result");
+    return capture.text();
+}
 
 /// Prints `result` as JSON (to_json(result), found by argument-dependent lookup) when `json`,
 /// else as text (print_text(result)).

@@ -9,12 +9,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/common/input_buffer.h"
+#include "bench/common/option_checks.h"
 #include "bench/common/rate.h"
 #include "bench/common/report.h"
 #include "bench/curves/curves_programs.h"
+#include "lucent/error.h"
 #include "lucent/lucent.h"
 #include "samples/stages.h"
 #include "scene/hair_strands.h"
@@ -34,9 +38,21 @@ const char* type_name(CurveType type) {
     }
 }
 
+void check_options(const CurvesBenchOptions& options) {
+    require_in_range("bench curves", "segments (--segments)", options.segments, 1, 16777216);
+    require_in_range("bench curves", "repeat (--repeat)", options.repeat, 1, 1000);
+    require_in_range("bench curves", "threads (--threads)", options.threads, 0, 4096);
+    require_image_size("bench curves", options.width, options.height);
+}
+
 }  // namespace
 
+std::string bench_curves_json(CurvesBenchOptions options) {
+    return captured_document("bench curves", std::move(options), run_curves_bench);
+}
+
 int run_curves_bench(const CurvesBenchOptions& options) {
+    check_options(options);
     scene::HairStyle style;  // the unit head at the origin
     style.segments = options.segments;
     style.type = options.type;
@@ -113,13 +129,9 @@ int run_curves_bench(const CurvesBenchOptions& options) {
         ctx.launch(1, options.width, options.height);
         diffuse_launches.add(ctx.last_launch());
     }
-    if (primary_launches.ms.empty() || diffuse_launches.ms.empty()) {
-        std::fprintf(stderr,
-                     "lucent bench curves: the launch-shape tuning was still trying shapes "
-                     "after %d launches of each entry; no steady launch to time\n",
-                     most);
-        return 1;
-    }
+    if (primary_launches.ms.empty() || diffuse_launches.ms.empty())
+        throw Error("bench curves: the launch-shape tuning was still trying shapes after " +
+                    std::to_string(most) + " launches of each entry; no steady launch to time");
     const auto rates = [&](const samples::SteadyLaunches& launches, double rays) {
         std::vector<double> out;
         for (size_t i = 0; i < launches.ms.size() && out.size() < repeat; ++i)

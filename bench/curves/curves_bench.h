@@ -2,6 +2,8 @@
 // built-in curves (issue figures: at least 100K cubic segments at 3840x2160 on the GPU).
 #pragma once
 
+#include <string>
+
 #include "lucent/context.h"
 
 namespace lucent::bench {
@@ -16,7 +18,11 @@ struct CurvesBenchOptions {
     bool json = false;
 };
 
-/// Prints the table (or JSON); returns the exit code.
+/// Prints the table (or JSON) and returns 0; throws lucent::Error for a bad option (naming it).
 int run_curves_bench(const CurvesBenchOptions& options);
+
+/// What run_curves_bench measures, as the JSON document `lucent bench curves --json` prints,
+/// returned instead of printed (Lucent::bench; Python's lucent.bench_curves).
+std::string bench_curves_json(CurvesBenchOptions options);
 
 }  // namespace lucent::bench

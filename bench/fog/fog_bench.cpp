@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "bench/common/option_checks.h"
 #include "bench/common/report.h"
+#include "lucent/error.h"
 #include "samples/fog/fog_scene.h"
 
 namespace lucent::bench {
@@ -55,9 +58,20 @@ void print_text(const FogResult& result) {
                     r.min_ms, r.max_ms);
 }
 
+void check_options(const FogBenchOptions& options) {
+    require_in_range("bench fog", "frames (--frames)", options.frames, 1, 100000);
+    require_in_range("bench fog", "threads (--threads)", options.threads, 0, 4096);
+    require_image_size("bench fog", options.width, options.height);
+}
+
 }  // namespace
 
+std::string bench_fog_json(FogBenchOptions options) {
+    return captured_document("bench fog", std::move(options), run_fog_bench);
+}
+
 int run_fog_bench(const FogBenchOptions& options) {
+    check_options(options);
     struct Configuration {
         const char* name;
         bool fog;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "lucent/context.h"
 
@@ -18,6 +19,11 @@ struct FogBenchOptions {
     std::function<void(unsigned, unsigned)> progress;  // (done, total) frames; may be empty
 };
 
+/// Prints the table (or JSON) and returns 0; throws lucent::Error for a bad option.
 int run_fog_bench(const FogBenchOptions& options);
+
+/// What run_fog_bench measures, as the JSON document `lucent bench fog --json` prints,
+/// returned instead of printed (Lucent::bench; Python's lucent.bench_fog).
+std::string bench_fog_json(FogBenchOptions options);
 
 }  // namespace lucent::bench

@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <map>
 #include <string>
+#include <utility>
 
+#include "bench/common/option_checks.h"
 #include "bench/common/report.h"
+#include "lucent/error.h"
 #include "samples/sample.h"
 #include "samples/igi/igi_frames.h"
 
@@ -135,9 +138,29 @@ void print_text(const IgiResult& result) {
     }
 }
 
+void check_options(const IgiBenchOptions& options) {
+    if (options.scene.empty())
+        throw Error("bench igi: no scene (scene, --scene); give a built-in scene's name "
+                    "(cornell) or a scene file");
+    require_in_range("bench igi", "frames (--frames)", options.frames, 1, 100000);
+    if (options.vpls.empty())
+        throw Error("bench igi: vpls (--vpls) is empty; give at least one VPL count, e.g. 30");
+    for (const unsigned vpls : options.vpls)
+        require_in_range("bench igi", "a VPL count (vpls, --vpls)", vpls, 1, 65536);
+    require_in_range("bench igi", "downsample (--downsample)", options.downsample, 2, 16);
+    require_in_range("bench igi", "interleave (--interleave)", options.interleave, 2, 8);
+    require_in_range("bench igi", "threads (--threads)", options.threads, 0, 4096);
+    require_image_size("bench igi", options.width, options.height);
+}
+
 }  // namespace
 
+std::string bench_igi_json(IgiBenchOptions options) {
+    return captured_document("bench igi", std::move(options), run_igi_bench);
+}
+
 int run_igi_bench(const IgiBenchOptions& options) {
+    check_options(options);
     IgiResult result;
     result.options = &options;
     std::vector<Row>& rows = result.rows;

@@ -30,6 +30,11 @@ struct IgiBenchOptions {
 };
 
 /// Runs every configuration and prints a table (or one JSON object); returns the exit code.
+/// Throws lucent::Error for a bad option (naming it and its range) or scene.
 int run_igi_bench(const IgiBenchOptions& options);
+
+/// What run_igi_bench measures, as the JSON document `lucent bench igi --json` prints,
+/// returned instead of printed (Lucent::bench; Python's lucent.bench_igi).
+std::string bench_igi_json(IgiBenchOptions options);
 
 }  // namespace lucent::bench

@@ -18,6 +18,7 @@
 #include "accel/triangle_accel.h"
 #include "bench/common/bench_camera.h"
 #include "bench/common/embree_peer.h"
+#include "bench/common/option_checks.h"
 #include "bench/common/rate.h"
 #include "bench/common/ray_checksums.h"
 #include "bench/common/report.h"
@@ -535,9 +536,9 @@ namespace {
 void check_options(const RaysOptions& options) {
     if (options.scene.empty())
         throw Error("bench rays: no scene (scene, --scene); give an OBJ file's path");
-    if (options.width == 0 || options.height == 0)
-        throw Error("bench rays: the image size (size, --size) must be at least 1x1");
-    if (options.repeat < 1) throw Error("bench rays: repeat (--repeat) must be at least 1");
+    require_image_size("bench rays", options.width, options.height);
+    require_in_range("bench rays", "repeat (--repeat)", options.repeat, 1, 1000);
+    require_in_range("bench rays", "threads (--threads)", options.threads, 0, 4096);
     if (options.backend != "cpu" && options.backend != "cuda")
         throw Error("bench rays: backend (--backend) is \"" + options.backend +
                     "\"; use \"cpu\" or \"cuda\"");
@@ -559,10 +560,7 @@ void check_options(const RaysOptions& options) {
 }  // namespace
 
 std::string bench_rays_json(RaysOptions options) {
-    options.json = true;
-    JsonCapture capture;
-    run_bench_rays(options);
-    return capture.text();
+    return captured_document("bench rays", std::move(options), run_bench_rays);
 }
 
 int run_bench_rays(const RaysOptions& options) {

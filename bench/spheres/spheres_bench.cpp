@@ -9,12 +9,16 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/common/input_buffer.h"
+#include "bench/common/option_checks.h"
 #include "bench/common/rate.h"
 #include "bench/common/report.h"
 #include "bench/spheres/spheres_programs.h"
+#include "lucent/error.h"
 #include "lucent/lucent.h"
 #include "samples/stages.h"
 
@@ -115,9 +119,21 @@ PathLaunch timed_launch(SpherePath& path, const SpheresBenchOptions& options,
             report.launch_shape_trial};
 }
 
+void check_options(const SpheresBenchOptions& options) {
+    require_in_range("bench spheres", "count (--count)", options.count, 1, 16777216);
+    require_in_range("bench spheres", "repeat (--repeat)", options.repeat, 1, 1000);
+    require_in_range("bench spheres", "threads (--threads)", options.threads, 0, 4096);
+    require_image_size("bench spheres", options.width, options.height);
+}
+
 }  // namespace
 
+std::string bench_spheres_json(SpheresBenchOptions options) {
+    return captured_document("bench spheres", std::move(options), run_spheres_bench);
+}
+
 int run_spheres_bench(const SpheresBenchOptions& options) {
+    check_options(options);
     const SphereField field = make_field(options.count);
     SpherePath builtin = make_path(options, field, true);
     SpherePath custom = make_path(options, field, false);
@@ -153,13 +169,9 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
         b.push_back(y.mrays);
         ratios.push_back(y.mrays > 0 ? x.mrays / y.mrays : 0.0);
     }
-    if (a.empty()) {
-        std::fprintf(stderr,
-                     "lucent bench spheres: the launch-shape tuning was still trying shapes "
-                     "after %d pairs of launches; no steady launch to time\n",
-                     most);
-        return 1;
-    }
+    if (a.empty())
+        throw Error("bench spheres: the launch-shape tuning was still trying shapes after " +
+                    std::to_string(most) + " pairs of launches; no steady launch to time");
     // The same work: every pixel the same sphere (or none), t to float rounding.
     const unsigned* pa = builtin.prim->data<unsigned>();
     const unsigned* pb = custom.prim->data<unsigned>();
@@ -196,13 +208,10 @@ int run_spheres_bench(const SpheresBenchOptions& options) {
             std::printf("  (after %u launch-shape trial launches, left out)\n", trials);
         std::printf("  pixels whose sphere differs: %u of %u\n", differ, pixels);
     }
-    if (differ > pixels / 10000) {
-        std::fprintf(stderr,
-                     "lucent bench spheres: the two paths disagree on %u pixels; the figures "
-                     "are not of the same work\n",
-                     differ);
-        return 1;
-    }
+    if (differ > pixels / 10000)
+        throw Error("bench spheres: the built-in and the custom-program spheres disagree on " +
+                    std::to_string(differ) + " of " + std::to_string(pixels) +
+                    " pixels; the figures are not of the same work");
     return 0;
 }
 

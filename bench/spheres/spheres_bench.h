@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "lucent/context.h"
 
@@ -18,7 +19,12 @@ struct SpheresBenchOptions {
     bool json = false;
 };
 
-/// Prints the table (or JSON); returns the exit code (1 when the two paths disagree).
+/// Prints the table (or JSON) and returns 0. Throws lucent::Error for a bad option (naming
+/// it), or, after printing, when the two paths disagree on more than one pixel in 10,000.
 int run_spheres_bench(const SpheresBenchOptions& options);
+
+/// What run_spheres_bench measures, as the JSON document `lucent bench spheres --json`
+/// prints, returned instead of printed (Lucent::bench; Python's lucent.bench_spheres).
+std::string bench_spheres_json(SpheresBenchOptions options);
 
 }  // namespace lucent::bench

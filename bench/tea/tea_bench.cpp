@@ -7,8 +7,11 @@
 #include <chrono>
 #include <cstdio>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "bench/common/option_checks.h"
 #include "bench/common/report.h"
 #include "bench/tea/tea_bench_cuda.h"
 #include "lucent/error.h"
@@ -161,9 +164,20 @@ void check_stream_checksums(const TeaResult& r) {
                         "; the GPU made other numbers than the engine's programs");
 }
 
+void check_options(const TeaBenchOptions& options) {
+    require_in_range("bench tea", "megabytes (--megabytes)", options.megabytes, 1, 65536);
+    require_in_range("bench tea", "rounds (--rounds)", options.rounds, 1, 64);
+    require_in_range("bench tea", "threads (--threads)", options.threads, 0, 4096);
+}
+
 }  // namespace
 
+std::string bench_tea_json(TeaBenchOptions options) {
+    return captured_document("bench tea", std::move(options), run_tea_bench);
+}
+
 int run_tea_bench(const TeaBenchOptions& options) {
+    check_options(options);
     Context ctx(ContextOptions{options.backend, options.threads});
     ctx.set_entry_point_count(3);
     ctx.set_ray_generation_program(0,

@@ -21,6 +21,11 @@ struct TeaBenchOptions {
 };
 
 /// Runs both variants and prints MB/s (and an XOR checksum of all output) per variant.
+/// Throws lucent::Error for a bad option (naming it and its range).
 int run_tea_bench(const TeaBenchOptions& options);
+
+/// What run_tea_bench measures, as the JSON document `lucent bench tea --json` prints,
+/// returned instead of printed (Lucent::bench; Python's lucent.bench_tea).
+std::string bench_tea_json(TeaBenchOptions options);
 
 }  // namespace lucent::bench

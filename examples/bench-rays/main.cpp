@@ -2,19 +2,22 @@
 // program, as `lucent bench rays --json` does: the ray sets of shared/BENCH.md (primary rays
 // from the scene's camera, a shadow ray and a cosine-distributed diffuse ray from each hit)
 // traced by Lucent's bare kernels, its ray streams and, with --programs, a program module
-// launched through a Context; Embree traces the same rays on the same threads.
+// launched through a Context; Embree traces the same rays on the same threads. Then it times
+// the scene's BVH build beside Embree's, as `lucent bench build --json` does.
 //
 //   bench-rays [--scene FILE.obj] [--size WxH] [--repeat N] [--programs]
 //              [--backend cpu|cuda] [--out FILE.json]
 //
 // The camera comes from cameras.txt beside the scene (room.obj, the default scene, has
-// one). Prints a table of Mrays/s and ratios; --out writes the whole document.
+// one). Prints a table of Mrays/s and ratios and a line for the build; --out writes the
+// rays' whole document.
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bench/build/build_bench.h"
 #include "bench/rays/rays_bench.h"
 #include "lucent/error.h"
 
@@ -72,6 +75,18 @@ bool parse_args(int argc, char** argv, Arguments& a) {
     return true;
 }
 
+/// The build's line: Lucent's tree (its SAH cost and size, which `lucent bench build` on the
+/// same scene gives too) and the median build time, beside Embree's when it ran.
+void print_build(const nlohmann::json& b) {
+    std::printf("build    %s triangles, sah_cost %s, %s wide nodes, %.2f ms", b["triangles"].dump().c_str(),
+                b["sah_cost"].dump().c_str(), b["wide_nodes"].dump().c_str(),
+                b["build_ms"].get<double>());
+    if (b.contains("embree_build_ms"))
+        std::printf(", Embree %.2f ms, %.2fx", b["embree_build_ms"].get<double>(),
+                    b["ratio"].get<double>());
+    std::printf("\n");
+}
+
 /// One row: a ray kind's Mrays/s for each engine the document has, and the ratios.
 void print_row(const nlohmann::json& d, const char* kind) {
     auto rate = [&](const nlohmann::json& engine) {
@@ -105,6 +120,13 @@ int main(int argc, char** argv) {
         if (d.contains("checksums_agree"))
             std::printf("checksums agree with Embree: %s\n",
                         d["checksums_agree"].get<bool>() ? "yes" : "no");
+        // The CPU's build (with --backend cuda, `bench build` times the GPU builder instead;
+        // its document has other keys).
+        lucent::bench::BuildBenchOptions build;
+        build.scene = args.options.scene;
+        build.repeat = args.options.repeat;
+        build.threads = args.options.threads;
+        print_build(nlohmann::json::parse(lucent::bench::bench_build_json(build)));
         if (!args.out.empty()) {
             std::ofstream out(args.out, std::ios::binary);
             out << text;

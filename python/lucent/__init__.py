@@ -11,7 +11,8 @@
 - Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
   FLIP, as ``lucent compare``).
 - Speed: ``bench_rays("sponza.obj", programs=True)`` measures as ``lucent bench rays --json``
-  and returns its document as a dict.
+  and returns its document as a dict; ``bench_build``, ``bench_spheres``, ``bench_curves``,
+  ``bench_igi``, ``bench_fog`` and ``bench_tea`` do the same for the other benchmarks.
 
 docs/python.md in the repository is the tutorial.
 """
@@ -64,7 +65,13 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     Transform,
     TriangleMesh,
     __version__,
+    bench_build,
+    bench_curves,
+    bench_fog,
+    bench_igi,
     bench_rays,
+    bench_spheres,
+    bench_tea,
     compare,
     cuda_built,
     modules,

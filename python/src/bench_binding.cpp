@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -26,17 +27,8 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
                       const std::string& builder, const py::object& eye, const py::object& look,
                       const py::object& up, const std::optional<float>& fov,
                       const py::object& light) {
-    const py::module_ os = py::module_::import("os");
-    if (!py::isinstance<py::str>(scene) && !py::isinstance(scene, os.attr("PathLike")))
-        throw py::type_error(
-            "bench_rays: scene must be an OBJ file's path (str or os.PathLike); got " +
-            py::repr(scene).cast<std::string>());
-    const py::object path = os.attr("fspath")(scene);
-    if (!py::isinstance<py::str>(path))
-        throw py::type_error("bench_rays: scene must be a text path, not bytes; got " +
-                             py::repr(scene).cast<std::string>());
     bench::RaysOptions options;
-    options.scene = path.cast<std::string>();
+    options.scene = scene_path(scene, "bench_rays", "an OBJ file's path");
     options.width = size.first;
     options.height = size.second;
     options.repeat = repeat;
@@ -70,15 +62,31 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
         options.fov = *fov;
         options.light = camera_point(light, "light");
     }
-    std::string document;
-    {
-        py::gil_scoped_release release;
-        document = bench::bench_rays_json(options);
-    }
-    return py::module_::import("json").attr("loads")(document);
+    return document_of([&] { return bench::bench_rays_json(options); });
 }
 
 }  // namespace
+
+std::string scene_path(const py::object& scene, const char* call, const char* what) {
+    const py::module_ os = py::module_::import("os");
+    if (!py::isinstance<py::str>(scene) && !py::isinstance(scene, os.attr("PathLike")))
+        throw py::type_error(std::string(call) + ": scene must be " + what +
+                             " (str or os.PathLike); got " + py::repr(scene).cast<std::string>());
+    const py::object path = os.attr("fspath")(scene);
+    if (!py::isinstance<py::str>(path))
+        throw py::type_error(std::string(call) + ": scene must be a text path, not bytes; got " +
+                             py::repr(scene).cast<std::string>());
+    return path.cast<std::string>();
+}
+
+py::object document_of(const std::function<std::string()>& measure) {
+    std::string document;
+    {
+        py::gil_scoped_release release;  // the benchmark runs no Python
+        document = measure();
+    }
+    return py::module_::import("json").attr("loads")(document);
+}
 
 void bind_bench(py::module_& m) {
     m.def("bench_rays", &bench_rays, py::arg("scene"), py::kw_only(),

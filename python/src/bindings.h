@@ -23,7 +23,15 @@ void bind_programs(py::module_& m);        // programs_binding.cpp
 void bind_triangle_mesh(py::module_& m);   // mesh_binding.cpp
 void bind_samples(py::module_& m);         // samples_binding.cpp
 void bind_images(py::module_& m);          // images_binding.cpp
-void bind_bench(py::module_& m);           // bench_binding.cpp
+void bind_bench(py::module_& m);           // bench_binding.cpp: bench_rays
+void bind_bench_suite(py::module_& m);     // bench_suite_binding.cpp: the other benchmarks
+
+/// A benchmark's `scene` argument (str or os.PathLike, as text): a TypeError naming `call`
+/// and saying it must be `what` ("an OBJ file's path") otherwise (bench_binding.cpp).
+std::string scene_path(const py::object& scene, const char* call, const char* what);
+/// Runs `measure` (a bench_*_json call) without the GIL and returns its JSON document as
+/// a dict (bench_binding.cpp).
+py::object document_of(const std::function<std::string()>& measure);
 
 /// The class lucent.RankError (module.cpp), for code that tells it from other errors.
 PyObject* rank_error_type();

@@ -73,4 +73,5 @@ PYBIND11_MODULE(_lucent, m) {
     bind_samples(m);
     bind_images(m);
     bind_bench(m);
+    bind_bench_suite(m);
 }
