@@ -20,6 +20,7 @@
 #include "bench/spheres/spheres_bench.h"
 #include "bench/tea/tea_bench.h"
 #include "bindings.h"
+#include "lucent/run_agreed.h"
 
 namespace lucent::python {
 
@@ -88,10 +89,12 @@ py::object bench_curves(const std::string& backend, unsigned threads, unsigned s
 py::object bench_igi(const py::object& scene, const std::string& backend, unsigned threads,
                      std::pair<unsigned, unsigned> size, unsigned frames,
                      std::vector<unsigned> vpls, unsigned downsample, unsigned interleave,
-                     bool reflection_layer) {
+                     bool reflection_layer, const py::object& devices, const py::object& ranks) {
     bench::IgiBenchOptions options;
     options.scene = scene_path(scene, "bench_igi", "a built-in scene's name or a scene file");
     options.backend = backend_kind(backend, "bench_igi: backend");
+    options.devices = device_list(devices);
+    options.ranks = ranks_argument(ranks, "bench_igi: ranks");
     options.threads = threads;
     std::tie(options.width, options.height) = size;
     options.frames = frames;
@@ -99,13 +102,20 @@ py::object bench_igi(const py::object& scene, const std::string& backend, unsign
     options.downsample = downsample;
     options.interleave = interleave;
     options.reflection_layer = reflection_layer;
-    return document_of([&] { return bench::bench_igi_json(options); });
+    return document_of([&] {
+        // Under ranks, a rank's failure is every rank's RankError, as in render().
+        std::string document;
+        run_agreed(options.ranks, [&] { document = bench::bench_igi_json(options); });
+        return document;
+    });
 }
 
 py::object bench_fog(const std::string& backend, unsigned threads,
-                     std::pair<unsigned, unsigned> size, unsigned frames) {
+                     std::pair<unsigned, unsigned> size, unsigned frames,
+                     const py::object& devices) {
     bench::FogBenchOptions options;
     options.backend = backend_kind(backend, "bench_fog: backend");
+    options.devices = device_list(devices);
     options.threads = threads;
     std::tie(options.width, options.height) = size;
     options.frames = frames;
@@ -156,16 +166,20 @@ void bind_bench_suite(py::module_& m) {
           py::arg("size") = std::pair<unsigned, unsigned>{800, 600}, py::arg("frames") = 10u,
           py::arg("vpls") = std::vector<unsigned>{30, 90, 180}, py::arg("downsample") = 4u,
           py::arg("interleave") = 3u, py::arg("reflection_layer") = true,
+          py::arg("devices") = py::none(), py::arg("ranks") = py::none(),
           "Instant global illumination as Marques and Santos measure it (Fig. 4 and 5), as "
           "`lucent bench igi --json`: canonical IGI, then imperfect visibility, downsampling "
           "and interleaving added in turn, each at every VPL count; returns the document "
-          "(frames/s and the stages' ms per configuration) as a dict.");
+          "(frames/s and the stages' ms per configuration) as a dict. devices='0,1' spreads "
+          "each frame's launches over devices, ranks=lucent.Ranks.world() over the ranks of "
+          "mpirun (every rank calls it alike and gets the document).");
     m.def("bench_fog", &bench_fog, py::kw_only(), py::arg("backend") = "cpu",
           py::arg("threads") = 0u, py::arg("size") = std::pair<unsigned, unsigned>{1024, 768},
-          py::arg("frames") = 30u,
+          py::arg("frames") = 30u, py::arg("devices") = py::none(),
           "Sebald's Table 1, as `lucent bench fog --json`: frames/s of the fog tutorial scene "
           "without fog and with fog marched at steps 0.1, 0.05 and 0.01, along one turn of the "
-          "camera's orbit; returns the document as a dict.");
+          "camera's orbit; returns the document as a dict. devices='0,1' spreads each "
+          "frame's launches over devices.");
     m.def("bench_tea", &bench_tea, py::kw_only(), py::arg("backend") = "cpu",
           py::arg("threads") = 0u, py::arg("megabytes") = 2048u, py::arg("rounds") = 2u,
           py::arg("device") = 0u, py::arg("seed") = 0u,

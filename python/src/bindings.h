@@ -44,6 +44,11 @@ std::shared_ptr<Ranks> ranks_argument(const py::object& ranks, const char* what)
 /// "<what> must be three numbers (x, y, z); got ..." otherwise (samples_binding.cpp).
 float3 three_numbers(const py::handle& value, const std::string& what);
 
+/// A `devices=` argument: None (empty: the backend's one device), a string ('0,1', 'cpu,0',
+/// 'all') or a sequence of items ('cpu', 0); lucent.Error naming a bad item
+/// (context_binding.cpp).
+std::vector<DeviceSpec> device_list(const py::object& devices);
+
 /// "auto", "cpu" or "cuda"; a ValueError naming `what` otherwise.
 BackendKind backend_kind(const std::string& name, const char* what);
 

@@ -12,6 +12,18 @@
 
 namespace lucent::python {
 
+std::vector<DeviceSpec> device_list(const py::object& devices) {
+    if (devices.is_none()) return {};
+    std::string list;
+    if (py::isinstance<py::str>(devices)) {
+        list = devices.cast<std::string>();
+    } else {
+        for (const py::handle& d : devices)
+            list += (list.empty() ? "" : ",") + py::str(d).cast<std::string>();
+    }
+    return parse_device_list(list);
+}
+
 namespace {
 
 /// The payload type of a ray type: a type name, or a Program whose payload it takes.
@@ -28,20 +40,6 @@ const TypeInfo& payload_type(const py::handle& payload) {
         return type_by_name(payload.cast<std::string>(), "set_ray_type: payload");
     throw py::type_error("set_ray_type: payload must be a type name or a Program; got " +
                          py::repr(payload).cast<std::string>());
-}
-
-/// A device list from Python: None (empty: the backend's one device), a string ('0,1',
-/// 'cpu,0', 'all') or a sequence of items ('cpu', 0, 'cuda:1' is not an item: 1 is).
-std::vector<DeviceSpec> device_list(const py::object& devices) {
-    if (devices.is_none()) return {};
-    std::string list;
-    if (py::isinstance<py::str>(devices)) {
-        list = devices.cast<std::string>();
-    } else {
-        for (const py::handle& d : devices)
-            list += (list.empty() ? "" : ",") + py::str(d).cast<std::string>();
-    }
-    return parse_device_list(list);
 }
 
 RegisterVariants register_variants(const std::string& name) {

@@ -48,8 +48,8 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
                   unsigned spp, int jit_check_sm, const py::object& eye, const py::object& look,
                   const py::object& up, std::optional<float> fov, std::optional<unsigned> camera,
                   bool denoise, unsigned denoise_passes,
-                  const std::optional<std::vector<std::string>>& aovs, const py::object& ranks,
-                  bool want_report, const py::kwargs& options) {
+                  const std::optional<std::vector<std::string>>& aovs, const py::object& devices,
+                  const py::object& ranks, bool want_report, const py::kwargs& options) {
     samples::RenderSettings settings;
     settings.width = size.first;
     settings.height = size.second;
@@ -75,6 +75,7 @@ py::object render(const std::string& name, const std::optional<std::string>& sce
         throw py::value_error("render: denoise_passes must be 0..10; got " +
                               std::to_string(denoise_passes));
     if (denoise_passes) settings.denoise_options.iterations = denoise_passes;
+    settings.devices = device_list(devices);
     settings.ranks = ranks_argument(ranks, "render: ranks");
     samples::RenderResult result;
     try {
@@ -170,7 +171,8 @@ void bind_samples(py::module_& m) {
           py::arg("eye") = py::none(), py::arg("look") = py::none(), py::arg("up") = py::none(),
           py::arg("fov") = py::none(), py::arg("camera") = py::none(), py::arg("denoise") = false,
           py::arg("denoise_passes") = 0u, py::arg("aovs") = py::none(),
-          py::arg("ranks") = py::none(), py::arg("report") = false,
+          py::arg("devices") = py::none(), py::arg("ranks") = py::none(),
+          py::arg("report") = false,
           "Renders a sample as `lucent render --sample NAME` does: scene (a built-in name or a "
           "file; None: the sample's own), size (width, height), backend, CPU threads, spp "
           "(progressive samples; 0: the sample's default), the camera's eye, look, up (x, y, z) "
@@ -182,7 +184,9 @@ void bind_samples(py::module_& m) {
           "linear RGB image as an (H, W, 4) float32 array, row 0 at the top, alpha 1; with "
           "aovs=['albedo', 'normal', 'depth', 'position', 'instance'] (any of them, --aov) "
           "returns (image, layers): alpha is the coverage and layers maps each EXR channel "
-          "name ('Albedo.R', 'Nx', 'Z', ...) to an (H, W) float32 array. ranks=lucent.Ranks."
+          "name ('Albedo.R', 'Nx', 'Z', ...) to an (H, W) float32 array. devices='0,1' (or "
+          "['cpu', 'cpu'], --devices) spreads every launch over those devices, with the "
+          "image of one (docs/multi-device.md). ranks=lucent.Ranks."
           "world() under mpirun spreads every launch over the ranks (every rank calls render "
           "alike and gets the whole image, the image of one process; a rank's failure is "
           "every rank's lucent.RankError; docs/distributed.md). report=True also returns the "

@@ -118,3 +118,27 @@ def test_a_missing_scene_is_named(tmp_path):
         lucent.bench_build(tmp_path / "nothing.obj")
     with pytest.raises(lucent.Error, match="nothing.json"):
         lucent.bench_igi(tmp_path / "nothing.json", size=(8, 8), frames=1, vpls=[1])
+
+
+@pytest.mark.skipif(BACKEND != "cpu", reason="two CPU devices; the GPUs' spread: gpu-check.sh multi")
+def test_igi_and_fog_spread_over_devices(cli):
+    mine = lucent.bench_fog(size=(48, 32), frames=1, devices=["cpu", "cpu"])
+    theirs = cli_document(cli, "fog", "--size", "48x32", "--frames", "1", "--devices", "cpu,cpu")
+    assert mine["backend"] == theirs["backend"]
+    assert mine["backend"] != lucent.bench_fog(size=(48, 32), frames=1)["backend"]
+    igi = lucent.bench_igi(size=(48, 32), frames=1, vpls=[4], devices="cpu,cpu")
+    assert igi["backend"] == mine["backend"]
+    with pytest.raises(lucent.Error, match="gpu"):
+        lucent.bench_fog(size=(48, 32), frames=1, devices="cpu,gpu")
+
+
+@pytest.mark.skipif(lucent.Ranks.launched_as_rank(), reason="one process alone")
+def test_igi_over_one_rank_measures_the_same_rows():
+    world = lucent.Ranks.world()
+    spread = lucent.bench_igi(size=(48, 32), frames=1, vpls=[4], backend="cpu", ranks=world)
+    alone = lucent.bench_igi(size=(48, 32), frames=1, vpls=[4], backend="cpu")
+    assert [r["configuration"] for r in spread["rows"]] == [r["configuration"] for r in alone["rows"]]
+    with pytest.raises(TypeError, match="bench_igi: ranks must be a lucent.Ranks"):
+        lucent.bench_igi(size=(48, 32), frames=1, vpls=[4], ranks="all")
+    with pytest.raises(lucent.RankError, match=r"^rank 0: .*nothing\.json"):
+        lucent.bench_igi("/nothing.json", size=(8, 8), frames=1, vpls=[1], backend="cpu", ranks=world)

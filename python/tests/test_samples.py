@@ -120,3 +120,14 @@ def test_render_a_gltf_scene_by_path(tmp_path, cli):
     assert red.sum() > 20
     with pytest.raises(Exception, match="--camera 1: scene 'spheres' has 1 camera of its own"):
         lucent.render("direct", scene=str(path), size=(8, 8), backend=BACKEND, camera=1)
+
+
+@pytest.mark.skipif(BACKEND != "cpu", reason="two CPU devices; the GPUs' spread: gpu-check.sh multi")
+def test_render_over_two_devices_is_the_image_of_one():
+    """devices= (--devices): each launch spread over the devices, the image the same."""
+    one = lucent.render("whitted", size=(64, 48), backend="cpu")
+    two, report = lucent.render("whitted", size=(64, 48), backend="cpu", devices=["cpu", "cpu"], report=True)
+    assert two.tobytes() == one.tobytes()
+    assert len(report.devices) == 2
+    with pytest.raises(lucent.Error, match="gpu"):
+        lucent.render("whitted", size=(64, 48), backend="cpu", devices="cpu,gpu")
