@@ -8,6 +8,8 @@
   (H, W, 4) float32 image; ``samples()`` lists them with their options.
 - Processes: ``Context(ranks=Ranks.world())`` and ``render(..., ranks=Ranks.world())``
   spread launches over the ranks of ``mpirun -np N python3 script.py``.
+- TEA (the fog sample's random numbers): ``tea(block, key, rounds)``, ``tea_statistics()``
+  and ``noise("white" | "gradient" | "spectrum")``, as ``lucent tea`` and ``lucent noise``.
 - Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
   FLIP, as ``lucent compare``).
 - Speed: ``bench_rays("sponza.obj", programs=True)`` measures as ``lucent bench rays --json``
@@ -75,8 +77,11 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     compare,
     cuda_built,
     modules,
+    noise,
     read_image,
     render,
     samples,
+    tea,
+    tea_statistics,
     types,
 )

@@ -25,6 +25,7 @@ void bind_samples(py::module_& m);         // samples_binding.cpp
 void bind_images(py::module_& m);          // images_binding.cpp
 void bind_bench(py::module_& m);           // bench_binding.cpp: bench_rays
 void bind_bench_suite(py::module_& m);     // bench_suite_binding.cpp: the other benchmarks
+void bind_tea(py::module_& m);             // tea_binding.cpp: tea, tea_statistics, noise
 
 /// A benchmark's `scene` argument (str or os.PathLike, as text): a TypeError naming `call`
 /// and saying it must be `what` ("an OBJ file's path") otherwise (bench_binding.cpp).

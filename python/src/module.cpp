@@ -74,4 +74,5 @@ PYBIND11_MODULE(_lucent, m) {
     bind_images(m);
     bind_bench(m);
     bind_bench_suite(m);
+    bind_tea(m);
 }
