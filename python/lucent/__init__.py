@@ -10,8 +10,8 @@
   spread launches over the ranks of ``mpirun -np N python3 script.py``.
 - TEA (the fog sample's random numbers): ``tea(block, key, rounds)``, ``tea_statistics()``
   and ``noise("white" | "gradient" | "spectrum")``, as ``lucent tea`` and ``lucent noise``.
-- Images: ``read_image(path)`` and ``compare(reference, test)`` (RMSE, relative MSE, PSNR and
-  FLIP, as ``lucent compare``).
+- Images: ``read_image(path)``, ``write_image(path, image)`` and ``compare(reference,
+  test)`` (RMSE, relative MSE, PSNR and FLIP, as ``lucent compare``).
 - Speed: ``bench_rays("sponza.obj", programs=True)`` measures as ``lucent bench rays --json``
   and returns its document as a dict; ``bench_build``, ``bench_spheres``, ``bench_curves``,
   ``bench_igi``, ``bench_fog`` and ``bench_tea`` do the same for the other benchmarks.
@@ -84,4 +84,5 @@ from ._lucent import (  # noqa: F401  (the extension is the whole API)
     tea,
     tea_statistics,
     types,
+    write_image,
 )

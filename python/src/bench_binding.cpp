@@ -28,7 +28,7 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
                       const py::object& up, const std::optional<float>& fov,
                       const py::object& light) {
     bench::RaysOptions options;
-    options.scene = scene_path(scene, "bench_rays", "an OBJ file's path");
+    options.scene = path_argument(scene, "bench_rays", "scene", "an OBJ file's path");
     options.width = size.first;
     options.height = size.second;
     options.repeat = repeat;
@@ -67,15 +67,17 @@ py::object bench_rays(const py::object& scene, std::pair<unsigned, unsigned> siz
 
 }  // namespace
 
-std::string scene_path(const py::object& scene, const char* call, const char* what) {
+std::string path_argument(const py::object& value, const char* call, const char* name,
+                          const char* what) {
     const py::module_ os = py::module_::import("os");
-    if (!py::isinstance<py::str>(scene) && !py::isinstance(scene, os.attr("PathLike")))
-        throw py::type_error(std::string(call) + ": scene must be " + what +
-                             " (str or os.PathLike); got " + py::repr(scene).cast<std::string>());
-    const py::object path = os.attr("fspath")(scene);
+    const std::string named = std::string(call) + ": " + name;
+    if (!py::isinstance<py::str>(value) && !py::isinstance(value, os.attr("PathLike")))
+        throw py::type_error(named + " must be " + what + " (str or os.PathLike); got " +
+                             py::repr(value).cast<std::string>());
+    const py::object path = os.attr("fspath")(value);
     if (!py::isinstance<py::str>(path))
-        throw py::type_error(std::string(call) + ": scene must be a text path, not bytes; got " +
-                             py::repr(scene).cast<std::string>());
+        throw py::type_error(named + " must be a text path, not bytes; got " +
+                             py::repr(value).cast<std::string>());
     return path.cast<std::string>();
 }
 

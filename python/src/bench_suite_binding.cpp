@@ -39,7 +39,7 @@ std::pair<unsigned, unsigned> size_or(const ImageSize& size, std::pair<unsigned,
 py::object bench_build(const py::object& scene, int repeat, unsigned threads, bool peer,
                        const std::string& backend, unsigned subdivide, const ImageSize& size) {
     bench::BuildBenchOptions options;
-    options.scene = scene_path(scene, "bench_build", "an OBJ file's path");
+    options.scene = path_argument(scene, "bench_build", "scene", "an OBJ file's path");
     options.repeat = repeat;
     options.threads = threads;
     options.peer = peer;
@@ -91,7 +91,7 @@ py::object bench_igi(const py::object& scene, const std::string& backend, unsign
                      std::vector<unsigned> vpls, unsigned downsample, unsigned interleave,
                      bool reflection_layer, const py::object& devices, const py::object& ranks) {
     bench::IgiBenchOptions options;
-    options.scene = scene_path(scene, "bench_igi", "a built-in scene's name or a scene file");
+    options.scene = path_argument(scene, "bench_igi", "scene", "a built-in scene's name or a scene file");
     options.backend = backend_kind(backend, "bench_igi: backend");
     options.devices = device_list(devices);
     options.ranks = ranks_argument(ranks, "bench_igi: ranks");

@@ -27,9 +27,10 @@ void bind_bench(py::module_& m);           // bench_binding.cpp: bench_rays
 void bind_bench_suite(py::module_& m);     // bench_suite_binding.cpp: the other benchmarks
 void bind_tea(py::module_& m);             // tea_binding.cpp: tea, tea_statistics, noise
 
-/// A benchmark's `scene` argument (str or os.PathLike, as text): a TypeError naming `call`
-/// and saying it must be `what` ("an OBJ file's path") otherwise (bench_binding.cpp).
-std::string scene_path(const py::object& scene, const char* call, const char* what);
+/// A path argument (str or os.PathLike, as text): a TypeError "<call>: <name> must be <what>
+/// (str or os.PathLike); got ..." otherwise (bench_binding.cpp).
+std::string path_argument(const py::object& value, const char* call, const char* name,
+                          const char* what);
 /// Runs `measure` (a bench_*_json call) without the GIL and returns its JSON document as
 /// a dict (bench_binding.cpp).
 py::object document_of(const std::function<std::string()>& measure);

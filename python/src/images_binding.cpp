@@ -1,5 +1,6 @@
 // Images from Python: lucent.read_image(path) and lucent.compare(reference, test), as
-// `lucent compare` (scene/image_compare.h) reads and compares them.
+// `lucent compare` (scene/image_compare.h) reads and compares them, and
+// lucent.write_image(path, image, layers), as `lucent render --out` writes its images.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -11,7 +12,9 @@
 
 #include "array_args.h"
 #include "bindings.h"
+#include "scene/exr_encoder.h"
 #include "scene/image_compare.h"
+#include "scene/image_io.h"
 #include "scene/image_read.h"
 
 namespace lucent::python {
@@ -22,6 +25,32 @@ py::array_t<float> image_array(const scene::Image& image) {
     py::array_t<float> out({py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(3)});
     std::memcpy(out.mutable_data(), image.pixels.data(), image.pixels.size() * sizeof(float3));
     return out;
+}
+
+/// An (H, W, 3) or (H, W, 4) float array of linear RGB (alpha ignored); a TypeError or
+/// ValueError "<call>: <name> must be ..." otherwise.
+scene::Image image_from_array(const py::handle& value, const std::string& call, const char* name) {
+    if (!py::isinstance<py::array>(value))
+        throw py::type_error(call + ": " + name +
+                             " must be an (H, W, 3) or (H, W, 4) float array; got " +
+                             py::repr(value).cast<std::string>());
+    const py::array a = py::reinterpret_borrow<py::array>(value);
+    if (a.dtype().kind() != 'f')
+        throw py::type_error(call + ": " + name + " must be a float array (linear RGB); got " +
+                             describe_array(a));
+    if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) == 0 || a.shape(1) == 0)
+        throw py::value_error(call + ": " + name + " must be an (H, W, 3) or (H, W, 4) array; got " +
+                              describe_array(a));
+    const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
+    scene::Image image;
+    image.height = unsigned(a.shape(0));
+    image.width = unsigned(a.shape(1));
+    const size_t channels = size_t(a.shape(2));
+    const float* p = f.data();
+    image.pixels.resize(size_t(image.width) * image.height);
+    for (size_t i = 0; i < image.pixels.size(); ++i, p += channels)
+        image.pixels[i] = make_float3(p[0], p[1], p[2]);
+    return image;
 }
 
 /// A path (str or os.PathLike: read as `lucent compare` reads it) or an (H, W, 3) or
@@ -37,23 +66,48 @@ scene::Image image_argument(const py::handle& value, const char* name) {
         throw py::type_error(std::string("compare: ") + name +
                              " must be a file path or an (H, W, 3) or (H, W, 4) float array; got " +
                              py::repr(value).cast<std::string>());
-    const py::array a = py::reinterpret_borrow<py::array>(value);
-    if (a.dtype().kind() != 'f')
-        throw py::type_error(std::string("compare: ") + name +
-                             " must be a float array (linear RGB); got " + describe_array(a));
-    if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) == 0 || a.shape(1) == 0)
-        throw py::value_error(std::string("compare: ") + name +
-                              " must be an (H, W, 3) or (H, W, 4) array; got " + describe_array(a));
-    const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
-    scene::Image image;
-    image.height = unsigned(a.shape(0));
-    image.width = unsigned(a.shape(1));
-    const size_t channels = size_t(a.shape(2));
-    const float* p = f.data();
-    image.pixels.resize(size_t(image.width) * image.height);
-    for (size_t i = 0; i < image.pixels.size(); ++i, p += channels)
-        image.pixels[i] = make_float3(p[0], p[1], p[2]);
-    return image;
+    return image_from_array(value, "compare", name);
+}
+
+/// Writes `image` (and, to an .exr, `layers`: {channel name: (H, W) float array}, as
+/// render(aovs=...) returns them, and with `alpha` its 4th channel as A) through scene::write_image: a temporary file renamed into
+/// place, so a failure leaves no partial file.
+void write_image(const py::object& path, const py::handle& image, const py::object& layers,
+                 bool alpha) {
+    const std::string file = path_argument(path, "write_image", "path", "an image file's path");
+    const scene::Image pixels = image_from_array(image, "write_image", "image");
+    scene::ExrExtras extras;
+    if (alpha) {
+        // The coverage render(aovs=...) returns in the 4th channel, as `lucent render --aov`
+        // writes it: the EXR's A channel.
+        const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(image);
+        if (a.shape(2) != 4)
+            throw py::value_error("write_image: alpha=True needs an (H, W, 4) image; got " +
+                                  describe_array(a));
+        std::vector<float> values(size_t(pixels.width) * pixels.height);
+        for (size_t i = 0; i < values.size(); ++i) values[i] = a.data()[4 * i + 3];
+        extras.channels.push_back({"A", std::move(values)});
+    }
+    if (!layers.is_none()) {
+        if (!py::isinstance<py::dict>(layers))
+            throw py::type_error("write_image: layers must be a dict {channel name: (H, W) float "
+                                 "array}, as render(aovs=...) returns; got " +
+                                 py::repr(layers).cast<std::string>());
+        for (const auto& [key, value] : layers.cast<py::dict>()) {
+            const std::string name = py::str(key).cast<std::string>();
+            const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+            if (!a || a.ndim() != 2 || size_t(a.shape(0)) != pixels.height ||
+                size_t(a.shape(1)) != pixels.width)
+                throw py::value_error("write_image: layer '" + name + "' must be a (" +
+                                      std::to_string(pixels.height) + ", " +
+                                      std::to_string(pixels.width) +
+                                      ") float array, the image's height and width; got " +
+                                      py::repr(value).cast<std::string>());
+            extras.channels.push_back({name, std::vector<float>(a.data(), a.data() + a.size())});
+        }
+    }
+    py::gil_scoped_release release;
+    scene::write_image(file, pixels, extras);
 }
 
 py::dict compare(const py::handle& reference, const py::handle& test, std::optional<double> ppd) {
@@ -86,6 +140,14 @@ void bind_images(py::module_& m) {
         py::arg("path"),
         "Reads .exr, .pfm, .hdr (linear) or .png, .jpg, .bmp, .tga (decoded from sRGB) as an "
         "(H, W, 3) float32 array of linear RGB, row 0 at the top.");
+    m.def("write_image", &write_image, py::arg("path"), py::arg("image"), py::kw_only(),
+          py::arg("layers") = py::none(), py::arg("alpha") = false,
+          "Writes an (H, W, 3) or (H, W, 4) float array of linear RGB (row 0 at the top; "
+          "alpha dropped) as `lucent render --out` does, by the path's extension: .png (8-bit "
+          "sRGB), .pfm (32-bit float) or .exr (OpenEXR, float), through a temporary file, so "
+          "that a failure leaves no partial file. layers ({channel: (H, W) array}, as "
+          "render(aovs=...) returns) go into an .exr beside R, G, B, and with alpha=True the "
+          "image's 4th channel as A (the coverage render(aovs=...) returns).");
     m.def("compare", &compare, py::arg("reference"), py::arg("test"), py::kw_only(),
           py::arg("ppd") = py::none(),
           "Compares a test image with a reference as `lucent compare` does. Each is a file path "

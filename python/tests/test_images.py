@@ -1,6 +1,7 @@
 """lucent.read_image and lucent.compare give what `lucent compare` gives, on files and on
 arrays, and refuse bad arguments by name."""
 import json
+import struct
 import subprocess
 
 import numpy as np
@@ -67,3 +68,74 @@ def test_the_path_tracer_converges_by_flip_and_relmse():
     for coarse, fine in zip(errors, errors[1:]):
         assert fine["flip_mean"] < coarse["flip_mean"]
         assert fine["relmse"] < coarse["relmse"]
+
+
+def test_write_image_writes_what_read_image_reads(tmp_path):
+    image = lucent.render("whitted", size=(40, 30), backend="cpu")
+    lucent.write_image(tmp_path / "w.pfm", image)
+    np.testing.assert_array_equal(lucent.read_image(tmp_path / "w.pfm"), image[:, :, :3])
+    lucent.write_image(str(tmp_path / "w.exr"), image[:, :, :3])
+    np.testing.assert_array_equal(lucent.read_image(tmp_path / "w.exr"), image[:, :, :3])
+    lucent.write_image(tmp_path / "w.png", image)
+    assert lucent.compare(tmp_path / "w.png", image)["psnr_db"] > 40  # 8-bit sRGB
+
+
+def exr_channels(path):
+    """The channel names of an OpenEXR file's header (its "channels" chlist attribute)."""
+    data = path.read_bytes()
+    pos = 8  # magic number and version
+    while data[pos] != 0:
+        end = data.index(b"\0", pos)
+        name, pos = data[pos:end].decode(), end + 1
+        pos = data.index(b"\0", pos) + 1  # the attribute's type name
+        size, = struct.unpack_from("<i", data, pos)
+        pos += 4
+        if name == "channels":
+            names = []
+            while data[pos] != 0:
+                end = data.index(b"\0", pos)
+                names.append(data[pos:end].decode())
+                pos = end + 1 + 16  # pixel type, pLinear and reserved, x and y sampling
+            return sorted(names)
+        pos += size
+    return []
+
+
+def test_write_image_puts_the_layers_into_an_exr(tmp_path, cli):
+    image, layers = lucent.render("direct", size=(32, 24), backend="cpu", aovs=["depth", "normal"])
+    lucent.write_image(tmp_path / "d.exr", image, layers=layers, alpha=True)
+    subprocess.run([cli, "render", "--sample", "direct", "--size", "32x24", "--backend", "cpu", "--aov",
+                    "depth,normal", "--out", str(tmp_path / "cli.exr")], capture_output=True, check=True)
+    assert exr_channels(tmp_path / "d.exr") == exr_channels(tmp_path / "cli.exr")
+    assert {"A", "R", "G", "B", "Z", "Nx"} <= set(exr_channels(tmp_path / "d.exr"))
+    np.testing.assert_array_equal(lucent.read_image(tmp_path / "d.exr"), lucent.read_image(tmp_path / "cli.exr"))
+    lucent.write_image(tmp_path / "rgb.exr", image)
+    assert exr_channels(tmp_path / "rgb.exr") == ["B", "G", "R"]
+
+
+@pytest.mark.parametrize("args, error, words", [
+    (lambda d: (d / "x.png", np.zeros((4, 4), np.float32)), ValueError, "write_image: image must be an (H, W, 3)"),
+    (lambda d: (d / "x.png", np.zeros((4, 4, 3), np.uint8)), TypeError, "write_image: image must be a float array"),
+    (lambda d: (3, np.zeros((4, 4, 3), np.float32)), TypeError, "write_image: path must be an image file's path"),
+    (lambda d: (d / "x.gif", np.zeros((4, 4, 3), np.float32)), lucent.Error, "x.gif"),
+    (lambda d: (d / "no" / "x.png", np.zeros((4, 4, 3), np.float32)), lucent.Error, "x.png"),
+])
+def test_write_image_refuses_bad_arguments_and_writes_nothing(tmp_path, args, error, words):
+    path, image = args(tmp_path)
+    with pytest.raises(error) as e:
+        lucent.write_image(path, image)
+    assert words in str(e.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_image_checks_the_layers(tmp_path):
+    image = np.zeros((4, 6, 3), np.float32)
+    with pytest.raises(ValueError, match="layer 'Z' must be a \\(4, 6\\) float array"):
+        lucent.write_image(tmp_path / "x.exr", image, layers={"Z": np.zeros((6, 4), np.float32)})
+    with pytest.raises(lucent.Error, match="exr"):
+        lucent.write_image(tmp_path / "x.png", image, layers={"Z": np.zeros((4, 6), np.float32)})
+    with pytest.raises(TypeError, match="layers must be a dict"):
+        lucent.write_image(tmp_path / "x.exr", image, layers=[1])
+    with pytest.raises(ValueError, match="alpha=True needs an \\(H, W, 4\\) image"):
+        lucent.write_image(tmp_path / "x.exr", image, alpha=True)
+    assert list(tmp_path.iterdir()) == []
