@@ -15,7 +15,6 @@ import sys
 import numpy as np
 
 import lucent
-from render_sample import write_png  # beside this script
 
 
 def main():
@@ -50,9 +49,9 @@ def main():
                 with open(args.out, "wb") as f:
                     np.save(f, image)
             else:
-                write_png(args.out, image[..., :3])
+                lucent.write_image(args.out, image)
             print(f"wrote {args.out}")
-        except (OSError, RuntimeError) as e:
+        except (OSError, RuntimeError) as e:  # lucent.Error is a RuntimeError
             failure = e
     # Every rank learns whether rank 0's write failed, and all exit alike.
     try:

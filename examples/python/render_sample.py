@@ -2,33 +2,16 @@
 """Render a sample into a numpy array, as `lucent render` does, and save it.
 
     render_sample.py [--sample igi] [--scene cornell] [--size 512x512] [--backend auto]
-                     [--set vpls=64 ...] [--out image.npy|image.png]
+                     [--set vpls=64 ...] [--out image.png|image.exr|image.pfm|image.npy]
 
-A .png is written 8-bit sRGB through numpy alone (zlib); .npy keeps the linear floats.
+lucent.write_image writes .png (8-bit sRGB), .exr and .pfm (linear floats) as `lucent
+render --out` does; .npy keeps the array as numpy saves it.
 """
 import argparse
-import struct
-import zlib
 
 import numpy as np
 
 import lucent
-
-
-def write_png(path, rgb):
-    """An (H, W, 3) linear RGB image as an 8-bit sRGB PNG."""
-    c = np.clip(rgb, 0, 1)
-    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
-    pixels = np.round(srgb * 255).astype(np.uint8)
-    h, w, _ = pixels.shape
-    raw = b"".join(b"\0" + pixels[y].tobytes() for y in range(h))
-
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
-                chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
 def main():
@@ -52,7 +35,7 @@ def main():
         with open(args.out, "wb") as f:
             np.save(f, image)
     else:
-        write_png(args.out, image[..., :3])
+        lucent.write_image(args.out, image)
     print(f"wrote {args.out}")
 
 
