@@ -50,8 +50,10 @@ lucent::bench::BuildBenchOptions small_build() {
 
 TEST(BenchCalls, BuildReturnsTheTreeItTimed) {
     lucent::bench::BuildBenchOptions o = small_build();
+    o.threads = 1;  // Lucent's build on one thread, as Embree's would be
     const json d = quiet_document([&] { return lucent::bench::bench_build_json(o); });
     EXPECT_EQ(d.at("triangles"), 2242);
+    EXPECT_EQ(d.at("threads"), 1);
     EXPECT_GT(d.at("build_ms").get<double>(), 0.0);
     EXPECT_GT(d.at("wide_nodes").get<int>(), 0);
     EXPECT_FALSE(d.contains("embree_build_ms"));  // peer = false

@@ -60,6 +60,7 @@ Json to_json(const BuildResult& r) {
     const double ms = r.build_ms.median;
     Json j{{"scene", r.options->scene},
            {"triangles", r.triangles},
+           {"threads", r.threads},
            {"build_ms", rounded(ms, 3)},
            {"min_ms", rounded(r.build_ms.min, 3)},
            {"max_ms", rounded(r.build_ms.max, 3)},
@@ -78,8 +79,8 @@ Json to_json(const BuildResult& r) {
 
 void print_text(const BuildResult& r) {
     const double ms = r.build_ms.median;
-    std::printf("scene %s: %zu triangles, median of %d builds\n", r.options->scene.c_str(),
-                r.triangles, r.options->repeat);
+    std::printf("scene %s: %zu triangles, median of %d builds on %u threads\n",
+                r.options->scene.c_str(), r.triangles, r.options->repeat, r.threads);
     std::printf(
         "build %.2f ms (min %.2f, max %.2f) %.2f Mtris/s sah=%.3f wide_nodes=%zu "
         "leaves=%zu large_leaves=%zu depth=%u\n",
@@ -146,9 +147,11 @@ int run_bench_build(const BuildBenchOptions& options) {
     result.triangles = tris;
     result.threads = threads;
     std::vector<double> ms;
+    accel::BuildOptions build_options;
+    build_options.threads = threads;  // as many as Embree's build gets
     for (int run = -1; run < options.repeat; ++run) {
         accel::TriangleAccel accel;
-        accel.build(mesh.positions, mesh.indices, {}, &result.stats);
+        accel.build(mesh.positions, mesh.indices, build_options, &result.stats);
         if (run >= 0) ms.push_back(result.stats.build_ms);
     }
     result.build_ms = rate_of(ms);

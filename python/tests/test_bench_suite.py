@@ -28,7 +28,9 @@ def same_keys_and(mine, theirs, keys):
 def test_build_counts_the_clis_tree(cli):
     mine = lucent.bench_build(ROOM, repeat=1, threads=2, peer=False)
     theirs = cli_document(cli, "build", "--scene", str(ROOM), "--repeat", "1", "--threads", "2", "--no-peer")
-    same_keys_and(mine, theirs, ["triangles", "sah_cost", "wide_nodes", "leaves", "large_leaves", "depth"])
+    same_keys_and(mine, theirs, ["triangles", "threads", "sah_cost", "wide_nodes", "leaves", "large_leaves",
+                                 "depth"])
+    assert mine["threads"] == 2
     assert mine["triangles"] == 2242
     assert mine["build_ms"] > 0
     assert mine["mtris_per_s"] > 0

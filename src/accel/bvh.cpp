@@ -558,7 +558,8 @@ void Bvh::build(std::span<const Aabb> boxes, const BuildOptions& options, BuildS
     m_nodes[0].lo = make_float3(root.lo[0], root.lo[1], root.lo[2]);
     m_nodes[0].hi = make_float3(root.hi[0], root.hi[1], root.hi[2]);
     Builder builder(m_nodes, refs, options);
-    unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    const unsigned threads =
+        options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     builder.spawn_depth = std::bit_width(threads) - 1;
     builder.block_shift = std::bit_width(std::max(1u, m_block_size)) - 1;
     if (split) {

@@ -21,6 +21,9 @@ struct BuildOptions {
     // TriangleAccel: split space too, not only the triangles (see SplitTriangles). Off where
     // an any-hit program must see each triangle once per ray.
     bool spatial_splits = true;
+    // Threads the build may use (0: one per core). `lucent bench build --threads N` gives
+    // Lucent's build the threads it gives Embree's.
+    unsigned threads = 0;
 };
 
 /// Triangles behind the boxes of a build, for spatial splits (Stich, Friedrich and Dietrich
