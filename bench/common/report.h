@@ -7,9 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "lucent/error.h"
-
 #include "bench/common/rate.h"
+#include "lucent/error.h"
 
 namespace lucent::bench {
 
