@@ -67,7 +67,9 @@ TEST(BenchCalls, BuildRefusesBadOptionsByName) {
         change(o);
         return refusal([&] { lucent::bench::bench_build_json(o); });
     };
-    EXPECT_NE(with([](auto& o) { o.repeat = 0; }).find("repeat (--repeat) is 0; it must lie in [1, 1000]"),
+    EXPECT_NE(with([](auto& o) {
+                  o.repeat = 0;
+              }).find("repeat (--repeat) is 0; it must lie in [1, 1000]"),
               std::string::npos);
     EXPECT_NE(with([](auto& o) { o.subdivide = 6; }).find("subdivide (--subdivide) is 6"),
               std::string::npos);
@@ -87,8 +89,9 @@ TEST(BenchCalls, SpheresAndCurvesReturnTheirHitsAndRefuseBadCounts) {
     EXPECT_EQ(s.at("pixels_that_differ"), 0);
     EXPECT_GT(s.at("hit_fraction").get<double>(), 0.0);
     spheres.count = 0;
-    EXPECT_NE(refusal([&] { lucent::bench::bench_spheres_json(spheres); })
-                  .find("bench spheres: count (--count) is 0"),
+    EXPECT_NE(refusal([&] {
+                  lucent::bench::bench_spheres_json(spheres);
+              }).find("bench spheres: count (--count) is 0"),
               std::string::npos);
 
     lucent::bench::CurvesBenchOptions curves;
@@ -97,8 +100,9 @@ TEST(BenchCalls, SpheresAndCurvesReturnTheirHitsAndRefuseBadCounts) {
     EXPECT_EQ(c.at("benchmark"), "curves");
     EXPECT_GT(c.at("primary_hit_fraction").get<double>(), 0.0);
     curves.width = 0;
-    EXPECT_NE(refusal([&] { lucent::bench::bench_curves_json(curves); })
-                  .find("the image size (size, --size) is 0x48"),
+    EXPECT_NE(refusal([&] {
+                  lucent::bench::bench_curves_json(curves);
+              }).find("the image size (size, --size) is 0x48"),
               std::string::npos);
 }
 
@@ -124,13 +128,15 @@ TEST(BenchCalls, IgiAndFogReturnARowPerConfiguration) {
     EXPECT_EQ(i.at("rows")[0].at("vpls"), 4);
     EXPECT_EQ(i.at("rows")[1].at("vpls"), 8);
     igi.vpls = {30, 0};
-    EXPECT_NE(refusal([&] { lucent::bench::bench_igi_json(igi); })
-                  .find("a VPL count (vpls, --vpls) is 0"),
+    EXPECT_NE(refusal([&] {
+                  lucent::bench::bench_igi_json(igi);
+              }).find("a VPL count (vpls, --vpls) is 0"),
               std::string::npos);
     igi.vpls = {4};
     igi.downsample = 1;
-    EXPECT_NE(refusal([&] { lucent::bench::bench_igi_json(igi); })
-                  .find("downsample (--downsample) is 1; it must lie in [2, 16]"),
+    EXPECT_NE(refusal([&] {
+                  lucent::bench::bench_igi_json(igi);
+              }).find("downsample (--downsample) is 1; it must lie in [2, 16]"),
               std::string::npos);
 
     lucent::bench::FogBenchOptions fog;

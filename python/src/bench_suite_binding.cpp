@@ -65,11 +65,10 @@ py::object bench_spheres(const std::string& backend, unsigned threads, unsigned 
 
 py::object bench_curves(const std::string& backend, unsigned threads, unsigned segments,
                         const std::string& curve_type, const ImageSize& size, int repeat) {
-    static const std::map<std::string, CurveType> kTypes = {
-        {"linear", kCurveLinear},
-        {"quadratic", kCurveQuadraticBSpline},
-        {"cubic", kCurveCubicBSpline},
-        {"catmull-rom", kCurveCatmullRom}};
+    static const std::map<std::string, CurveType> kTypes = {{"linear", kCurveLinear},
+                                                            {"quadratic", kCurveQuadraticBSpline},
+                                                            {"cubic", kCurveCubicBSpline},
+                                                            {"catmull-rom", kCurveCatmullRom}};
     const auto type = kTypes.find(curve_type);
     if (type == kTypes.end())
         throw py::value_error("bench_curves: curve_type is '" + curve_type +
@@ -91,7 +90,8 @@ py::object bench_igi(const py::object& scene, const std::string& backend, unsign
                      std::vector<unsigned> vpls, unsigned downsample, unsigned interleave,
                      bool reflection_layer, const py::object& devices, const py::object& ranks) {
     bench::IgiBenchOptions options;
-    options.scene = path_argument(scene, "bench_igi", "scene", "a built-in scene's name or a scene file");
+    options.scene =
+        path_argument(scene, "bench_igi", "scene", "a built-in scene's name or a scene file");
     options.backend = backend_kind(backend, "bench_igi: backend");
     options.devices = device_list(devices);
     options.ranks = ranks_argument(ranks, "bench_igi: ranks");
@@ -155,8 +155,8 @@ void bind_bench_suite(py::module_& m) {
           "its document as a dict. size defaults to (1024, 768), (3840, 2160) on 'cuda'. "
           "Raises lucent.Error when the two paths disagree.");
     m.def("bench_curves", &bench_curves, py::kw_only(), py::arg("backend") = "cpu",
-          py::arg("threads") = 0u, py::arg("segments") = 100000u,
-          py::arg("curve_type") = "cubic", py::arg("size") = no_size, py::arg("repeat") = 5,
+          py::arg("threads") = 0u, py::arg("segments") = 100000u, py::arg("curve_type") = "cubic",
+          py::arg("size") = no_size, py::arg("repeat") = 5,
           "Primary rays, and a diffuse ray per primary hit, into a head of hair of built-in "
           "curves (curve_type 'linear', 'quadratic', 'cubic' or 'catmull-rom'), as `lucent "
           "bench curves --json`; returns its document as a dict. size defaults to (640, 480), "

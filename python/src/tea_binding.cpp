@@ -24,7 +24,8 @@ std::vector<unsigned> words_of(const py::handle& words, size_t count, const char
     std::vector<unsigned> out;
     const auto refuse = [&] {
         return py::value_error(std::string(what) + " must be " + std::to_string(count) +
-                               " integers in [0, 2**32); got " + py::repr(words).cast<std::string>());
+                               " integers in [0, 2**32); got " +
+                               py::repr(words).cast<std::string>());
     };
     if (!py::isinstance<py::sequence>(words) || py::isinstance<py::str>(words)) throw refuse();
     for (const py::handle& w : words) {
@@ -39,7 +40,8 @@ std::vector<unsigned> words_of(const py::handle& words, size_t count, const char
 
 void check_rounds(unsigned rounds, const char* what) {
     if (rounds < 1 || rounds > 64)
-        throw py::value_error(std::string(what) + ": rounds must be 1..64 (32 is the cipher); got " +
+        throw py::value_error(std::string(what) +
+                              ": rounds must be 1..64 (32 is the cipher); got " +
                               std::to_string(rounds));
 }
 
@@ -64,13 +66,12 @@ py::list tea_statistics(const std::vector<unsigned>& rounds, unsigned blocks) {
     }
     py::list out;
     for (const samples::TeaStatistics& s : rows)
-        out.append(py::dict(py::arg("rounds") = s.rounds, py::arg("bytes") = s.bytes,
-                            py::arg("ones_fraction") = s.ones_fraction,
-                            py::arg("bit_balance_z") = s.bit_balance_z,
-                            py::arg("byte_chi_square") = s.byte_chi_square,
-                            py::arg("chi_square_p") = s.chi_square_p,
-                            py::arg("serial_correlation") = s.serial_correlation,
-                            py::arg("passes") = s.passes()));
+        out.append(py::dict(
+            py::arg("rounds") = s.rounds, py::arg("bytes") = s.bytes,
+            py::arg("ones_fraction") = s.ones_fraction, py::arg("bit_balance_z") = s.bit_balance_z,
+            py::arg("byte_chi_square") = s.byte_chi_square,
+            py::arg("chi_square_p") = s.chi_square_p,
+            py::arg("serial_correlation") = s.serial_correlation, py::arg("passes") = s.passes()));
     return out;
 }
 
@@ -78,8 +79,9 @@ py::array_t<float> noise(const std::string& kind, std::optional<unsigned> size, 
                          std::optional<unsigned long long> seed, unsigned device) {
     check_rounds(rounds, "noise");
     if (kind != "white" && kind != "gradient" && kind != "spectrum")
-        throw py::value_error("noise: kind is '" + kind +
-                              "'; use 'white', 'gradient' or 'spectrum' (as `lucent noise --kind`)");
+        throw py::value_error(
+            "noise: kind is '" + kind +
+            "'; use 'white', 'gradient' or 'spectrum' (as `lucent noise --kind`)");
     if (size && (*size < 8 || *size > 4096))
         throw py::value_error("noise: size must be 8..4096 pixels a side; got " +
                               std::to_string(*size));
@@ -94,7 +96,8 @@ py::array_t<float> noise(const std::string& kind, std::optional<unsigned> size, 
         if (kind == "white")
             image = samples::white_noise(size.value_or(64), size.value_or(64), rounds, key);
         else if (kind == "gradient")
-            image = samples::gradient_noise(size.value_or(256), size.value_or(256), 32, rounds, key);
+            image =
+                samples::gradient_noise(size.value_or(256), size.value_or(256), 32, rounds, key);
         else
             image = samples::noise_spectrum(size.value_or(1024), rounds, key);
     }
