@@ -78,9 +78,9 @@ bool parse_args(int argc, char** argv, Arguments& a) {
 /// The build's line: Lucent's tree (its SAH cost and size, which `lucent bench build` on the
 /// same scene gives too) and the median build time, beside Embree's when it ran.
 void print_build(const nlohmann::json& b) {
-    std::printf("build    %s triangles, sah_cost %s, %s wide nodes, %.2f ms", b["triangles"].dump().c_str(),
-                b["sah_cost"].dump().c_str(), b["wide_nodes"].dump().c_str(),
-                b["build_ms"].get<double>());
+    std::printf("build    %s triangles, sah_cost %s, %s wide nodes, %.2f ms",
+                b["triangles"].dump().c_str(), b["sah_cost"].dump().c_str(),
+                b["wide_nodes"].dump().c_str(), b["build_ms"].get<double>());
     if (b.contains("embree_build_ms"))
         std::printf(", Embree %.2f ms, %.2fx", b["embree_build_ms"].get<double>(),
                     b["ratio"].get<double>());

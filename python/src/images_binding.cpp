@@ -39,8 +39,8 @@ scene::Image image_from_array(const py::handle& value, const std::string& call, 
         throw py::type_error(call + ": " + name + " must be a float array (linear RGB); got " +
                              describe_array(a));
     if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) == 0 || a.shape(1) == 0)
-        throw py::value_error(call + ": " + name + " must be an (H, W, 3) or (H, W, 4) array; got " +
-                              describe_array(a));
+        throw py::value_error(call + ": " + name +
+                              " must be an (H, W, 3) or (H, W, 4) array; got " + describe_array(a));
     const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
     scene::Image image;
     image.height = unsigned(a.shape(0));
@@ -70,8 +70,9 @@ scene::Image image_argument(const py::handle& value, const char* name) {
 }
 
 /// Writes `image` (and, to an .exr, `layers`: {channel name: (H, W) float array}, as
-/// render(aovs=...) returns them, and with `alpha` its 4th channel as A) through scene::write_image: a temporary file renamed into
-/// place, so a failure leaves no partial file.
+/// render(aovs=...) returns them, and with `alpha` its 4th channel as A) through
+/// scene::write_image: a temporary file renamed into place, so a failure leaves no partial
+/// file.
 void write_image(const py::object& path, const py::handle& image, const py::object& layers,
                  bool alpha) {
     const std::string file = path_argument(path, "write_image", "path", "an image file's path");
@@ -95,7 +96,8 @@ void write_image(const py::object& path, const py::handle& image, const py::obje
                                  py::repr(layers).cast<std::string>());
         for (const auto& [key, value] : layers.cast<py::dict>()) {
             const std::string name = py::str(key).cast<std::string>();
-            const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+            using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+            const auto a = FloatArray::ensure(value);
             if (!a || a.ndim() != 2 || size_t(a.shape(0)) != pixels.height ||
                 size_t(a.shape(1)) != pixels.width)
                 throw py::value_error("write_image: layer '" + name + "' must be a (" +
