@@ -19,7 +19,8 @@ namespace lucent::python {
 
 namespace {
 
-/// `words` as `count` 32-bit words; a ValueError naming `what` otherwise.
+/// `words` as `count` 32-bit words (Python or numpy integers, any size: compared as Python
+/// integers); a ValueError naming `what` otherwise.
 std::vector<unsigned> words_of(const py::handle& words, size_t count, const char* what) {
     std::vector<unsigned> out;
     const auto refuse = [&] {
@@ -29,10 +30,11 @@ std::vector<unsigned> words_of(const py::handle& words, size_t count, const char
     };
     if (!py::isinstance<py::sequence>(words) || py::isinstance<py::str>(words)) throw refuse();
     for (const py::handle& w : words) {
-        if (!py::isinstance<py::int_>(w) || py::isinstance<py::bool_>(w)) throw refuse();
-        const long long value = w.cast<long long>();
-        if (value < 0 || value > 0xffffffffll) throw refuse();
-        out.push_back(unsigned(value));
+        if (py::isinstance<py::bool_>(w) || !PyIndex_Check(w.ptr())) throw refuse();
+        const auto n = py::reinterpret_steal<py::int_>(PyNumber_Index(w.ptr()));
+        if (!n) throw py::error_already_set();
+        if (n < py::int_(0) || n > py::int_(0xffffffffu)) throw refuse();
+        out.push_back(n.cast<unsigned>());
     }
     if (out.size() != count) throw refuse();
     return out;

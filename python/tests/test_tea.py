@@ -11,6 +11,7 @@ from test_samples import read_pfm
 
 def test_tea_is_the_cipher_and_the_clis_block(cli):
     assert lucent.tea((0, 0), (0, 0, 0, 0)) == (0x41EA3A0A, 0x94BAA940)  # TEA's test vector
+    assert lucent.tea(np.zeros(2, np.uint32), np.zeros(4, np.int64)) == (0x41EA3A0A, 0x94BAA940)
     mine = lucent.tea((0x12345678, 7), [1, 2, 3, 4], rounds=4)
     run = subprocess.run([cli, "tea", "--block", "0x12345678,7", "--key", "1,2,3,4", "--rounds", "4"],
                          capture_output=True, text=True, check=True)
@@ -54,6 +55,8 @@ def test_default_sizes_are_the_clis():
     (lambda: lucent.tea((0, -1), (0, 0, 0, 0)), ValueError, "tea: block must be 2 integers in [0, 2**32)"),
     (lambda: lucent.tea((0, 0), (0, 0, 0, 2**32)), ValueError, "tea: key must be 4 integers"),
     (lambda: lucent.tea((0, 0), "0,0,0,0"), ValueError, "tea: key must be 4 integers"),
+    (lambda: lucent.tea((0, 2**70), (0, 0, 0, 0)), ValueError, "tea: block must be 2 integers"),
+    (lambda: lucent.tea((0, 1.0), (0, 0, 0, 0)), ValueError, "tea: block must be 2 integers"),
     (lambda: lucent.tea_statistics(blocks=10), ValueError, "tea_statistics: blocks must be 1000..2**26"),
     (lambda: lucent.tea_statistics(rounds=[65]), ValueError, "tea_statistics: rounds must be 1..64"),
     (lambda: lucent.noise("pink"), ValueError, "noise: kind is 'pink'"),
