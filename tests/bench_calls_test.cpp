@@ -30,14 +30,17 @@ json quiet_document(const std::function<std::string()>& call) {
     return json::parse(text);
 }
 
-/// The message of the lucent::Error `call` throws, or "(no error)".
-std::string refusal(const std::function<void()>& call) {
+/// Whether `call` throws a lucent::Error whose message holds `words`; the message (or that
+/// none came) when not.
+testing::AssertionResult refused_with(const std::function<void()>& call, const std::string& words) {
+    std::string message = "(no error)";
     try {
         call();
     } catch (const lucent::Error& e) {
-        return e.what();
+        message = e.what();
     }
-    return "(no error)";
+    if (message.find(words) != std::string::npos) return testing::AssertionSuccess();
+    return testing::AssertionFailure() << "expected \"" << words << "\" in: " << message;
 }
 
 lucent::bench::BuildBenchOptions small_build() {
@@ -62,23 +65,18 @@ TEST(BenchCalls, BuildReturnsTheTreeItTimed) {
 }
 
 TEST(BenchCalls, BuildRefusesBadOptionsByName) {
-    auto with = [](auto change) {
+    // The build's options, changed by `change`, are refused with `words` in the message.
+    auto refuses = [](auto change, const std::string& words) {
         lucent::bench::BuildBenchOptions o = small_build();
         change(o);
-        return refusal([&] { lucent::bench::bench_build_json(o); });
+        return refused_with([&] { lucent::bench::bench_build_json(o); }, words);
     };
-    EXPECT_NE(with([](auto& o) {
-                  o.repeat = 0;
-              }).find("repeat (--repeat) is 0; it must lie in [1, 1000]"),
-              std::string::npos);
-    EXPECT_NE(with([](auto& o) { o.subdivide = 6; }).find("subdivide (--subdivide) is 6"),
-              std::string::npos);
-    EXPECT_NE(with([](auto& o) { o.backend = "gpu"; }).find("backend (--backend) is \"gpu\""),
-              std::string::npos);
-    EXPECT_NE(with([](auto& o) { o.scene.clear(); }).find("no scene (scene, --scene)"),
-              std::string::npos);
-    EXPECT_NE(with([](auto& o) { o.scene += ".missing.obj"; }).find("room.obj.missing.obj"),
-              std::string::npos);
+    EXPECT_TRUE(
+        refuses([](auto& o) { o.repeat = 0; }, "repeat (--repeat) is 0; it must lie in [1, 1000]"));
+    EXPECT_TRUE(refuses([](auto& o) { o.subdivide = 6; }, "subdivide (--subdivide) is 6"));
+    EXPECT_TRUE(refuses([](auto& o) { o.backend = "gpu"; }, "backend (--backend) is \"gpu\""));
+    EXPECT_TRUE(refuses([](auto& o) { o.scene.clear(); }, "no scene (scene, --scene)"));
+    EXPECT_TRUE(refuses([](auto& o) { o.scene += ".missing.obj"; }, "room.obj.missing.obj"));
 }
 
 TEST(BenchCalls, SpheresAndCurvesReturnTheirHitsAndRefuseBadCounts) {
@@ -89,10 +87,8 @@ TEST(BenchCalls, SpheresAndCurvesReturnTheirHitsAndRefuseBadCounts) {
     EXPECT_EQ(s.at("pixels_that_differ"), 0);
     EXPECT_GT(s.at("hit_fraction").get<double>(), 0.0);
     spheres.count = 0;
-    EXPECT_NE(refusal([&] {
-                  lucent::bench::bench_spheres_json(spheres);
-              }).find("bench spheres: count (--count) is 0"),
-              std::string::npos);
+    EXPECT_TRUE(refused_with([&] { lucent::bench::bench_spheres_json(spheres); },
+                             "bench spheres: count (--count) is 0"));
 
     lucent::bench::CurvesBenchOptions curves;
     curves.segments = 2000, curves.width = 64, curves.height = 48, curves.repeat = 1;
@@ -100,10 +96,8 @@ TEST(BenchCalls, SpheresAndCurvesReturnTheirHitsAndRefuseBadCounts) {
     EXPECT_EQ(c.at("benchmark"), "curves");
     EXPECT_GT(c.at("primary_hit_fraction").get<double>(), 0.0);
     curves.width = 0;
-    EXPECT_NE(refusal([&] {
-                  lucent::bench::bench_curves_json(curves);
-              }).find("the image size (size, --size) is 0x48"),
-              std::string::npos);
+    EXPECT_TRUE(refused_with([&] { lucent::bench::bench_curves_json(curves); },
+                             "the image size (size, --size) is 0x48"));
 }
 
 TEST(BenchCalls, TeaChecksumsDependOnTheSeedOfTheGeneratedKeyOnly) {
@@ -115,8 +109,7 @@ TEST(BenchCalls, TeaChecksumsDependOnTheSeedOfTheGeneratedKeyOnly) {
     EXPECT_EQ(a.at("fixed_checksum"), b.at("fixed_checksum"));
     EXPECT_NE(a.at("generated_checksum"), b.at("generated_checksum"));
     o.rounds = 0;
-    EXPECT_NE(refusal([&] { lucent::bench::bench_tea_json(o); }).find("rounds (--rounds) is 0"),
-              std::string::npos);
+    EXPECT_TRUE(refused_with([&] { lucent::bench::bench_tea_json(o); }, "rounds (--rounds) is 0"));
 }
 
 TEST(BenchCalls, IgiAndFogReturnARowPerConfiguration) {
@@ -128,16 +121,12 @@ TEST(BenchCalls, IgiAndFogReturnARowPerConfiguration) {
     EXPECT_EQ(i.at("rows")[0].at("vpls"), 4);
     EXPECT_EQ(i.at("rows")[1].at("vpls"), 8);
     igi.vpls = {30, 0};
-    EXPECT_NE(refusal([&] {
-                  lucent::bench::bench_igi_json(igi);
-              }).find("a VPL count (vpls, --vpls) is 0"),
-              std::string::npos);
+    EXPECT_TRUE(refused_with([&] { lucent::bench::bench_igi_json(igi); },
+                             "a VPL count (vpls, --vpls) is 0"));
     igi.vpls = {4};
     igi.downsample = 1;
-    EXPECT_NE(refusal([&] {
-                  lucent::bench::bench_igi_json(igi);
-              }).find("downsample (--downsample) is 1; it must lie in [2, 16]"),
-              std::string::npos);
+    EXPECT_TRUE(refused_with([&] { lucent::bench::bench_igi_json(igi); },
+                             "downsample (--downsample) is 1; it must lie in [2, 16]"));
 
     lucent::bench::FogBenchOptions fog;
     fog.width = 48, fog.height = 32, fog.frames = 2;
@@ -145,8 +134,8 @@ TEST(BenchCalls, IgiAndFogReturnARowPerConfiguration) {
     ASSERT_EQ(f.at("rows").size(), 4u);
     EXPECT_EQ(f.at("rows")[0].at("configuration"), "no fog");
     fog.frames = 0;
-    EXPECT_NE(refusal([&] { lucent::bench::bench_fog_json(fog); }).find("frames (--frames) is 0"),
-              std::string::npos);
+    EXPECT_TRUE(
+        refused_with([&] { lucent::bench::bench_fog_json(fog); }, "frames (--frames) is 0"));
 }
 
 }  // namespace

@@ -27,9 +27,14 @@ py::array_t<float> image_array(const scene::Image& image) {
     return out;
 }
 
-/// An (H, W, 3) or (H, W, 4) float array of linear RGB (alpha ignored); a TypeError or
-/// ValueError "<call>: <name> must be ..." otherwise.
-scene::Image image_from_array(const py::handle& value, const std::string& call, const char* name) {
+/// A float array as numpy gives it, converted to C-ordered float32 where it is not.
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+/// An (H, W, 3) or (H, W, 4) float array of linear RGB; a TypeError or ValueError "<call>:
+/// <name> must be ..." otherwise. The 4th channel goes to `alpha` when it is given (an
+/// (H, W, 3) image is then a ValueError), and is ignored when not.
+scene::Image image_from_array(const py::handle& value, const std::string& call, const char* name,
+                              std::vector<float>* alpha = nullptr) {
     if (!py::isinstance<py::array>(value))
         throw py::type_error(call + ": " + name +
                              " must be an (H, W, 3) or (H, W, 4) float array; got " +
@@ -41,15 +46,21 @@ scene::Image image_from_array(const py::handle& value, const std::string& call, 
     if (a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) == 0 || a.shape(1) == 0)
         throw py::value_error(call + ": " + name +
                               " must be an (H, W, 3) or (H, W, 4) array; got " + describe_array(a));
-    const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
+    const size_t channels = size_t(a.shape(2));
+    if (alpha && channels != 4)
+        throw py::value_error(call + ": alpha=True needs an (H, W, 4) " + name + "; got " +
+                              describe_array(a));
+    const auto f = FloatArray::ensure(a);
     scene::Image image;
     image.height = unsigned(a.shape(0));
     image.width = unsigned(a.shape(1));
-    const size_t channels = size_t(a.shape(2));
     const float* p = f.data();
     image.pixels.resize(size_t(image.width) * image.height);
-    for (size_t i = 0; i < image.pixels.size(); ++i, p += channels)
+    if (alpha) alpha->resize(image.pixels.size());
+    for (size_t i = 0; i < image.pixels.size(); ++i, p += channels) {
         image.pixels[i] = make_float3(p[0], p[1], p[2]);
+        if (alpha) (*alpha)[i] = p[3];
+    }
     return image;
 }
 
@@ -76,19 +87,13 @@ scene::Image image_argument(const py::handle& value, const char* name) {
 void write_image(const py::object& path, const py::handle& image, const py::object& layers,
                  bool alpha) {
     const std::string file = path_argument(path, "write_image", "path", "an image file's path");
-    const scene::Image pixels = image_from_array(image, "write_image", "image");
+    // With alpha, the coverage render(aovs=...) returns in the 4th channel becomes the EXR's
+    // A channel, as `lucent render --aov` writes it.
+    std::vector<float> coverage;
+    const scene::Image pixels =
+        image_from_array(image, "write_image", "image", alpha ? &coverage : nullptr);
     scene::ExrExtras extras;
-    if (alpha) {
-        // The coverage render(aovs=...) returns in the 4th channel, as `lucent render --aov`
-        // writes it: the EXR's A channel.
-        const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(image);
-        if (a.shape(2) != 4)
-            throw py::value_error("write_image: alpha=True needs an (H, W, 4) image; got " +
-                                  describe_array(a));
-        std::vector<float> values(size_t(pixels.width) * pixels.height);
-        for (size_t i = 0; i < values.size(); ++i) values[i] = a.data()[4 * i + 3];
-        extras.channels.push_back({"A", std::move(values)});
-    }
+    if (alpha) extras.channels.push_back({"A", std::move(coverage)});
     if (!layers.is_none()) {
         if (!py::isinstance<py::dict>(layers))
             throw py::type_error("write_image: layers must be a dict {channel name: (H, W) float "
@@ -96,7 +101,6 @@ void write_image(const py::object& path, const py::handle& image, const py::obje
                                  py::repr(layers).cast<std::string>());
         for (const auto& [key, value] : layers.cast<py::dict>()) {
             const std::string name = py::str(key).cast<std::string>();
-            using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
             const auto a = FloatArray::ensure(value);
             if (!a || a.ndim() != 2 || size_t(a.shape(0)) != pixels.height ||
                 size_t(a.shape(1)) != pixels.width)
