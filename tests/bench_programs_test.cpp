@@ -90,17 +90,22 @@ TEST(BenchPrograms, CpuProgramsGiveTheKernelsChecksums) {
     in.backend = BackendKind::kCpu;
     in.threads = 2;
     in.repeat = 1;
-    const ProgramsResult p = run_programs(in);
-    EXPECT_EQ(checksum_differences(p, kernels, "programs", "kernels"), "");
-    EXPECT_EQ(p.primary_hits, kernels.primary_hits);
-    EXPECT_EQ(p.shadow_rays, kernels.shadow_rays);
-    EXPECT_EQ(p.occluded, kernels.occluded);
-    EXPECT_EQ(p.diffuse_rays, kernels.diffuse_rays);
-    EXPECT_EQ(p.diffuse_hits, kernels.diffuse_hits);
-    EXPECT_GT(p.primary.median, 0.0);
-    EXPECT_GT(p.shadow.median, 0.0);
-    EXPECT_GT(p.diffuse.median, 0.0);
-    EXPECT_EQ(p.timing, "launch");
+    // Each ray waited for (trace(), occluded()), then deferred (the *_deferred entries).
+    for (const bool deferred : {false, true}) {
+        SCOPED_TRACE(deferred ? "deferred" : "waited for");
+        in.deferred = deferred;
+        const ProgramsResult p = run_programs(in);
+        EXPECT_EQ(checksum_differences(p, kernels, "programs", "kernels"), "");
+        EXPECT_EQ(p.primary_hits, kernels.primary_hits);
+        EXPECT_EQ(p.shadow_rays, kernels.shadow_rays);
+        EXPECT_EQ(p.occluded, kernels.occluded);
+        EXPECT_EQ(p.diffuse_rays, kernels.diffuse_rays);
+        EXPECT_EQ(p.diffuse_hits, kernels.diffuse_hits);
+        EXPECT_GT(p.primary.median, 0.0);
+        EXPECT_GT(p.shadow.median, 0.0);
+        EXPECT_GT(p.diffuse.median, 0.0);
+        EXPECT_EQ(p.timing, "launch");
+    }
 }
 
 TEST(BenchPrograms, PairedPassesRunBesideEachLaunchAndGiveTheirRatios) {

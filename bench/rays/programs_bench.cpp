@@ -162,7 +162,9 @@ ProgramsResult run_programs(const ProgramsInput& in) {
 
     // Primary rays, then the shadow and diffuse sets from their hits (BENCH.md).
     const std::vector<uint32_t> primary_order = launch_order(primary, in);
-    auto primary_program = program_for(ctx, "closest_rays", primary, primary_order);
+    const char* closest_entry = in.deferred ? "closest_rays_deferred" : "closest_rays";
+    const char* shadow_entry = in.deferred ? "shadow_rays_deferred" : "shadow_rays";
+    auto primary_program = program_for(ctx, closest_entry, primary, primary_order);
     auto primary_hits = closest_outputs(*primary_program, primary.size());
     // Each set's entry point is added when its rays exist (every entry needs its program).
     ctx.set_entry_point_count(1);
@@ -191,7 +193,7 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     if (shadow.size() == 0) return res;  // no primary hit: nothing more to trace
 
     const std::vector<uint32_t> shadow_order = launch_order(shadow, in);
-    auto shadow_program = program_for(ctx, "shadow_rays", shadow, shadow_order);
+    auto shadow_program = program_for(ctx, shadow_entry, shadow, shadow_order);
     auto blocked = ctx.create_buffer<unsigned char>(BufferType::kOutput, unsigned(shadow.size()));
     (*shadow_program)["blocked"] = blocked;
     ctx.set_entry_point_count(2);
@@ -203,7 +205,7 @@ ProgramsResult run_programs(const ProgramsInput& in) {
     for (size_t i = 0; i < shadow.size(); ++i) res.occluded += b[i];
 
     const std::vector<uint32_t> diffuse_order = launch_order(diffuse, in);
-    auto diffuse_program = program_for(ctx, "closest_rays", diffuse, diffuse_order);
+    auto diffuse_program = program_for(ctx, closest_entry, diffuse, diffuse_order);
     auto diffuse_hits = closest_outputs(*diffuse_program, diffuse.size());
     ctx.set_entry_point_count(3);
     ctx.set_ray_generation_program(kDiffuseEntry, diffuse_program);

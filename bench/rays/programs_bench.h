@@ -1,7 +1,8 @@
 // `lucent bench rays --programs`: the BENCH.md ray sets traced by an ordinary program
 // module (rays_programs.h) launched through a Context, as a user's programs are, on the CPU
 // or the CUDA backend. Beside the bare kernels' figures it shows what the engine's own
-// per-ray path (ray generation, trace, closest hit or miss) costs.
+// per-ray path (ray generation, trace, closest hit or miss) costs, with each ray waited
+// for (trace(), occluded()) or deferred (trace_deferred(), occluded_deferred()).
 #pragma once
 
 #include <functional>
@@ -38,6 +39,9 @@ struct ProgramsInput {
     // kernels' warps do and as a 2D launch's warps do; else in pixel order.
     unsigned width = 0, height = 0;
     bool tile_order = false;
+    // The module's deferred entry points (closest_rays_deferred, shadow_rays_deferred):
+    // trace_deferred() and occluded_deferred() where the others call trace() and occluded().
+    bool deferred = false;
     // When set, each timed launch has a neighbour: these passes run beside it, before it
     // and after it in turn (A B, B A, ...), as the kernels and the peer take turns. The
     // machines this runs on slow down for seconds at a time, so a ratio of two rates

@@ -320,10 +320,16 @@ struct RaysResult {
     std::string differences;  // of the checksums, lucent against embree ("" when they agree)
     std::string stream_differences;  // the stream queries' checksums against the kernels'
     // --programs: the ray sets through rays_programs.h, and its checksums against the kernels'.
+    // Both forms of the module's entry points: each ray waited for, and deferred.
     bool programs = false;
-    ProgramsResult program_figures;
-    std::string program_differences;
+    ProgramsResult program_figures, deferred_figures;
+    std::string program_differences, deferred_differences;
 };
+
+/// The name of a form of the programs in the text report.
+const char* form_name(bool deferred) {
+    return deferred ? "deferred programs" : "programs";
+}
 
 /// The programs' figures as an EngineResult, for the shared printers.
 EngineResult engine_of(const ProgramsResult& p) {
@@ -360,22 +366,28 @@ Json programs_json(const ProgramsResult& p, const EngineResult& kernels, const E
 }
 
 /// The programs' lines: figures, ratios to the kernels (and to Embree), checksums.
-void print_programs(const ProgramsResult& p, const EngineResult& kernels, const EngineResult* peer,
-                    const std::string& differences) {
-    std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
-                p.backend.c_str(),
+void print_programs(const ProgramsResult& p, bool deferred, const EngineResult& kernels,
+                    const EngineResult* peer, const std::string& differences) {
+    const char* name = form_name(deferred);
+    std::printf("%s on %s (rays_programs.h%s through a Context; %s time per launch)\n", name,
+                p.backend.c_str(), deferred ? "'s *_deferred entries" : "",
                 p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
-    print_engine("programs ", engine_of(p));
+    print_engine((std::string(name) + " ").c_str(), engine_of(p));
     auto ratios = [&](const char* what, const PairedRatios& r) {
-        std::printf("ratio programs/%s primary %.2fx, shadow %.2fx, diffuse %.2fx\n", what,
+        std::printf("ratio %s/%s primary %.2fx, shadow %.2fx, diffuse %.2fx\n", name, what,
                     r.primary, r.shadow, r.diffuse);
     };
     ratios("kernels", programs_ratios(p, kernels, 0));
     if (peer) ratios("embree", programs_ratios(p, *peer, 1));
     if (differences.empty())
-        std::printf("programs' checksums agree with the kernels\n");
+        std::printf("%s' checksums agree with the kernels\n", name);
     else
-        std::printf("programs' checksums differ from the kernels: %s\n", differences.c_str());
+        std::printf("%s' checksums differ from the kernels: %s\n", name, differences.c_str());
+}
+/// Both forms' lines.
+void print_programs(const RaysResult& r, const EngineResult* peer) {
+    print_programs(r.program_figures, false, r.engines.lucent, peer, r.program_differences);
+    print_programs(r.deferred_figures, true, r.engines.lucent, peer, r.deferred_differences);
 }
 
 /// Lucent's bare CPU traversal as the (closest, occluded) bodies run_engines times.
@@ -421,9 +433,13 @@ Json to_json(const RaysResult& r) {
         streams["checksums_agree_with_kernels"] = r.stream_differences.empty();
         j["streams"] = streams;
     }
-    if (r.programs)
-        j["programs"] = programs_json(r.program_figures, r.engines.lucent,
-                                      r.peer ? &r.engines.peer : nullptr, r.program_differences);
+    if (r.programs) {
+        const EngineResult* peer = r.peer ? &r.engines.peer : nullptr;
+        j["programs"] =
+            programs_json(r.program_figures, r.engines.lucent, peer, r.program_differences);
+        j["programs_deferred"] =
+            programs_json(r.deferred_figures, r.engines.lucent, peer, r.deferred_differences);
+    }
     return j;
 }
 
@@ -458,8 +474,7 @@ void print_text(const RaysResult& r) {
     if (!r.peer) {
         if (o.peer) std::printf("embree: not built in, no peer figures\n");
         print_streams(r);
-        if (r.programs)
-            print_programs(r.program_figures, r.engines.lucent, nullptr, r.program_differences);
+        if (r.programs) print_programs(r, nullptr);
         return;
     }
     std::printf("embree build %.2f ms\n", r.embree_build_ms);
@@ -473,8 +488,7 @@ void print_text(const RaysResult& r) {
     else
         std::printf("checksums differ from embree: %s\n", r.differences.c_str());
     print_streams(r);
-    if (r.programs)
-        print_programs(r.program_figures, r.engines.lucent, &r.engines.peer, r.program_differences);
+    if (r.programs) print_programs(r, &r.engines.peer);
 }
 
 #ifdef LUCENT_HAVE_CUDA
@@ -493,38 +507,44 @@ void run_programs_cuda(const RaysOptions& options, const scene::ObjMesh& mesh, c
     // The kernels' ray order (LUCENT_BENCH_TILES), so that both trace the same warps' rays.
     in.width = options.width, in.height = options.height;
     in.tile_order = cuda::env_flag("LUCENT_BENCH_TILES", true);
-    const ProgramsResult p = run_programs(in);
     auto none = [](auto&&...) { return false; };
     const BenchResult kernels =
         run_engines(primary, mesh, cam.light, threads, 1, closest_query(accel),
                     occluded_query(accel), none, none, false);
-    const std::string differences = checksum_differences(p, kernels.lucent, "programs", "kernels");
-    if (options.json) {
-        Json j = json_engine(engine_of(p));
-        j["backend"] = p.backend;
-        j["timing"] = p.timing;
-        j["checksums_agree_with_cpu_kernels"] = differences.empty();
-        j["kernel_variants"] = Json{{"primary", p.primary_variant},
-                                    {"shadow", p.shadow_variant},
-                                    {"diffuse", p.diffuse_variant}};
-        j["trees_upgraded"] = p.trees_upgraded;
-        document["programs"] = j;  // beside the kernels' figures: one document
-        return;
+    for (const bool deferred : {false, true}) {
+        in.deferred = deferred;
+        const ProgramsResult p = run_programs(in);
+        const char* name = form_name(deferred);
+        const std::string differences = checksum_differences(p, kernels.lucent, name, "kernels");
+        if (options.json) {
+            Json j = json_engine(engine_of(p));
+            j["backend"] = p.backend;
+            j["timing"] = p.timing;
+            j["checksums_agree_with_cpu_kernels"] = differences.empty();
+            j["kernel_variants"] = Json{{"primary", p.primary_variant},
+                                        {"shadow", p.shadow_variant},
+                                        {"diffuse", p.diffuse_variant}};
+            j["trees_upgraded"] = p.trees_upgraded;
+            // Beside the kernels' figures: one document.
+            document[deferred ? "programs_deferred" : "programs"] = j;
+            continue;
+        }
+        std::printf("%s on %s (rays_programs.h%s through a Context; %s time per launch)\n", name,
+                    p.backend.c_str(), deferred ? "'s *_deferred entries" : "",
+                    p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
+        print_engine((std::string(name) + " ").c_str(), engine_of(p));
+        std::printf("%s' kernel variants: primary %s, shadow %s, diffuse %s\n", name,
+                    p.primary_variant.c_str(), p.shadow_variant.c_str(), p.diffuse_variant.c_str());
+        if (p.trees_upgraded > 0)
+            std::printf(
+                "%s' tree: built on the GPU, then upgraded to the host's tree with "
+                "spatial splits before the first launch\n", name);
+        if (differences.empty())
+            std::printf("%s' checksums agree with the CPU kernels\n", name);
+        else
+            std::printf("%s' checksums differ from the CPU kernels: %s\n", name,
+                        differences.c_str());
     }
-    std::printf("programs on %s (rays_programs.h through a Context; %s time per launch)\n",
-                p.backend.c_str(),
-                p.timing == "kernel" ? "the megakernel's CUDA-event" : "the whole");
-    print_engine("programs ", engine_of(p));
-    std::printf("programs' kernel variants: primary %s, shadow %s, diffuse %s\n",
-                p.primary_variant.c_str(), p.shadow_variant.c_str(), p.diffuse_variant.c_str());
-    if (p.trees_upgraded > 0)
-        std::printf(
-            "programs' tree: built on the GPU, then upgraded to the host's tree with "
-            "spatial splits before the first launch\n");
-    if (differences.empty())
-        std::printf("programs' checksums agree with the CPU kernels\n");
-    else
-        std::printf("programs' checksums differ from the CPU kernels: %s\n", differences.c_str());
 }
 #endif
 
@@ -648,6 +668,10 @@ int run_bench_rays(const RaysOptions& options) {
         result.program_figures = run_programs(in);
         result.program_differences = checksum_differences(
             result.program_figures, result.engines.lucent, "programs", "kernels");
+        in.deferred = true;
+        result.deferred_figures = run_programs(in);
+        result.deferred_differences = checksum_differences(
+            result.deferred_figures, result.engines.lucent, "deferred programs", "kernels");
     }
     if (peer)
         result.differences =

@@ -97,6 +97,7 @@ void print_row(const nlohmann::json& d, const char* kind) {
     if (d.contains("embree"))
         std::printf(" %10.2f %8.2fx", rate(d["embree"]), d["ratio"][kind].get<double>());
     if (d.contains("programs")) std::printf(" %10.2f", rate(d["programs"]));
+    if (d.contains("programs_deferred")) std::printf(" %10.2f", rate(d["programs_deferred"]));
     std::printf("\n");
 }
 
@@ -112,10 +113,11 @@ int main(int argc, char** argv) {
         std::printf("%s: %s triangles, %ux%u rays, %s threads\n", args.options.scene.c_str(),
                     d["triangles"].dump().c_str(), args.options.width, args.options.height,
                     d.contains("threads") ? d["threads"].dump().c_str() : "GPU");
-        std::printf("%-8s %10s%s%s%s   (Mrays/s)\n", "rays", "kernels",
+        std::printf("%-8s %10s%s%s%s%s   (Mrays/s)\n", "rays", "kernels",
                     d.contains("streams") ? "    streams" : "",
                     d.contains("embree") ? "     embree    ratio" : "",
-                    d.contains("programs") ? "   programs" : "");
+                    d.contains("programs") ? "   programs" : "",
+                    d.contains("programs_deferred") ? "   deferred" : "");
         for (const char* kind : {"primary", "shadow", "diffuse"}) print_row(d, kind);
         if (d.contains("checksums_agree"))
             std::printf("checksums agree with Embree: %s\n",

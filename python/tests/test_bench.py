@@ -38,6 +38,9 @@ def test_streams_and_programs_agree_with_the_kernels():
     assert d["streams"]["checksums_agree_with_kernels"] is True
     assert d["programs"]["checksums_agree"] is True
     assert d["programs"]["primary"]["hits"] == d["lucent"]["primary"]["hits"]
+    # The module's deferred entries (trace_deferred, occluded_deferred): the same answers.
+    assert d["programs_deferred"]["checksums_agree"] is True
+    assert d["programs_deferred"]["shadow"]["occluded"] == d["lucent"]["shadow"]["occluded"]
 
 
 def test_a_camera_given_whole_replaces_cameras_txt():

@@ -1,14 +1,19 @@
 // The CPU backend: the launch grid cut into tiles, taken by the workers of a thread pool
 // from a shared counter; each launch index runs the ray-generation program, and an
-// exception raised anywhere below it ends that index and runs the exception program.
+// exception raised anywhere below it ends that index and runs the exception program. The
+// rays the programs defer wait in their worker's queue and are traced together
+// (deferred_rays.h) when it is full and when the worker's tiles are done.
 #include <algorithm>
 #include <atomic>
 #include <exception>
 #include <map>
+#include <memory>
 #include <mutex>
 
 #include "core/backend.h"
 #include "cpu/cpu_state.h"
+#include "cpu/deferred_rays.h"
+#include "cpu/launch_index.h"
 #include "cpu/thread_pool.h"
 
 namespace lucent::cpu {
@@ -17,26 +22,12 @@ namespace {
 
 constexpr unsigned kTileWidth = 8, kTileHeight = 8, kTile1D = 64;
 
-struct WorkerExceptions {
-    struct Entry {
-        uint64_t count = 0;
-        uint64_t first_linear = ~0ull;
-        uint3 first_index{0, 0, 0};
-    };
-    std::map<int, Entry> by_code;
-    void add(int code, uint3 index, uint64_t linear) {
-        Entry& e = by_code[code];
-        ++e.count;
-        if (linear < e.first_linear) {
-            e.first_linear = linear;
-            e.first_index = index;
-        }
-    }
-};
-
 class CpuBackend final : public core::Backend {
   public:
-    explicit CpuBackend(unsigned threads) : m_pool(threads) {}
+    explicit CpuBackend(unsigned threads) : m_pool(threads) {
+        for (unsigned w = 0; w < m_pool.size(); ++w)
+            m_deferred.push_back(std::make_unique<DeferredRays>());
+    }
 
     std::string name() const override {
         return "cpu (" + std::to_string(m_pool.size()) + " thread" +
@@ -71,6 +62,14 @@ class CpuBackend final : public core::Backend {
             ts.launch_size = size;
             ts.device_keys = m_spec.device_keys.data();
             ts.device_slots = unsigned(m_spec.device_keys.size());
+            DeferredRays& deferred = *m_deferred[worker];
+            ts.deferred = &deferred;
+            ts.programs_stack_top = static_cast<const char*>(__builtin_frame_address(0));
+            WorkerExceptions& exceptions = m_exceptions[worker];
+            auto run = [&](uint3 index) {
+                run_index(ts, e, index, exceptions);
+                if (deferred.full()) deferred.trace_all(ts, e, exceptions);
+            };
             set_thread_state(&ts);
             try {
                 for (uint64_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
@@ -78,8 +77,7 @@ class CpuBackend final : public core::Backend {
                     if (!by_rows) {
                         const uint64_t i0 = piece.first + tx * kTile1D;
                         const uint64_t i1 = std::min(piece.last, i0 + kTile1D);
-                        for (uint64_t i = i0; i < i1; ++i)
-                            run_index(ts, scene, e, uint3{unsigned(i), 0, 0}, m_exceptions[worker]);
+                        for (uint64_t i = i0; i < i1; ++i) run(uint3{unsigned(i), 0, 0});
                         continue;
                     }
                     const unsigned x0 = unsigned(tx) * kTileWidth;
@@ -88,15 +86,16 @@ class CpuBackend final : public core::Backend {
                     const uint64_t r1 = std::min(first_row + rows, r0 + kTileHeight);
                     for (uint64_t r = r0; r < r1; ++r) {
                         const unsigned y = unsigned(r % size.y), z = unsigned(r / size.y);
-                        for (unsigned x = x0; x < x1; ++x)
-                            run_index(ts, scene, e, uint3{x, y, z}, m_exceptions[worker]);
+                        for (unsigned x = x0; x < x1; ++x) run(uint3{x, y, z});
                     }
                 }
+                deferred.trace_all(ts, e, exceptions);
             } catch (...) {
                 // A C++ exception that is not the engine's (e.g. std::bad_alloc in a program).
                 std::lock_guard lock(error_mutex);
                 if (!error) error = std::current_exception();
                 next_tile = tile_count;  // stop the others early
+                deferred.clear();        // the launch has failed: its rays are not traced
             }
             set_thread_state(nullptr);
         }, unsigned(std::min<uint64_t>(tile_count, ~0u)));  // no more workers than tiles
@@ -121,34 +120,13 @@ class CpuBackend final : public core::Backend {
     bool uses_host_storage() const override { return true; }
 
   private:
-    static void run_index(ThreadState& ts, const core::CompiledScene& scene,
-                          const core::CompiledEntry& e, uint3 index, WorkerExceptions& out) {
-        set_launch_index(ts, index);
-        ts.depth = 0;
-        ts.frame = nullptr;
-        ts.context = ProgramContext::kRayGeneration;
-        ts.print_here = scene.print_enabled &&
-                        (scene.print_index.x < 0 || unsigned(scene.print_index.x) == index.x) &&
-                        (scene.print_index.y < 0 || unsigned(scene.print_index.y) == index.y) &&
-                        (scene.print_index.z < 0 || unsigned(scene.print_index.z) == index.z);
+    static void run_index(ThreadState& ts, const core::CompiledEntry& e, uint3 index,
+                          WorkerExceptions& out) {
+        enter_index(ts, index);
         try {
             e.ray_generation.entry<RayGenerationFn>()(e.ray_generation.rec());
         } catch (const ProgramException& ex) {
-            uint64_t linear =
-                (uint64_t(index.z) * ts.launch_size.y + index.y) * ts.launch_size.x + index.x;
-            out.add(ex.code, index, linear);
-            if (e.exception && scene.exception_enabled(ex.code)) {
-                ts.depth = 0;
-                ts.frame = nullptr;  // the unwound traces' frames are gone
-                ts.context = ProgramContext::kException;
-                try {
-                    e.exception.entry<ExceptionFn>()(e.exception.rec(),
-                                                     ExceptionInfo{ex.code, index, ex.detail});
-                } catch (const ProgramException& nested) {
-                    // An exception program that raises is counted, not re-run.
-                    out.add(nested.code, index, linear);
-                }
-            }
+            handle_program_exception(ts, e, index, ex, out);
         }
     }
 
@@ -157,6 +135,7 @@ class CpuBackend final : public core::Backend {
     core::LaunchSpec m_spec;
     std::vector<WorkerExceptions> m_exceptions;  // per worker, for the launch's pieces
     std::map<int, WorkerExceptions::Entry> m_merged;
+    std::vector<std::unique_ptr<DeferredRays>> m_deferred;  // per worker, kept between launches
 };
 
 }  // namespace

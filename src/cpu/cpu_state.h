@@ -17,6 +17,7 @@ using core::ProgramException;
 using runtime::ProgramContext;
 
 struct ThreadState;
+class DeferredRays;
 
 struct CpuPolicy {
     using Thread = ThreadState;
@@ -133,6 +134,12 @@ struct ThreadState {
     TraceFrame* frame = nullptr;  // the innermost, on the stack of its trace
     ProgramContext context = ProgramContext::kRayGeneration;  // outside any trace
     bool print_here = false;
+    // The worker's queue of the rays its ray-generation programs defer (deferred_rays.h);
+    // null outside a launch's worker.
+    DeferredRays* deferred = nullptr;
+    // The worker's frame below which its programs' frames lie: a deferred ray's payload
+    // between it and the deferring call is a program's local (require_outside_programs).
+    const char* programs_stack_top = nullptr;
 };
 
 /// Sets ts.launch_index as launch_index() reads it: (x, y) in one 8-byte store, z in one
@@ -159,6 +166,15 @@ void set_thread_state(ThreadState* state);
 /// Throws the error a program gets for passing ray flags or a mask from a module that does
 /// not declare kUsesRayFlags (the GPU's megakernel would not compile the call).
 void require_ray_flags_declared();
+
+/// Throws lucent::Error when `object` (what `call` writes after the calling program has
+/// returned) lies in the frame of a program on this thread's stack: it would be gone.
+void require_outside_programs(const ThreadState& ts, const void* object, const char* call,
+                              const char* what);
+
+/// Throws the error a program gets for calling occluded() from a scene whose modules do
+/// not declare kUsesOccluded (the GPU's megakernel would not compile the call).
+void require_occluded_declared(const core::CompiledScene& scene);
 
 /// occluded() of the device API.
 bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test, unsigned ray_flags,

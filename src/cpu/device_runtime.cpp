@@ -3,8 +3,10 @@
 // follow the shared trace state machine (runtime/device_api.h).
 #include <cstdio>
 #include <mutex>
+#include <string>
 
 #include "cpu/cpu_state.h"
+#include "cpu/deferred_rays.h"
 #include "lucent/device/api.h"
 #include "lucent/error.h"
 
@@ -33,6 +35,24 @@ void require_ray_flags_declared() {
             "this scene declares it; declare it in the module that calls it: "
             "LUCENT_MODULE(name, lucent::kUsesRayFlags)");
 }
+
+void require_outside_programs(const ThreadState& ts, const void* object, const char* call,
+                              const char* what) {
+    // Frames grow down: the programs' lie between this call's and the worker's.
+    const char* here = static_cast<const char*>(__builtin_frame_address(0));
+    const char* at = static_cast<const char*>(object);
+    if (ts.programs_stack_top && at >= here && at < ts.programs_stack_top)
+        throw Error(std::string(call) + " is given a " + what +
+                    " that is a local variable of the calling program; the ray is traced "
+                    "after the program returns, when the variable is gone. Pass an element "
+                    "of a buffer instead (for example rec.hits[launch_index().x])");
+}
+
+/// May a deferred ray wait in the queue? Only a ray-generation program's, outside any trace:
+/// elsewhere (hit programs, the exception program) it is traced at once.
+bool may_defer(const ThreadState& ts) {
+    return ts.deferred && ts.depth == 0 && ts.context == ProgramContext::kRayGeneration;
+}
 }  // namespace cpu
 
 namespace detail {
@@ -56,6 +76,42 @@ bool occluded_fields(Handle root, float3 origin, float3 direction, float tmin, f
     if ((ray_flags | (visibility_mask ^ kVisibilityMaskAll)) != 0) cpu::require_ray_flags_declared();
     return cpu::occluded(cpu::thread_state(), root, ray, Occlusion(occlusion), ray_flags,
                          visibility_mask);
+}
+
+void trace_deferred_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
+                           unsigned ray_type, float time, void* payload,
+                           const void* payload_tag) {
+    const Ray ray{origin, tmin, direction, tmax, ray_type, time};
+    cpu::ThreadState& ts = cpu::thread_state();
+    if (!cpu::may_defer(ts)) {
+        runtime::trace(runtime::backend(), root, ray, payload, payload_tag, kRayFlagNone,
+                       kVisibilityMaskAll);
+        return;
+    }
+    cpu::require_outside_programs(ts, payload, "trace_deferred()", "payload");
+    // trace()'s checks now, so that an exception is the deferring program's, as trace()'s.
+    runtime::trace_allowed(cpu::CpuPolicy{&ts}, root, ray, payload_tag, kRayFlagNone,
+                           kVisibilityMaskAll);
+    ts.deferred->add(cpu::DeferredTrace{ray, root, payload, ts.launch_index});
+}
+
+void occluded_deferred_fields(Handle root, float3 origin, float3 direction, float tmin,
+                              float tmax, unsigned ray_type, float time, unsigned occlusion,
+                              void* flag, void (*write_flag)(void*, bool)) {
+    const Ray ray{origin, tmin, direction, tmax, ray_type, time};
+    cpu::ThreadState& ts = cpu::thread_state();
+    if (!cpu::may_defer(ts)) {
+        write_flag(flag, cpu::occluded(ts, root, ray, Occlusion(occlusion), kRayFlagNone,
+                                       kVisibilityMaskAll));
+        return;
+    }
+    cpu::require_occluded_declared(*ts.scene);
+    cpu::require_outside_programs(ts, flag, "occluded_deferred()", "flag");
+    runtime::occlusion_allowed(cpu::CpuPolicy{&ts}, root, ray,
+                               Occlusion(occlusion) == Occlusion::kLeafBoxes, kRayFlagNone,
+                               kVisibilityMaskAll);
+    ts.deferred->add(
+        cpu::DeferredOcclusion{ray, root, Occlusion(occlusion), flag, write_flag, ts.launch_index});
 }
 
 void raise_exception(int code, unsigned detail) {

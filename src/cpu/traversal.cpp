@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "cpu/cpu_state.h"
+#include "cpu/triangle_groups.h"
 #include "lucent/device/triangle_intersect.h"
 #include "lucent/error.h"
 
@@ -195,17 +196,6 @@ class Traverser {
         return (m_frame.ray_flags & kRayFlagsFacingCull) || n.instances_masked;
     }
 
-    /// Global triangle of a triangles-only group → (instance index, local index).
-    void locate_triangle(const CompiledNode& n, unsigned global, unsigned& instance,
-                         unsigned& local) const {
-        const core::GeometryAccel& ga = *n.geometry;
-        // One instance (the common case) needs no lookup: tri_instance[global] is a load
-        // from a per-triangle array that a diffuse ray's random triangle misses in cache.
-        const size_t k = n.instances.size() == 1 ? 0 : ga.tri_instance[global];
-        instance = n.instances[k];
-        local = global - ga.prim_first[k];
-    }
-
     /// The closest triangle of a group without any-hit programs: committed, its attributes
     /// computed at shade time.
     void commit_triangle(const CompiledNode& n, unsigned global, float t, float2 bary) {
@@ -258,13 +248,18 @@ void CpuPolicy::traverse_frame(TraceFrame& frame, Handle root) const {
     Traverser(*ts, frame).root(root.index);
 }
 
+void require_occluded_declared(const CompiledScene& scene) {
+    if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
+        throw Error(
+            "occluded() or occluded_deferred() is called, but no module of this scene "
+            "declares it; declare it in the module that calls it: LUCENT_MODULE(name, "
+            "lucent::kUsesOccluded)");
+}
+
 bool occluded(ThreadState& ts, Handle root, const Ray& ray, Occlusion test, unsigned ray_flags,
               unsigned ray_mask) {
     const CompiledScene& scene = *ts.scene;
-    if (!scene.uses_occluded)  // the GPU's megakernel would not compile this call either
-        throw Error(
-            "occluded() is called, but no module of this scene declares it; declare "
-            "it in the module that calls it: LUCENT_MODULE(name, lucent::kUsesOccluded)");
+    require_occluded_declared(scene);
     const CpuPolicy policy{&ts};
     const bool leaf_boxes = test == Occlusion::kLeafBoxes;
     // Raises (throws) on bad input.

@@ -229,6 +229,73 @@ inline bool occluded(Handle root, const Ray& ray, Occlusion test = Occlusion::kE
 }
 #endif
 
+// ---- deferred rays: traced before the launch ends, not before the call returns ---------------
+// A ray-generation program that only hands a ray's answer on (to an output buffer, through
+// its hit programs) need not wait for it. trace_deferred() and occluded_deferred() queue
+// the ray and return at once; the ray is traced, and its programs run, before the launch
+// ends. On the CPU a worker's queued rays, tens of thousands from many launch indices, are
+// traced together as ray streams (many rays through each BVH node at once, Barringer and
+// Akenine-Möller 2014): what makes incoherent rays fast there, where trace() has to finish
+// one ray's walk before the program can go on. On the GPU a warp already traces 32 rays
+// together, and each is traced at once, as trace() traces it.
+// - What the ray's programs write must live in a buffer: the caller has returned when they
+//   run. The CPU backend refuses a local variable of the program (lucent::Error).
+// - Only a ray-generation program's rays wait; called from any other program (closest hit,
+//   miss, exception) these are trace() and occluded().
+// - Their programs see the deferring launch index (launch_index()); an exception raised in
+//   them ends that ray's programs and runs the entry point's exception program for that
+//   index. The order in which deferred rays' programs run is unspecified.
+// - No ray flags or visibility mask: a deferred ray visits everything.
+#if !LUCENT_GPU_CODE
+namespace detail {
+void trace_deferred_fields(Handle root, float3 origin, float3 direction, float tmin, float tmax,
+                           unsigned ray_type, float time, void* payload,
+                           const void* payload_tag);
+void occluded_deferred_fields(Handle root, float3 origin, float3 direction, float tmin,
+                              float tmax, unsigned ray_type, float time, unsigned occlusion,
+                              void* flag, void (*write_flag)(void*, bool));
+}  // namespace detail
+#endif
+
+/// trace() without waiting: `ray` is traced against the graph below `root` before the
+/// launch ends, and its closest-hit or miss program runs then on `payload`, which must live
+/// in a buffer (an element of an output buffer, as `rec.hits[i]`). The payload type must
+/// match the ray type's, as in trace(); trace()'s checks raise their exceptions now.
+template <class Payload>
+LUCENT_HD void trace_deferred(Handle root, const Ray& ray, Payload& payload) {
+#if LUCENT_GPU_CODE
+    trace(root, ray, payload);
+#else
+    detail::trace_deferred_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
+                                  ray.ray_type, ray.time, &payload,
+                                  &detail::TypeTag<Payload>::id);
+#endif
+}
+
+/// occluded() without waiting: before the launch ends, `blocked` (in a buffer, as
+/// trace_deferred()'s payload) becomes 1 when anything below `root` intersects `ray` within
+/// (tmin, tmax), else 0. `test` as in occluded(); the module declares kUsesOccluded.
+#if defined(__CUDACC_RTC__) && defined(LUCENT_GPU_OCCLUSION) && !LUCENT_GPU_OCCLUSION
+template <class Flag>
+__device__ void occluded_deferred(Handle, const Ray&, Flag&, Occlusion = Occlusion::kExact) {
+    static_assert(detail::dependent_false<Flag>,
+                  "occluded_deferred() is called by a module that does not declare it: write "
+                  "LUCENT_MODULE(name, lucent::kUsesOccluded)");
+}
+#else
+template <class Flag>
+LUCENT_HD void occluded_deferred(Handle root, const Ray& ray, Flag& blocked,
+                                 Occlusion test = Occlusion::kExact) {
+#if LUCENT_GPU_CODE
+    blocked = Flag(occluded(root, ray, test) ? 1 : 0);
+#else
+    detail::occluded_deferred_fields(root, ray.origin, ray.direction, ray.tmin, ray.tmax,
+                                     ray.ray_type, ray.time, unsigned(test), &blocked,
+                                     [](void* flag, bool b) { *static_cast<Flag*>(flag) = Flag(b ? 1 : 0); });
+#endif
+}
+#endif
+
 /// In an intersection program: is t inside the ray's current interval (tmin, closest hit so
 /// far)? False, and no effect, in every other program kind.
 LUCENT_HD bool potential_intersection(float t);
