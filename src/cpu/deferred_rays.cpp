@@ -1,5 +1,6 @@
 #include "cpu/deferred_rays.h"
 
+#include <cstring>
 #include <utility>
 
 #include "cpu/triangle_groups.h"
@@ -48,11 +49,19 @@ std::vector<std::vector<uint32_t>> groups_of(const std::vector<Entry>& queue, Ke
     return out;
 }
 
-/// How many rays ahead of the one being shaded the hit triangles' indices are fetched (the
-/// vertices are fetched half as far ahead, once their indices have arrived). A diffuse
-/// ray's hit triangle is anywhere in the mesh; its attributes, computed at shade time,
-/// would otherwise wait on two misses per ray.
-constexpr size_t kIndicesAhead = 16, kVerticesAhead = 8;
+/// How many hits ahead of the one whose attributes are computed its triangle's indices are
+/// fetched (the vertices are fetched half as far ahead, once their indices have arrived).
+/// A diffuse ray's hit triangle is anywhere in the mesh: without them each hit waits on
+/// two misses.
+constexpr size_t kIndicesAhead = 48, kVerticesAhead = 24;
+
+/// Does every instance of the group take the built-in triangle attributes (no attribute
+/// program)? Then they are computed for all hits ahead of the programs.
+bool built_in_attributes(const CompiledScene& scene, const CompiledNode& n) {
+    for (unsigned i : n.instances)
+        if (scene.instances[i].attribute) return false;
+    return true;
+}
 
 }  // namespace
 
@@ -102,12 +111,10 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
         m_stream[j] = accel::StreamRay{r.origin, r.tmin, r.direction, r.tmax};
     }
     n.geometry->triangles.intersect_stream(m_stream, m_hits, m_workspace);
+    const bool built_in = built_in_attributes(scene, n);
+    if (built_in) compute_attributes(scene, n);
 
     for (size_t j = 0; j < group.size(); ++j) {
-        if (j + kIndicesAhead < group.size())
-            prefetch_triangle_indices(scene, n, m_hits[j + kIndicesAhead].prim);
-        if (j + kVerticesAhead < group.size())
-            prefetch_triangle_vertices(scene, n, m_hits[j + kVerticesAhead].prim);
         const DeferredTrace& q = m_traces[group[j]];
         const accel::StreamHit& hit = m_hits[j];
         enter_index(ts, q.index);
@@ -125,6 +132,11 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
                     f, instance, local, hit.t,
                     policy.primitive_material(scene.instances[instance], local),
                     make_float2(hit.u, hit.v));
+                if (built_in) {  // computed above, as the single-ray path computes them at the hit
+                    std::memcpy(f.hit_attr.bytes, m_attributes[j].bytes,
+                                sizeof m_attributes[j].bytes);
+                    f.hit_pending = false;
+                }
             }
             runtime::shade(policy, f, q.ray);
             ts.depth = 0;
@@ -132,6 +144,25 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
         } catch (const ProgramException& ex) {
             handle_program_exception(ts, entry, q.index, ex, out);
         }
+    }
+}
+
+void DeferredRays::compute_attributes(const CompiledScene& scene, const CompiledNode& n) {
+    m_attributes.resize(m_hits.size());
+    const CpuPolicy policy{nullptr};  // its triangle() reads only the instance (no motion here)
+    for (size_t j = 0; j < m_hits.size(); ++j) {
+        if (j + kIndicesAhead < m_hits.size())
+            prefetch_triangle_indices(scene, n, m_hits[j + kIndicesAhead].prim);
+        if (j + kVerticesAhead < m_hits.size())
+            prefetch_triangle_vertices(scene, n, m_hits[j + kVerticesAhead].prim);
+        const accel::StreamHit& hit = m_hits[j];
+        if (hit.prim == accel::kStreamMiss) continue;
+        unsigned instance, local;
+        locate_triangle(n, hit.prim, instance, local);
+        float3 p0, p1, p2;
+        policy.triangle(scene.instances[instance], local, p0, p1, p2);
+        runtime::builtin_triangle_attributes(make_float2(hit.u, hit.v), p0, p1, p2,
+                                             m_attributes[j]);
     }
 }
 

@@ -55,6 +55,8 @@ class DeferredRays {
   private:
     void trace_group(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
                      const std::vector<uint32_t>& group);
+    /// The built-in attributes of every hit of the stream (m_hits) into m_attributes.
+    void compute_attributes(const core::CompiledScene& scene, const core::CompiledNode& n);
     void occlude_group(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
                        const std::vector<uint32_t>& group);
 
@@ -64,6 +66,10 @@ class DeferredRays {
     std::vector<accel::StreamRay> m_stream;
     std::vector<accel::StreamHit> m_hits;
     std::vector<uint8_t> m_blocked;
+    struct HitAttributes {  // a TriangleAttributes, as the frame's attribute bytes hold it
+        alignas(8) unsigned char bytes[sizeof(TriangleAttributes)];
+    };
+    std::vector<HitAttributes> m_attributes;
 };
 
 }  // namespace lucent::cpu
