@@ -38,11 +38,12 @@ LUCENT_MISS(nothing, NoRecord, Payload) {{ prd.depth = -1.0f; prd.facing = 0.0f;
 """
 
 
-def depth_image(ctx, module_name, size=(8, 4), height=2.0):
-    """Launches the depth camera over a square at z = 0 covering x, y in [-0.5, 0.5] (no
-    pixel centre lies on its edges)."""
-    ctx.set_ray_type(0, "probe", payload=f"{module_name}::Payload")
-    ctx.set_ray_generation_program(0, ctx.create_program("camera", module_name))
+def depth_image(ctx, module_name, size=(8, 4), height=2.0, payload=None, camera="camera"):
+    """Launches the depth camera (ray-generation program `camera`; the payload type
+    `payload`, else the module's Payload) over a square at z = 0 covering x, y in
+    [-0.5, 0.5] (no pixel centre lies on its edges)."""
+    ctx.set_ray_type(0, "probe", payload=payload or f"{module_name}::Payload")
+    ctx.set_ray_generation_program(0, ctx.create_program(camera, module_name))
     ctx.set_miss_program(0, ctx.create_program("nothing", module_name))
     vertices = ctx.create_buffer("input", "float3", 4)
     vertices.upload(np.array([[-.5, -.5, 0], [.5, -.5, 0], [.5, .5, 0], [-.5, .5, 0]], np.float32))
@@ -171,3 +172,52 @@ def test_a_compiled_in_module_and_its_text_compiled_at_run_time_give_the_same_im
     at_run_time = first_program_image(ctx, "first_program_at_run_time")
     assert np.count_nonzero(compiled_in[..., 0] > 0.2) > 100  # the triangle is there
     np.testing.assert_array_equal(at_run_time, compiled_in)
+
+
+# The depth camera with its rays deferred (trace_deferred): the payload is the image's own
+# element, which the closest-hit or miss program writes after the camera has returned.
+DEFERRED_DEPTH_MODULE = """
+#include "lucent/device.h"
+namespace {name} {{
+LUCENT_MODULE({name})
+using namespace lucent;
+
+struct Camera {{ Handle scene; BufferView<float2> image; float height; }};
+LUCENT_RECORD(Camera, scene, image, height)
+
+LUCENT_RAY_GENERATION(camera, Camera) {{
+    const uint3 i = launch_index(), n = launch_size();
+    const float x = (i.x + 0.5f) / n.x * 2 - 1, y = 1 - (i.y + 0.5f) / n.y * 2;
+    trace_deferred(rec.scene, make_ray(make_float3(x, y, rec.height), make_float3(0, 0, -1), 0, 0.0f),
+                   rec.image[make_uint2(i.x, i.y)]);
+}}
+
+LUCENT_RAY_GENERATION(camera_into_local, Camera) {{
+    float2 p = make_float2(-1.0f, 0.0f);
+    trace_deferred(rec.scene, make_ray(make_float3(0, 0, rec.height), make_float3(0, 0, -1), 0, 0.0f), p);
+    rec.image[make_uint2(launch_index().x, launch_index().y)] = p;
+}}
+
+LUCENT_CLOSEST_HIT(depth, NoRecord, float2, TriangleAttributes) {{
+    prd = make_float2(t_hit(), fabsf(normalize(attr.geometric_normal).z));
+}}
+
+LUCENT_MISS(nothing, NoRecord, float2) {{ prd = make_float2(-1.0f, 0.0f); }}
+}}
+"""
+
+
+def test_a_module_from_a_string_may_defer_its_rays():
+    ctx = lucent.Context(backend=BACKEND)
+    ctx.add_module(DEFERRED_DEPTH_MODULE.format(name="py_deferred_depth"))
+    size = (40, 30)
+    np.testing.assert_allclose(depth_image(ctx, "py_deferred_depth", size=size, payload="float2"),
+                               expected_depth(size=size), rtol=1e-6)
+
+
+@pytest.mark.skipif(BACKEND != "cpu", reason="the GPU traces a deferred ray at once")
+def test_a_deferred_ray_into_a_local_is_refused():
+    ctx = lucent.Context(backend=BACKEND)
+    ctx.add_module(DEFERRED_DEPTH_MODULE.format(name="py_deferred_local"))
+    with pytest.raises(lucent.Error, match="trace_deferred.*local variable.*buffer"):
+        depth_image(ctx, "py_deferred_local", payload="float2", camera="camera_into_local")

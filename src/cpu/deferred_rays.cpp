@@ -32,21 +32,39 @@ bool streams_occlusion(const CompiledScene& scene, Handle root, Occlusion test) 
     return test == Occlusion::kExact && streamable_group(scene.nodes[root.index]);
 }
 
-/// The positions in `queue` of each run of rays that one query traces together (the same
-/// `key`), in the order of each key's first ray: most launches have one.
+/// Orders the positions of `queue` into `order` so that the rays one query traces together
+/// (the same `key`) lie next to each other, each key's in queue order and the keys in the
+/// order of their first rays, and puts where each key's rays end into `ends`. Most launches
+/// have one key. Both vectors keep their memory from call to call: a buffer of a worker's
+/// 65,536 rays allocated per call was mapped and unmapped each time, which with 16 workers
+/// cost more than the rays' programs.
 template <class Entry, class Key>
-std::vector<std::vector<uint32_t>> groups_of(const std::vector<Entry>& queue, Key key) {
-    std::vector<std::pair<uint64_t, std::vector<uint32_t>>> groups;
-    for (uint32_t i = 0; i < queue.size(); ++i) {
-        const uint64_t k = key(queue[i]);
-        auto it = groups.begin();
-        while (it != groups.end() && it->first != k) ++it;
-        if (it == groups.end()) it = groups.insert(groups.end(), {k, {}});
-        it->second.push_back(i);
+void order_by_key(const std::vector<Entry>& queue, Key key, std::vector<uint32_t>& order,
+                  std::vector<size_t>& ends) {
+    std::vector<std::pair<uint64_t, size_t>> counts;  // per key: its rays
+    for (const Entry& e : queue) {
+        const uint64_t k = key(e);
+        auto it = counts.begin();
+        while (it != counts.end() && it->first != k) ++it;
+        if (it == counts.end())
+            counts.push_back({k, 1});
+        else
+            ++it->second;
     }
-    std::vector<std::vector<uint32_t>> out;
-    for (auto& g : groups) out.push_back(std::move(g.second));
-    return out;
+    order.resize(queue.size());
+    ends.clear();
+    std::vector<size_t> next;  // per key: where its next ray goes
+    size_t end = 0;
+    for (const auto& [k, count] : counts) {
+        next.push_back(end);
+        end += count;
+        ends.push_back(end);
+    }
+    for (uint32_t i = 0; i < queue.size(); ++i) {
+        size_t g = 0;
+        while (counts[g].first != key(queue[i])) ++g;
+        order[next[g]++] = i;
+    }
 }
 
 /// How many hits ahead of the one whose attributes are computed its triangle's indices are
@@ -67,14 +85,20 @@ bool built_in_attributes(const CompiledScene& scene, const CompiledNode& n) {
 
 void DeferredRays::trace_all(ThreadState& ts, const core::CompiledEntry& entry,
                              WorkerExceptions& out) {
-    for (const auto& group : groups_of(m_traces, [](const DeferredTrace& q) {
-             return uint64_t(q.root.index) << 32 | q.ray.ray_type;
-         }))
-        trace_group(ts, entry, out, group);
-    for (const auto& group : groups_of(m_occlusions, [](const DeferredOcclusion& q) {
-             return uint64_t(q.root.index) << 32 | unsigned(q.test);
-         }))
-        occlude_group(ts, entry, out, group);
+    order_by_key(
+        m_traces,
+        [](const DeferredTrace& q) { return uint64_t(q.root.index) << 32 | q.ray.ray_type; },
+        m_order, m_group_ends);
+    for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
+        trace_group(ts, entry, out,
+                    std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
+    order_by_key(
+        m_occlusions,
+        [](const DeferredOcclusion& q) { return uint64_t(q.root.index) << 32 | unsigned(q.test); },
+        m_order, m_group_ends);
+    for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
+        occlude_group(ts, entry, out,
+                      std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
     m_traces.clear();
     m_occlusions.clear();
     ts.depth = 0;
@@ -82,7 +106,7 @@ void DeferredRays::trace_all(ThreadState& ts, const core::CompiledEntry& entry,
 }
 
 void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry,
-                               WorkerExceptions& out, const std::vector<uint32_t>& group) {
+                               WorkerExceptions& out, std::span<const uint32_t> group) {
     const CompiledScene& scene = *ts.scene;
     const CpuPolicy policy{&ts};
     const Handle root = m_traces[group[0]].root;
@@ -167,7 +191,7 @@ void DeferredRays::compute_attributes(const CompiledScene& scene, const Compiled
 }
 
 void DeferredRays::occlude_group(ThreadState& ts, const core::CompiledEntry& entry,
-                                 WorkerExceptions& out, const std::vector<uint32_t>& group) {
+                                 WorkerExceptions& out, std::span<const uint32_t> group) {
     const CompiledScene& scene = *ts.scene;
     const Handle root = m_occlusions[group[0]].root;
     const Occlusion test = m_occlusions[group[0]].test;

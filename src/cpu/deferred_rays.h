@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "accel/ray_stream.h"
@@ -54,14 +55,18 @@ class DeferredRays {
 
   private:
     void trace_group(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
-                     const std::vector<uint32_t>& group);
+                     std::span<const uint32_t> group);
     /// The built-in attributes of every hit of the stream (m_hits) into m_attributes.
     void compute_attributes(const core::CompiledScene& scene, const core::CompiledNode& n);
     void occlude_group(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
-                       const std::vector<uint32_t>& group);
+                       std::span<const uint32_t> group);
 
     std::vector<DeferredTrace> m_traces;
     std::vector<DeferredOcclusion> m_occlusions;
+    // The queue's positions grouped by what one query traces together, and where each
+    // group ends (trace_all).
+    std::vector<uint32_t> m_order;
+    std::vector<size_t> m_group_ends;
     accel::RayStreamWorkspace m_workspace;
     std::vector<accel::StreamRay> m_stream;
     std::vector<accel::StreamHit> m_hits;

@@ -21,6 +21,26 @@ LUCENT_RAY_GENERATION(deferred_cast, CasterRecord) {
     trace_deferred(rec.top, make_ray(r.origin, r.direction, 0, 1e-4f), rec.results[i]);
 }
 
+/// Each ray twice in one launch (so that on the GPU both see the same tree): deferred into
+/// results, waited for into waited.
+struct BesideRecord {
+    Handle top;
+    BufferView<CastRay> rays;
+    BufferView<TestPayload> results;
+    BufferView<TestPayload> waited;
+};
+LUCENT_RECORD(BesideRecord, top, rays, results, waited)
+LUCENT_RAY_GENERATION(deferred_beside_trace, BesideRecord) {
+    const unsigned i = launch_index().x;
+    const CastRay r = rec.rays[i];
+    const Ray ray = make_ray(r.origin, r.direction, 0, 1e-4f);
+    rec.results[i] = make_test_payload();
+    trace_deferred(rec.top, ray, rec.results[i]);
+    TestPayload p = make_test_payload();
+    trace(rec.top, ray, p);
+    rec.waited[i] = p;
+}
+
 /// Wrong: the payload is the program's local, gone when the ray is traced.
 LUCENT_RAY_GENERATION(deferred_cast_into_local, CasterRecord) {
     const unsigned i = launch_index().x;
@@ -47,13 +67,21 @@ LUCENT_RAY_GENERATION(deferred_cast_both_ways, BothWaysRecord) {
     trace_deferred(rec.top, make_ray(r.origin, -r.direction, 0, 1e-4f), rec.backward[i]);
 }
 
-/// occlusion_cast's occluded() with the query deferred (trace() is not compared here).
-LUCENT_RAY_GENERATION(deferred_occlusion_cast, OcclusionRecord) {
+/// Each query twice in one launch: occluded() into occluded, occluded_deferred() into deferred.
+struct OcclusionBesideRecord {
+    Handle top;
+    BufferView<OcclusionQuery> queries;
+    BufferView<unsigned> occluded;
+    BufferView<unsigned> deferred;
+};
+LUCENT_RECORD(OcclusionBesideRecord, top, queries, occluded, deferred)
+LUCENT_RAY_GENERATION(deferred_beside_occluded, OcclusionBesideRecord) {
     const unsigned i = launch_index().x;
     const OcclusionQuery q = rec.queries[i];
     const Ray ray = make_ray(q.origin, q.direction, 0, 1e-4f, q.tmax);
     const Occlusion test = q.leaf_boxes ? Occlusion::kLeafBoxes : Occlusion::kExact;
-    occluded_deferred(rec.top, ray, rec.occluded[i], test);
+    occluded_deferred(rec.top, ray, rec.deferred[i], test);
+    rec.occluded[i] = occluded(rec.top, ray, test) ? 1u : 0u;
 }
 
 /// Closest hit: the launch index that deferred the ray (in `id`), and code A (detail = the
