@@ -50,7 +50,7 @@ void require_outside_programs(const ThreadState& ts, const void* object, const c
 
 /// May a deferred ray wait in the queue? Only a ray-generation program's, outside any trace:
 /// elsewhere (hit programs, the exception program) it is traced at once.
-bool may_defer(const ThreadState& ts) {
+static bool may_defer(const ThreadState& ts) {
     return ts.deferred && ts.depth == 0 && ts.context == ProgramContext::kRayGeneration;
 }
 }  // namespace cpu
