@@ -53,8 +53,10 @@ class GuidedTiles {
 class CpuBackend final : public core::Backend {
   public:
     explicit CpuBackend(unsigned threads) : m_pool(threads) {
-        for (unsigned w = 0; w < m_pool.size(); ++w)
-            m_deferred.push_back(std::make_unique<DeferredRays>());
+        for (unsigned w = 0; w < m_pool.size(); ++w) {
+            m_queues.push_back(std::make_unique<DeferredQueue>());
+            m_tracers.push_back(std::make_unique<DeferredTracer>());
+        }
     }
 
     std::string name() const override {
@@ -83,8 +85,10 @@ class CpuBackend final : public core::Backend {
 
         const unsigned workers = unsigned(std::min<uint64_t>(tile_count, m_pool.size()));
         GuidedTiles tiles(tile_count, workers);
+        DeferredParts parts(workers);
         std::mutex error_mutex;
         std::exception_ptr error;
+        std::atomic<bool> failed{false};
         m_pool.run(
             [&](unsigned worker) {
                 ThreadState ts;
@@ -92,45 +96,49 @@ class CpuBackend final : public core::Backend {
                 ts.launch_size = size;
                 ts.device_keys = m_spec.device_keys.data();
                 ts.device_slots = unsigned(m_spec.device_keys.size());
-                DeferredRays& deferred = *m_deferred[worker];
-                ts.deferred = &deferred;
+                DeferredQueue& queue = *m_queues[worker];
+                DeferredTracer& tracer = *m_tracers[worker];
+                ts.deferred = &queue;
                 ts.programs_stack_top = static_cast<const char*>(__builtin_frame_address(0));
                 WorkerExceptions& exceptions = m_exceptions[worker];
-                auto run = [&](uint3 index) {
-                    run_index(ts, e, index, exceptions);
-                    if (deferred.full()) deferred.trace_all(ts, e, exceptions);
+                auto fail = [&] {
+                    // A C++ exception that is not the engine's (e.g. std::bad_alloc in a
+                    // program, a lucent::Error of a misused call).
+                    std::lock_guard lock(error_mutex);
+                    if (!error) error = std::current_exception();
+                    tiles.stop();  // stop the others early
+                    failed = true;
                 };
                 set_thread_state(&ts);
                 try {
                     for (uint64_t first, n; tiles.take(first, n);)
-                        for (uint64_t tile = first; tile < first + n; ++tile) {
-                            const uint64_t tx = tile % tiles_x, ty = tile / tiles_x;
-                            if (!by_rows) {
-                                const uint64_t i0 = piece.first + tx * kTile1D;
-                                const uint64_t i1 = std::min(piece.last, i0 + kTile1D);
-                                for (uint64_t i = i0; i < i1; ++i) run(uint3{unsigned(i), 0, 0});
-                                continue;
-                            }
-                            const unsigned x0 = unsigned(tx) * kTileWidth;
-                            const unsigned x1 = std::min(size.x, x0 + kTileWidth);
-                            const uint64_t r0 = first_row + ty * kTileHeight;
-                            const uint64_t r1 = std::min(first_row + rows, r0 + kTileHeight);
-                            for (uint64_t r = r0; r < r1; ++r) {
-                                const unsigned y = unsigned(r % size.y), z = unsigned(r / size.y);
-                                for (unsigned x = x0; x < x1; ++x) run(uint3{x, y, z});
-                            }
-                        }
-                    deferred.trace_all(ts, e, exceptions);
+                        for (uint64_t tile = first; tile < first + n; ++tile)
+                            run_tile(ts, e, tile, tiles_x, first_row, rows, piece, exceptions, [&] {
+                                if (!queue.full()) return;
+                                tracer.trace_all(ts, e, exceptions, queue);
+                                queue.clear();
+                            });
+                    parts.add(queue);
                 } catch (...) {
-                    // A C++ exception that is not the engine's (e.g. std::bad_alloc in a program).
-                    std::lock_guard lock(error_mutex);
-                    if (!error) error = std::current_exception();
-                    tiles.stop();      // stop the others early
-                    deferred.clear();  // the launch has failed: its rays are not traced
+                    fail();
+                }
+                // The rays every worker still holds, shared out (DeferredParts).
+                parts.arrive_and_wait();
+                try {
+                    std::span<const DeferredTrace> traces;
+                    std::span<const DeferredOcclusion> occlusions;
+                    while (!failed && parts.take(traces, occlusions)) {
+                        tracer.trace(ts, e, exceptions, traces);
+                        tracer.occlude(ts, e, exceptions, occlusions);
+                    }
+                } catch (...) {
+                    fail();
                 }
                 set_thread_state(nullptr);
             },
             workers);  // no more workers than tiles
+        // Every part is traced (or the launch has failed, and its rays are not).
+        for (unsigned w = 0; w < workers; ++w) m_queues[w]->clear();
         if (error) std::rethrow_exception(error);
     }
 
@@ -152,6 +160,36 @@ class CpuBackend final : public core::Backend {
     bool uses_host_storage() const override { return true; }
 
   private:
+    /// Runs the launch indices of tile `tile` of a piece (8x8 of whole rows, or 64 of one
+    /// row), calling after_index() after each.
+    template <class AfterIndex>
+    void run_tile(ThreadState& ts, const core::CompiledEntry& e, uint64_t tile, uint64_t tiles_x,
+                  uint64_t first_row, uint64_t rows, core::LaunchPiece piece,
+                  WorkerExceptions& exceptions, AfterIndex&& after_index) const {
+        const uint3 size = m_spec.size;
+        const uint64_t tx = tile % tiles_x, ty = tile / tiles_x;
+        if (!m_spec.by_rows()) {
+            const uint64_t i0 = piece.first + tx * kTile1D;
+            const uint64_t i1 = std::min(piece.last, i0 + kTile1D);
+            for (uint64_t i = i0; i < i1; ++i) {
+                run_index(ts, e, uint3{unsigned(i), 0, 0}, exceptions);
+                after_index();
+            }
+            return;
+        }
+        const unsigned x0 = unsigned(tx) * kTileWidth;
+        const unsigned x1 = std::min(size.x, x0 + kTileWidth);
+        const uint64_t r0 = first_row + ty * kTileHeight;
+        const uint64_t r1 = std::min(first_row + rows, r0 + kTileHeight);
+        for (uint64_t r = r0; r < r1; ++r) {
+            const unsigned y = unsigned(r % size.y), z = unsigned(r / size.y);
+            for (unsigned x = x0; x < x1; ++x) {
+                run_index(ts, e, uint3{x, y, z}, exceptions);
+                after_index();
+            }
+        }
+    }
+
     static void run_index(ThreadState& ts, const core::CompiledEntry& e, uint3 index,
                           WorkerExceptions& out) {
         enter_index(ts, index);
@@ -167,7 +205,10 @@ class CpuBackend final : public core::Backend {
     core::LaunchSpec m_spec;
     std::vector<WorkerExceptions> m_exceptions;  // per worker, for the launch's pieces
     std::map<int, WorkerExceptions::Entry> m_merged;
-    std::vector<std::unique_ptr<DeferredRays>> m_deferred;  // per worker, kept between launches
+    // Per worker, kept from launch to launch: its deferred rays, and the memory it traces
+    // them in.
+    std::vector<std::unique_ptr<DeferredQueue>> m_queues;
+    std::vector<std::unique_ptr<DeferredTracer>> m_tracers;
 };
 
 }  // namespace

@@ -17,7 +17,7 @@ using core::ProgramException;
 using runtime::ProgramContext;
 
 struct ThreadState;
-class DeferredRays;
+class DeferredQueue;
 
 struct CpuPolicy {
     using Thread = ThreadState;
@@ -136,7 +136,7 @@ struct ThreadState {
     bool print_here = false;
     // The worker's queue of the rays its ray-generation programs defer (deferred_rays.h);
     // null outside a launch's worker.
-    DeferredRays* deferred = nullptr;
+    DeferredQueue* deferred = nullptr;
     // The worker's frame below which its programs' frames lie: a deferred ray's payload
     // between it and the deferring call is a program's local (require_outside_programs).
     const char* programs_stack_top = nullptr;

@@ -1,5 +1,6 @@
 #include "cpu/deferred_rays.h"
 
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -39,7 +40,7 @@ bool streams_occlusion(const CompiledScene& scene, Handle root, Occlusion test) 
 /// 65,536 rays allocated per call was mapped and unmapped each time, which with 16 workers
 /// cost more than the rays' programs.
 template <class Entry, class Key>
-void order_by_key(const std::vector<Entry>& queue, Key key, std::vector<uint32_t>& order,
+void order_by_key(std::span<const Entry> queue, Key key, std::vector<uint32_t>& order,
                   std::vector<size_t>& ends) {
     std::vector<std::pair<uint64_t, size_t>> counts;  // per key: its rays
     for (const Entry& e : queue) {
@@ -83,39 +84,43 @@ bool built_in_attributes(const CompiledScene& scene, const CompiledNode& n) {
 
 }  // namespace
 
-void DeferredRays::trace_all(ThreadState& ts, const core::CompiledEntry& entry,
-                             WorkerExceptions& out) {
+void DeferredTracer::trace(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
+                           std::span<const DeferredTrace> rays) {
     order_by_key(
-        m_traces,
-        [](const DeferredTrace& q) { return uint64_t(q.root.index) << 32 | q.ray.ray_type; },
+        rays, [](const DeferredTrace& q) { return uint64_t(q.root.index) << 32 | q.ray.ray_type; },
         m_order, m_group_ends);
     for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
-        trace_group(ts, entry, out,
+        trace_group(ts, entry, out, rays,
                     std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
-    order_by_key(
-        m_occlusions,
-        [](const DeferredOcclusion& q) { return uint64_t(q.root.index) << 32 | unsigned(q.test); },
-        m_order, m_group_ends);
-    for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
-        occlude_group(ts, entry, out,
-                      std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
-    m_traces.clear();
-    m_occlusions.clear();
     ts.depth = 0;
     ts.frame = nullptr;
 }
 
-void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry,
-                               WorkerExceptions& out, std::span<const uint32_t> group) {
+void DeferredTracer::occlude(ThreadState& ts, const core::CompiledEntry& entry,
+                             WorkerExceptions& out, std::span<const DeferredOcclusion> rays) {
+    order_by_key(
+        rays,
+        [](const DeferredOcclusion& q) { return uint64_t(q.root.index) << 32 | unsigned(q.test); },
+        m_order, m_group_ends);
+    for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
+        occlude_group(ts, entry, out, rays,
+                      std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
+    ts.depth = 0;
+    ts.frame = nullptr;
+}
+
+void DeferredTracer::trace_group(ThreadState& ts, const core::CompiledEntry& entry,
+                                 WorkerExceptions& out, std::span<const DeferredTrace> rays,
+                                 std::span<const uint32_t> group) {
     const CompiledScene& scene = *ts.scene;
     const CpuPolicy policy{&ts};
-    const Handle root = m_traces[group[0]].root;
-    const unsigned ray_type = m_traces[group[0]].ray.ray_type;
+    const Handle root = rays[group[0]].root;
+    const unsigned ray_type = rays[group[0]].ray.ray_type;
     // Checked against the ray type when the ray was deferred (trace_allowed).
     const void* payload_tag = scene.ray_types[ray_type].payload->tag;
     if (!streams_trace(scene, root, ray_type)) {
         for (uint32_t k : group) {
-            const DeferredTrace& q = m_traces[k];
+            const DeferredTrace& q = rays[k];
             enter_index(ts, q.index);
             try {
                 runtime::trace(policy, q.root, q.ray, q.payload, payload_tag, kRayFlagNone,
@@ -131,7 +136,7 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
     m_stream.resize(group.size());
     m_hits.resize(group.size());
     for (size_t j = 0; j < group.size(); ++j) {
-        const Ray& r = m_traces[group[j]].ray;
+        const Ray& r = rays[group[j]].ray;
         m_stream[j] = accel::StreamRay{r.origin, r.tmin, r.direction, r.tmax};
     }
     n.geometry->triangles.intersect_stream(m_stream, m_hits, m_workspace);
@@ -139,7 +144,7 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
     if (built_in) compute_attributes(scene, n);
 
     for (size_t j = 0; j < group.size(); ++j) {
-        const DeferredTrace& q = m_traces[group[j]];
+        const DeferredTrace& q = rays[group[j]];
         const accel::StreamHit& hit = m_hits[j];
         enter_index(ts, q.index);
         try {
@@ -171,7 +176,7 @@ void DeferredRays::trace_group(ThreadState& ts, const core::CompiledEntry& entry
     }
 }
 
-void DeferredRays::compute_attributes(const CompiledScene& scene, const CompiledNode& n) {
+void DeferredTracer::compute_attributes(const CompiledScene& scene, const CompiledNode& n) {
     m_attributes.resize(m_hits.size());
     const CpuPolicy policy{nullptr};  // its triangle() reads only the instance (no motion here)
     for (size_t j = 0; j < m_hits.size(); ++j) {
@@ -190,14 +195,15 @@ void DeferredRays::compute_attributes(const CompiledScene& scene, const Compiled
     }
 }
 
-void DeferredRays::occlude_group(ThreadState& ts, const core::CompiledEntry& entry,
-                                 WorkerExceptions& out, std::span<const uint32_t> group) {
+void DeferredTracer::occlude_group(ThreadState& ts, const core::CompiledEntry& entry,
+                                   WorkerExceptions& out, std::span<const DeferredOcclusion> rays,
+                                   std::span<const uint32_t> group) {
     const CompiledScene& scene = *ts.scene;
-    const Handle root = m_occlusions[group[0]].root;
-    const Occlusion test = m_occlusions[group[0]].test;
+    const Handle root = rays[group[0]].root;
+    const Occlusion test = rays[group[0]].test;
     if (!streams_occlusion(scene, root, test)) {
         for (uint32_t k : group) {
-            const DeferredOcclusion& q = m_occlusions[k];
+            const DeferredOcclusion& q = rays[k];
             enter_index(ts, q.index);
             try {  // intersection programs may raise
                 q.write_flag(q.flag,
@@ -211,14 +217,49 @@ void DeferredRays::occlude_group(ThreadState& ts, const core::CompiledEntry& ent
     m_stream.resize(group.size());
     m_blocked.resize(group.size());
     for (size_t j = 0; j < group.size(); ++j) {
-        const Ray& r = m_occlusions[group[j]].ray;
+        const Ray& r = rays[group[j]].ray;
         m_stream[j] = accel::StreamRay{r.origin, r.tmin, r.direction, r.tmax};
     }
     scene.nodes[root.index].geometry->triangles.occluded_stream(m_stream, m_blocked, m_workspace);
     for (size_t j = 0; j < group.size(); ++j) {
-        const DeferredOcclusion& q = m_occlusions[group[j]];
+        const DeferredOcclusion& q = rays[group[j]];
         q.write_flag(q.flag, m_blocked[j] != 0);
     }
+}
+
+void DeferredParts::add(const DeferredQueue& queue) {
+    // Parts of 16K rays: large enough for a stream to gain on incoherent rays (session 38),
+    // small enough that 16 workers get several each.
+    constexpr size_t kPartRays = 16384;
+    std::lock_guard lock(m_mutex);
+    const auto traces = queue.traces();
+    for (size_t begin = 0; begin < traces.size(); begin += kPartRays)
+        m_parts.push_back({traces.subspan(begin, std::min(kPartRays, traces.size() - begin)), {}});
+    const auto occlusions = queue.occlusions();
+    for (size_t begin = 0; begin < occlusions.size(); begin += kPartRays)
+        m_parts.push_back(
+            {{}, occlusions.subspan(begin, std::min(kPartRays, occlusions.size() - begin))});
+}
+
+void DeferredParts::arrive_and_wait() {
+    std::unique_lock lock(m_mutex);
+    if (++m_arrived == m_workers) {
+        // The largest parts first, so that the last ones taken are the smallest.
+        std::stable_sort(m_parts.begin(), m_parts.end(),
+                         [](const Part& a, const Part& b) { return a.size() > b.size(); });
+        m_all_arrived.notify_all();
+        return;
+    }
+    m_all_arrived.wait(lock, [&] { return m_arrived == m_workers; });
+}
+
+bool DeferredParts::take(std::span<const DeferredTrace>& traces,
+                         std::span<const DeferredOcclusion>& occlusions) {
+    const size_t k = m_next.fetch_add(1);
+    if (k >= m_parts.size()) return false;
+    traces = m_parts[k].traces;
+    occlusions = m_parts[k].occlusions;
+    return true;
 }
 
 }  // namespace lucent::cpu
