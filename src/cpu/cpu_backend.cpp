@@ -1,8 +1,9 @@
 // The CPU backend: the launch grid cut into tiles, taken by the workers of a thread pool
-// from a shared counter; each launch index runs the ray-generation program, and an
-// exception raised anywhere below it ends that index and runs the exception program. The
-// rays the programs defer wait in their worker's queue and are traced together
-// (deferred_rays.h) when it is full and when the worker's tiles are done.
+// in guided runs; each launch index runs the ray-generation program, and an exception
+// raised anywhere below it ends that index and runs the exception program. The rays the
+// programs defer wait in their worker's queue and are traced together (deferred_rays.h):
+// a worker's queue when it is full, and when the tiles are done, the rays still queued,
+// shared out among the workers.
 #include <algorithm>
 #include <atomic>
 #include <exception>
