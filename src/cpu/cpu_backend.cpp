@@ -86,7 +86,7 @@ class CpuBackend final : public core::Backend {
 
         const unsigned workers = unsigned(std::min<uint64_t>(tile_count, m_pool.size()));
         GuidedTiles tiles(tile_count, workers);
-        DeferredParts parts(workers);
+        DeferredParts parts;
         std::mutex error_mutex;
         std::exception_ptr error;
         std::atomic<bool> failed{false};
@@ -123,8 +123,7 @@ class CpuBackend final : public core::Backend {
                 } catch (...) {
                     fail();
                 }
-                // The rays every worker still holds, shared out (DeferredParts).
-                parts.arrive_and_wait();
+                // The rays the workers still hold, shared out (DeferredParts).
                 try {
                     std::span<const DeferredTrace> traces;
                     std::span<const DeferredOcclusion> occlusions;

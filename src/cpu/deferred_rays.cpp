@@ -241,24 +241,17 @@ void DeferredParts::add(const DeferredQueue& queue) {
             {{}, occlusions.subspan(begin, std::min(kPartRays, occlusions.size() - begin))});
 }
 
-void DeferredParts::arrive_and_wait() {
-    std::unique_lock lock(m_mutex);
-    if (++m_arrived == m_workers) {
-        // The largest parts first, so that the last ones taken are the smallest.
-        std::stable_sort(m_parts.begin(), m_parts.end(),
-                         [](const Part& a, const Part& b) { return a.size() > b.size(); });
-        m_all_arrived.notify_all();
-        return;
-    }
-    m_all_arrived.wait(lock, [&] { return m_arrived == m_workers; });
-}
-
 bool DeferredParts::take(std::span<const DeferredTrace>& traces,
                          std::span<const DeferredOcclusion>& occlusions) {
-    const size_t k = m_next.fetch_add(1);
-    if (k >= m_parts.size()) return false;
-    traces = m_parts[k].traces;
-    occlusions = m_parts[k].occlusions;
+    std::lock_guard lock(m_mutex);  // a few dozen parts a launch: a scan is nothing
+    if (m_parts.empty()) return false;
+    auto largest =
+        std::max_element(m_parts.begin(), m_parts.end(),
+                         [](const Part& a, const Part& b) { return a.size() < b.size(); });
+    traces = largest->traces;
+    occlusions = largest->occlusions;
+    *largest = m_parts.back();
+    m_parts.pop_back();
     return true;
 }
 

@@ -8,8 +8,6 @@
 // one by one, as trace() and occluded() would have.
 #pragma once
 
-#include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <mutex>
 #include <span>
@@ -101,17 +99,16 @@ class DeferredTracer {
 /// ray-generation program that defers its ray is fast: from one worker to another the
 /// count differs far more than the tiles' share, and a worker that traced only its own
 /// rays left the others waiting (16 workers: the deferred programs at 0.72x Embree's
-/// primary rays where one worker gave 1.22x, session 41). So each worker cuts its queue
-/// into parts, waits for the others, and then every worker takes parts, the largest first,
-/// until none is left.
+/// primary rays where one worker gave 1.22x, session 41). So each worker, its tiles done,
+/// adds its queue in parts and then takes parts, the largest left first, its own or
+/// another's, until none is left. Nobody waits for a worker that is late: its parts are
+/// traced by itself and by whoever is still taking (a barrier before the taking left
+/// every worker waiting whenever one was descheduled, session 41).
 class DeferredParts {
   public:
-    explicit DeferredParts(unsigned workers) : m_workers(workers) {}
     /// Adds `queue`'s rays in parts; the queue must not change until the launch has ended.
     void add(const DeferredQueue& queue);
-    /// Waits until every worker has called it (each once, having added its queue).
-    void arrive_and_wait();
-    /// The next part: rays of one kind (the other span empty); false when none is left.
+    /// The largest part left: rays of one kind (the other span empty); false when none is.
     bool take(std::span<const DeferredTrace>& traces,
               std::span<const DeferredOcclusion>& occlusions);
 
@@ -121,12 +118,8 @@ class DeferredParts {
         std::span<const DeferredOcclusion> occlusions;
         size_t size() const { return traces.size() + occlusions.size(); }
     };
-    const unsigned m_workers;
     std::mutex m_mutex;
-    std::condition_variable m_all_arrived;
-    unsigned m_arrived = 0;
-    std::vector<Part> m_parts;
-    std::atomic<size_t> m_next{0};
+    std::vector<Part> m_parts;  // those not taken yet
 };
 
 }  // namespace lucent::cpu
