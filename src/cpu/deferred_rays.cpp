@@ -36,9 +36,9 @@ bool streams_occlusion(const CompiledScene& scene, Handle root, Occlusion test) 
 /// Orders the positions of `queue` into `order` so that the rays one query traces together
 /// (the same `key`) lie next to each other, each key's in queue order and the keys in the
 /// order of their first rays, and puts where each key's rays end into `ends`. Most launches
-/// have one key. Both vectors keep their memory from call to call: a buffer of a worker's
-/// 65,536 rays allocated per call was mapped and unmapped each time, which with 16 workers
-/// cost more than the rays' programs.
+/// have one key. Both vectors keep their memory from call to call, so that a flush
+/// allocates nothing once the first has run (a 256 KB buffer per call would be mapped and
+/// unmapped by the allocator each time).
 template <class Entry, class Key>
 void order_by_key(std::span<const Entry> queue, Key key, std::vector<uint32_t>& order,
                   std::vector<size_t>& ends) {
