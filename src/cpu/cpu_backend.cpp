@@ -25,10 +25,9 @@ constexpr unsigned kTileWidth = 8, kTileHeight = 8, kTile1D = 64;
 
 /// The tiles of a piece handed out in runs of consecutive tiles, each run a share of the
 /// tiles still left (OpenMP's guided schedule). A worker's deferred rays then come from a
-/// few compact parts of the grid, so that their ray streams share the tree's nodes (from
-/// tiles handed out one by one, 16 workers' streams of primary rays ran at 0.66x Embree on
-/// a 16-core Xeon, session 41), and the last runs are single tiles, so that the workers
-/// still finish together.
+/// few compact parts of the grid, so that their ray streams share the tree's nodes, where
+/// tiles handed out one at a time scatter each worker's rays over the whole grid; and the
+/// last runs are single tiles, so that the workers still finish together.
 class GuidedTiles {
   public:
     GuidedTiles(uint64_t count, unsigned workers)
