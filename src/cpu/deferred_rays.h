@@ -97,9 +97,9 @@ class DeferredTracer {
 /// The rays the workers of a launch still hold when their tiles are done, shared out. A
 /// worker's rays are those of the launch indices it happened to run, and running a
 /// ray-generation program that defers its ray is fast: from one worker to another the
-/// count differs far more than the tiles' share, and a worker that traced only its own
-/// rays left the others waiting (16 workers: the deferred programs at 0.72x Embree's
-/// primary rays where one worker gave 1.22x, session 41). So each worker, its tiles done,
+/// count can differ far more than the tiles' share, and a worker that traced only its own
+/// rays would leave the others waiting (with each tracing its own, 16 workers ran the
+/// deferred programs at 0.72x Embree's primary rays where one worker gave 1.22x, session 41). So each worker, its tiles done,
 /// adds its queue in parts and then takes parts, the largest left first, its own or
 /// another's, until none is left. Nobody waits for a worker that is late: its parts are
 /// traced by itself and by whoever is still taking. (With a barrier before the taking, two
