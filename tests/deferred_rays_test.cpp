@@ -18,10 +18,16 @@ using namespace lucent_tests;
 
 class DeferredRaysTest : public testing::Test {
   protected:
-    DeferredRaysTest() : ctx(test_context_options()) {
+    explicit DeferredRaysTest(unsigned cpu_threads = 2) : ctx(options(cpu_threads)) {
         ctx.set_entry_point_count(1);
         ctx.set_ray_type<TestPayload>(0, "radiance");
         ctx.set_miss_program(0, program(ctx, LUCENT_PROGRAM(common_miss)));
+    }
+
+    static ContextOptions options(unsigned cpu_threads) {
+        ContextOptions o = test_context_options();
+        o.threads = cpu_threads;
+        return o;
     }
 
     /// The payloads of `rays` cast by ray-generation program `caster` against `top` (with
@@ -103,6 +109,33 @@ class DeferredRaysTest : public testing::Test {
 TEST_F(DeferredRaysTest, ClosestHitsOfATriangleGroupAreTraceOnes) {
     // More rays than a CPU worker's queue holds (65,536): the queue is traced mid-launch too.
     expect_same_as_trace(clutter_group(), rays_down(150000));
+}
+
+/// Eight CPU workers (more than the machine's cores is no matter): they publish full queues
+/// mid-launch, take runs of each other's queues between their tiles and share out the
+/// rays left at the end (SharedDeferredRays).
+class DeferredRaysEightWorkersTest : public DeferredRaysTest {
+  protected:
+    DeferredRaysEightWorkersTest() : DeferredRaysTest(8) {}
+};
+
+TEST_F(DeferredRaysEightWorkersTest, ClosestHitsOfATriangleGroupAreTraceOnes) {
+    // About 75K rays a worker: each queue fills at least once.
+    expect_same_as_trace(clutter_group(), rays_down(600000));
+}
+
+TEST_F(DeferredRaysEightWorkersTest, ALaunchThatFailsLateEndsWithItsError) {
+    if (test_backend() != BackendKind::kCpu)
+        GTEST_SKIP() << "the GPU traces the ray at once, while the local still exists";
+    auto top = clutter_group();
+    const auto rays = rays_down(600000);
+    expect_error([&] { cast(LUCENT_PROGRAM(deferred_cast_last_into_local), top, rays); },
+                 {"trace_deferred()", "local variable", "buffer"});
+    // The workers are free again: the next launch runs whole.
+    const auto results = cast(LUCENT_PROGRAM(deferred_cast), top, rays);
+    size_t hits = 0;
+    for (const TestPayload& p : results) hits += p.hit == 1;
+    EXPECT_GT(hits, rays.size() / 4);
 }
 
 TEST_F(DeferredRaysTest, EveryOtherRootAnswersAsTrace) {

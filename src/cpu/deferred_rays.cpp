@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <thread>
 #include <utility>
 
 #include "cpu/triangle_groups.h"
@@ -84,29 +85,30 @@ bool built_in_attributes(const CompiledScene& scene, const CompiledNode& n) {
 
 }  // namespace
 
-void DeferredTracer::trace(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
-                           std::span<const DeferredTrace> rays) {
-    order_by_key(
-        rays, [](const DeferredTrace& q) { return uint64_t(q.root.index) << 32 | q.ray.ray_type; },
-        m_order, m_group_ends);
+template <class Entry, class Key, class TraceGroup>
+void DeferredTracer::by_group(ThreadState& ts, std::span<const Entry> rays, Key key,
+                              TraceGroup trace_group) {
+    order_by_key(rays, key, m_order, m_group_ends);
     for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
-        trace_group(ts, entry, out, rays,
-                    std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
+        trace_group(std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
     ts.depth = 0;
     ts.frame = nullptr;
 }
 
+void DeferredTracer::trace(ThreadState& ts, const core::CompiledEntry& entry, WorkerExceptions& out,
+                           std::span<const DeferredTrace> rays) {
+    by_group(
+        ts, rays,
+        [](const DeferredTrace& q) { return uint64_t(q.root.index) << 32 | q.ray.ray_type; },
+        [&](std::span<const uint32_t> group) { trace_group(ts, entry, out, rays, group); });
+}
+
 void DeferredTracer::occlude(ThreadState& ts, const core::CompiledEntry& entry,
                              WorkerExceptions& out, std::span<const DeferredOcclusion> rays) {
-    order_by_key(
-        rays,
+    by_group(
+        ts, rays,
         [](const DeferredOcclusion& q) { return uint64_t(q.root.index) << 32 | unsigned(q.test); },
-        m_order, m_group_ends);
-    for (size_t g = 0, begin = 0; g < m_group_ends.size(); begin = m_group_ends[g++])
-        occlude_group(ts, entry, out, rays,
-                      std::span<const uint32_t>(m_order).subspan(begin, m_group_ends[g] - begin));
-    ts.depth = 0;
-    ts.frame = nullptr;
+        [&](std::span<const uint32_t> group) { occlude_group(ts, entry, out, rays, group); });
 }
 
 void DeferredTracer::trace_group(ThreadState& ts, const core::CompiledEntry& entry,
@@ -227,32 +229,80 @@ void DeferredTracer::occlude_group(ThreadState& ts, const core::CompiledEntry& e
     }
 }
 
-void DeferredParts::add(const DeferredQueue& queue) {
-    // Parts of 16K rays: large enough for a stream to gain on incoherent rays (session 38),
-    // small enough that 16 workers get several each.
-    constexpr size_t kPartRays = 16384;
-    std::lock_guard lock(m_mutex);
-    const auto traces = queue.traces();
-    for (size_t begin = 0; begin < traces.size(); begin += kPartRays)
-        m_parts.push_back({traces.subspan(begin, std::min(kPartRays, traces.size() - begin)), {}});
-    const auto occlusions = queue.occlusions();
-    for (size_t begin = 0; begin < occlusions.size(); begin += kPartRays)
-        m_parts.push_back(
-            {{}, occlusions.subspan(begin, std::min(kPartRays, occlusions.size() - begin))});
+void SharedDeferredRays::publish(unsigned id, const DeferredQueue& queue) {
+    {
+        std::lock_guard lock(m_mutex);
+        m_queues[id].traces = queue.traces();
+        m_queues[id].occlusions = queue.occlusions();
+        m_left += m_queues[id].size();
+        m_published += m_queues[id].size();
+        m_progress[id / kQueuesPerWorker].queued.store(0, std::memory_order_relaxed);
+    }
+    if (queue.size() != 0) announce();
 }
 
-bool DeferredParts::take(std::span<const DeferredTrace>& traces,
-                         std::span<const DeferredOcclusion>& occlusions) {
-    std::lock_guard lock(m_mutex);  // a few dozen parts a launch: a scan is nothing
-    if (m_parts.empty()) return false;
-    auto largest =
-        std::max_element(m_parts.begin(), m_parts.end(),
-                         [](const Part& a, const Part& b) { return a.size() < b.size(); });
-    traces = largest->traces;
-    occlusions = largest->occlusions;
-    *largest = m_parts.back();
-    m_parts.pop_back();
+size_t SharedDeferredRays::rays_to_trace() const {
+    uint64_t tiles_run = 0;
+    size_t queued = 0;
+    for (const Progress& p : m_progress) {
+        tiles_run += p.tiles.load(std::memory_order_relaxed);
+        queued += p.queued.load(std::memory_order_relaxed);
+    }
+    const double per_tile = tiles_run ? double(m_published + queued) / double(tiles_run) : 0.0;
+    const uint64_t tiles_left = m_tiles - std::min(m_tiles, tiles_run);
+    return m_left.load(std::memory_order_relaxed) + queued + size_t(per_tile * double(tiles_left));
+}
+
+bool SharedDeferredRays::take(unsigned worker, Run& run) {
+    // Runs of 1K rays at least, where a stream still pays on coherent rays, and a whole
+    // queue at most.
+    constexpr size_t kShortest = 1024, kLongest = accel::kStreamBatch;
+    if (!any_left())
+        return false;  // without the lock: workers that wait for others' tiles ask often
+    std::lock_guard lock(m_mutex);  // some dozens of runs a launch: a scan of the queues is nothing
+    const size_t left = m_left.load(std::memory_order_relaxed);
+    if (left == 0) return false;
+    Queue* from = &m_queues[queue_id(worker, 0)];
+    for (unsigned k = 1; k < kQueuesPerWorker && from->size() == 0; ++k)
+        from = &m_queues[queue_id(worker, k)];
+    if (from->size() == 0)
+        from =
+            &*std::max_element(m_queues.begin(), m_queues.end(),
+                               [](const Queue& a, const Queue& b) { return a.size() < b.size(); });
+    const size_t n = std::clamp(rays_to_trace() / (2 * size_t(m_workers)), kShortest, kLongest);
+    run.queue = unsigned(from - m_queues.data());
+    run.traces = from->traces.first(std::min(n, from->traces.size()));
+    from->traces = from->traces.subspan(run.traces.size());
+    run.occlusions = {};
+    if (run.traces.empty()) {
+        run.occlusions = from->occlusions.first(std::min(n, from->occlusions.size()));
+        from->occlusions = from->occlusions.subspan(run.occlusions.size());
+    }
+    ++from->runs_out;
+    m_left.store(left - run.traces.size() - run.occlusions.size(), std::memory_order_relaxed);
     return true;
+}
+
+void SharedDeferredRays::done(const Run& run) {
+    std::lock_guard lock(m_mutex);
+    --m_queues[run.queue].runs_out;
+}
+
+void SharedDeferredRays::reclaim(unsigned id) {
+    for (;;) {
+        {
+            std::lock_guard lock(m_mutex);
+            Queue& q = m_queues[id];
+            if (q.runs_out == 0) {
+                m_left.store(m_left.load(std::memory_order_relaxed) - q.size(),
+                             std::memory_order_relaxed);
+                q.traces = {};
+                q.occlusions = {};
+                return;
+            }
+        }
+        std::this_thread::yield();
+    }
 }
 
 }  // namespace lucent::cpu

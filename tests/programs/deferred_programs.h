@@ -50,6 +50,21 @@ LUCENT_RAY_GENERATION(deferred_cast_into_local, CasterRecord) {
     rec.results[i] = p;
 }
 
+/// Wrong at the last launch index alone (its payload a local): the launch fails late, while
+/// the other indices' rays are queued and traced.
+LUCENT_RAY_GENERATION(deferred_cast_last_into_local, CasterRecord) {
+    const unsigned i = launch_index().x;
+    const CastRay r = rec.rays[i];
+    rec.results[i] = make_test_payload();
+    if (i + 1 < launch_size().x) {
+        trace_deferred(rec.top, make_ray(r.origin, r.direction, 0, 1e-4f), rec.results[i]);
+        return;
+    }
+    TestPayload p = make_test_payload();
+    trace_deferred(rec.top, make_ray(r.origin, r.direction, 0, 1e-4f), p);
+    rec.results[i] = p;
+}
+
 /// Two rays a launch index, both deferred: along the ray into results, back into backward.
 struct BothWaysRecord {
     Handle top;
