@@ -22,16 +22,9 @@ using lucent::cpu::SharedDeferredRays;
 /// tmin its number (traces first).
 DeferredQueue numbered_queue(size_t traces, size_t occlusions, size_t first = 0) {
     DeferredQueue queue;
-    for (size_t i = 0; i < traces; ++i) {
-        DeferredTrace t{};
-        t.ray.tmin = float(first + i);
-        queue.add(t);
-    }
-    for (size_t i = 0; i < occlusions; ++i) {
-        DeferredOcclusion o{};
-        o.ray.tmin = float(first + traces + i);
-        queue.add(o);
-    }
+    for (size_t i = 0; i < traces; ++i) queue.add_trace().ray.tmin = float(first + i);
+    for (size_t i = 0; i < occlusions; ++i)
+        queue.add_occlusion().ray.tmin = float(first + traces + i);
     return queue;
 }
 

@@ -41,8 +41,9 @@ struct DeferredOcclusion {
 /// One worker's queue of deferred rays, kept from launch to launch.
 class DeferredQueue {
   public:
-    void add(const DeferredTrace& ray) { m_traces.push_back(ray); }
-    void add(const DeferredOcclusion& ray) { m_occlusions.push_back(ray); }
+    /// A new entry at the end, for the caller to fill in.
+    DeferredTrace& add_trace() { return m_traces.emplace_back(); }
+    DeferredOcclusion& add_occlusion() { return m_occlusions.emplace_back(); }
     /// Enough rays for a stream to pay (session 38: incoherent rays gain from about 16K).
     bool full() const { return size() >= accel::kStreamBatch; }
     size_t size() const { return m_traces.size() + m_occlusions.size(); }
