@@ -2,11 +2,11 @@
 // lucent/device/api.h): each worker of a CPU launch queues them while it runs launch
 // indices, and publishes its queue once it holds a ray stream's worth (kStreamBatch) and
 // when its tiles are done; the workers trace the published rays, in runs that any of them
-// may take (SharedDeferredRays). Rays of a
-// GeometryGroup of triangles whose candidates nothing needs to see are traced together as ray
-// streams (accel/ray_stream.h, Barringer and Akenine-Möller 2014); then each ray's closest-hit or
-// miss program runs on its payload, as at the end of trace(). Any other root traces its queued rays
-// one by one, as trace() and occluded() would have.
+// may take (SharedDeferredRays). Rays of a GeometryGroup of triangles whose candidates
+// nothing needs to see are traced together as ray streams (accel/ray_stream.h, Barringer and
+// Akenine-Möller 2014); then each ray's closest-hit or miss program runs on its payload, as
+// at the end of trace(). Any other root traces its rays one by one, as trace() and
+// occluded() would have.
 #pragma once
 
 #include <atomic>
@@ -110,9 +110,11 @@ class DeferredTracer {
 /// the publisher until none is left, the others between their tiles and once their own
 /// tiles are done. Each worker has two queues: when one is full and published, it queues in
 /// the other, so that it need not wait for the runs of the first that others still trace
-/// (waiting for them cost a third of the diffuse rays' speed on 2 cores). Nobody waits at
-/// the end for a worker that is late: its rays are traced by itself and by whoever still
-/// takes.
+/// (waiting for them cost a third of the diffuse rays' speed on 2 cores). A worker whose
+/// tiles are done does not leave while others still run theirs: it sleeps until rays are
+/// published or the last tiles end, so that a late worker's rays are shared too (when each
+/// left once nothing was left to take, a worker on 2 cores could trace alone for half the
+/// launch).
 ///
 /// A run is a share of the rays still to trace, as a run of tiles is of the tiles left
 /// (OpenMP's guided schedule): long runs while many rays are to come, for a stream gains on
