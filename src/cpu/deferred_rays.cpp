@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <numeric>
 #include <thread>
 #include <utility>
 
@@ -55,6 +56,11 @@ void order_by_key(std::span<const Entry> queue, Key key, std::vector<uint32_t>& 
     }
     order.resize(queue.size());
     ends.clear();
+    if (counts.size() <= 1) {  // the common case: the queue's order, without a second pass
+        std::iota(order.begin(), order.end(), 0u);
+        if (!counts.empty()) ends.push_back(queue.size());
+        return;
+    }
     std::vector<size_t> next;  // per key: where its next ray goes
     size_t end = 0;
     for (const auto& [k, count] : counts) {
