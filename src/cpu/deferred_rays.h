@@ -102,8 +102,8 @@ class DeferredTracer {
 /// tiles' share. A worker that traced its own queue alone, when it is full and when its
 /// tiles are done, would leave the others waiting: with each tracing its own, 16 workers ran
 /// the deferred programs at 0.72x Embree's primary rays where one worker gave 1.22x
-/// (session 41), and one queue's 65,536 rays take one worker longer than 16 take a whole
-/// 1024x768 launch.
+/// (session 41); and at 16 workers a 1024x768 launch is about 49K rays a worker, fewer
+/// than one full queue's 65,536.
 ///
 /// So a worker publishes its queue, when it is full and when its tiles are done, and every
 /// worker takes runs of the published rays, its own first and then the largest queue's left:
